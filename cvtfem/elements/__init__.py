@@ -1,0 +1,1 @@
+"""The element library: vectorised families of physics (one object per family)."""

@@ -1,0 +1,1 @@
+"""Results files, checkpoints and exports."""

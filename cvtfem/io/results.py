@@ -1,0 +1,175 @@
+"""Results files: one HDF5 file per run, written incrementally.
+
+Layout::
+
+    /                attrs: cvtfem_version, created, status, message, kind
+    /scene           TOML text of the resolved scene (string dataset)
+    /stats           attrs: solver statistics (counters, wall time)
+    /series/time     (n,) float64, unit "s"
+    /series/NAME     (n, size) float64, attrs unit, doc
+    /checkpoint/...  full state for resuming (written by the run driver)
+
+Rows are appended to resizable datasets and the file is flushed every
+``flush_interval`` seconds of wall time, so a run killed half-way leaves a
+readable file with every row up to the last flush (``status`` then stays
+"running"): the file is in HDF5's single-writer/multiple-reader mode, which
+keeps it consistent on disk at every moment, and readers open it with
+``swmr=True``.  Attributes and datasets cannot be created in that mode, so
+statistics, whole arrays and the final status are written when the run
+closes the file.  At each flush the series are extended first and ``time``
+last; a reader trusts the shortest of them.
+"""
+from __future__ import annotations
+
+import time
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from datetime import datetime, timezone
+from pathlib import Path
+from typing import Any
+
+import h5py
+import numpy as np
+
+from cvtfem import __version__
+from cvtfem.elements.base import OutputSpec
+from cvtfem.errors import InputError
+
+CHUNK_ROWS = 256
+
+
+class ResultsWriter:
+    """Append time histories of named outputs to an HDF5 file.
+
+    Parameters
+    ----------
+    path : str or Path
+        File to create (an existing file is refused unless ``overwrite``).
+    scene_toml : str
+        Resolved scene as TOML text.
+    kind : str
+        What produced the file ("run", "modes", ...).
+    outputs : sequence of OutputSpec
+        Series to record; each sample of a series is ``size`` floats.
+    flush_interval : float
+        Wall time between flushes, s.
+    overwrite : bool
+        Replace an existing file.
+    """
+
+    def __init__(self, path: str | Path, scene_toml: str, kind: str, outputs: Sequence[OutputSpec],
+                 flush_interval: float = 2.0, overwrite: bool = False) -> None:
+        self.path = Path(path)
+        if self.path.exists() and not overwrite:
+            raise InputError("results file", str(self.path), "must not exist already (results are never overwritten)",
+                             "choose another name or delete it")
+        self.path.parent.mkdir(parents=True, exist_ok=True)
+        self.flush_interval = flush_interval
+        self._file = h5py.File(self.path, "w", libver="latest")
+        f = self._file
+        f.attrs.update(cvtfem_version=__version__, kind=kind, status="running", message="",
+                       created=datetime.now(timezone.utc).isoformat(timespec="seconds"))
+        f.create_dataset("scene", data=scene_toml, dtype=h5py.string_dtype())
+        f.create_group("stats")
+        series = f.create_group("series")
+        t = series.create_dataset("time", shape=(0,), maxshape=(None,), chunks=(CHUNK_ROWS,), dtype="f8")
+        t.attrs.update(unit="s", doc="Simulated time.")
+        self._specs = {spec.name: spec for spec in outputs}
+        for spec in outputs:
+            d = series.create_dataset(spec.name, shape=(0, spec.size), maxshape=(None, spec.size),
+                                      chunks=(CHUNK_ROWS, spec.size), dtype="f8")
+            d.attrs.update(unit=spec.unit, doc=spec.doc)
+        self._rows = 0
+        self._buffer: list[tuple[float, dict[str, np.ndarray]]] = []
+        self._stats: dict[str, Any] = {}
+        self._arrays: dict[str, tuple[np.ndarray, str, str]] = {}
+        self._last_flush = time.monotonic()
+        f.swmr_mode = True  # single-writer/multiple-reader: the file stays consistent if the writer dies
+
+    def append(self, t: float, values: Mapping[str, Any]) -> None:
+        """Record one output sample at time ``t`` (s); flushes when due."""
+        row = {name: np.asarray(values[name], dtype=float).reshape(spec.size) for name, spec in self._specs.items()}
+        self._buffer.append((float(t), row))
+        if time.monotonic() - self._last_flush >= self.flush_interval:
+            self.flush()
+
+    def flush(self) -> None:
+        """Write buffered rows and make them visible to readers."""
+        if self._buffer:
+            n_new = len(self._buffer)
+            series = self._file["series"]
+            end = self._rows + n_new
+            for name in self._specs:
+                d = series[name]
+                d.resize((end, d.shape[1]))
+                d[self._rows:end] = np.stack([row[name] for _, row in self._buffer])
+                d.flush()
+            times = series["time"]
+            times.resize((end,))
+            times[self._rows:end] = [t for t, _ in self._buffer]
+            times.flush()
+            self._rows = end
+            self._buffer.clear()
+        self._file.flush()
+        self._last_flush = time.monotonic()
+
+    def set_stats(self, stats: Mapping[str, Any]) -> None:
+        """Solver statistics (numbers or strings), stored as ``/stats`` attributes at close."""
+        self._stats.update({k: v for k, v in stats.items() if v is not None})
+
+    def add_array(self, name: str, data: Any, unit: str = "", doc: str = "") -> None:
+        """A whole array (mode shapes, a Campbell table), stored at close."""
+        self._arrays[name] = (np.asarray(data), unit, doc)
+
+    def close(self, status: str = "finished", message: str = "") -> None:
+        """Flush, then record statistics, arrays and the final status ("finished" or "failed")."""
+        if not self._file.id.valid:
+            return
+        self.flush()
+        self._file.close()
+        with h5py.File(self.path, "r+", libver="latest") as f:
+            f.attrs.update(status=status, message=message)
+            f["stats"].attrs.update(self._stats)
+            for name, (data, unit, doc) in self._arrays.items():
+                d = f.create_dataset(name, data=data)
+                d.attrs.update(unit=unit, doc=doc)
+
+    def __enter__(self) -> ResultsWriter:
+        return self
+
+    def __exit__(self, exc_type: Any, exc: Any, tb: Any) -> None:
+        if exc is None:
+            self.close()
+        else:
+            self.close("failed", f"{type(exc).__name__}: {exc}")
+
+
+@dataclass(frozen=True)
+class Results:
+    """A results file read back: plain arrays with names and units."""
+
+    path: Path
+    attrs: dict[str, Any]
+    scene_toml: str
+    stats: dict[str, Any]
+    time: np.ndarray
+    series: dict[str, np.ndarray] = field(repr=False)
+    units: dict[str, str] = field(repr=False)
+
+
+def read_results(path: str | Path) -> Results:
+    """Read a results file (also one whose run was killed: complete rows only)."""
+    path = Path(path)
+    if not path.is_file():
+        raise InputError("RESULTS", str(path), "must be an existing results file (.h5)")
+    try:
+        f = h5py.File(path, "r", libver="latest", swmr=True, locking=False)
+    except OSError as err:
+        raise InputError("RESULTS", str(path), f"must be a readable HDF5 file ({err})") from None
+    with f:
+        group = f["series"]
+        rows = min(d.shape[0] for d in group.values())
+        series = {name: d[:rows] for name, d in group.items() if name != "time"}
+        units = {name: str(d.attrs.get("unit", "")) for name, d in group.items()}
+        return Results(path=path, attrs=dict(f.attrs), scene_toml=f["scene"][()].decode(),
+                       stats=dict(f["stats"].attrs), time=group["time"][:rows], series=series, units=units)

@@ -1,0 +1,142 @@
+"""Scene files (TOML) -> validated, immutable :class:`Scene`.
+
+A scene may start from a preset (``preset = "NAME"``) and override keys:
+tables merge key by key, arrays of tables are replaced whole.
+"""
+from __future__ import annotations
+
+import tomllib
+from collections.abc import Mapping
+from dataclasses import dataclass
+from importlib import resources
+from pathlib import Path
+from typing import Any
+
+import tomli_w
+
+from cvtfem.errors import InputError
+from cvtfem.scene.node import Node, thaw
+from cvtfem.scene.schema import SCENE, scene_kind
+from cvtfem.scene.schema.base import validate
+
+PRESET_PACKAGE = "cvtfem.scene.presets"
+
+
+@dataclass(frozen=True)
+class Scene:
+    """A validated scene.
+
+    Attributes
+    ----------
+    data : Node
+        Every key of the schema, defaults filled, read-only.
+    kind : str
+        "cvt", "rotor" or "torsional" (which machine the scene describes).
+    source : str
+        Where it came from (file path, ``preset:NAME`` or ``<dict>``).
+    """
+
+    data: Node
+    kind: str
+    source: str
+
+    def __getattr__(self, name: str) -> Any:
+        try:
+            return self.data[name]
+        except KeyError:
+            raise AttributeError(name) from None
+
+    def to_toml(self) -> str:
+        """The full resolved scene (defaults included) as TOML text."""
+        return tomli_w.dumps(_drop_none(thaw(self.data)))
+
+    def replace(self, overrides: Mapping[str, Any]) -> Scene:
+        """A new scene with ``overrides`` (nested dict) merged in and re-validated."""
+        return scene_from_dict(merge(thaw(self.data), overrides), source=self.source)
+
+
+def _drop_none(value: Any) -> Any:
+    if isinstance(value, dict):
+        return {k: _drop_none(v) for k, v in value.items() if v is not None}
+    if isinstance(value, list):
+        return [_drop_none(v) for v in value]
+    return value
+
+
+def merge(base: Mapping[str, Any], override: Mapping[str, Any]) -> dict[str, Any]:
+    """Deep-merge ``override`` into ``base``: tables merge, everything else replaces."""
+    out = dict(base)
+    for key, value in override.items():
+        if isinstance(value, Mapping) and isinstance(out.get(key), Mapping):
+            out[key] = merge(out[key], value)
+        else:
+            out[key] = value
+    return out
+
+
+def preset_names() -> list[str]:
+    """Names of the built-in presets, sorted."""
+    files = resources.files(PRESET_PACKAGE).iterdir()
+    return sorted(f.name[:-5] for f in files if f.name.endswith(".toml"))
+
+
+def preset_text(name: str) -> str:
+    """TOML text of a built-in preset (with its provenance comments)."""
+    if name not in preset_names():
+        from cvtfem.scene.schema.base import _suggest
+
+        raise InputError("preset", name, "must name a built-in preset (see `cvtfem scenes`)",
+                         _suggest(name, preset_names()) or "available: " + ", ".join(preset_names()))
+    return resources.files(PRESET_PACKAGE).joinpath(f"{name}.toml").read_text(encoding="utf-8")
+
+
+def _parse(text: str, source: str) -> dict[str, Any]:
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError as err:
+        raise InputError(source, "<file>", f"must be valid TOML: {err}") from None
+
+
+def resolve_presets(data: Mapping[str, Any], seen: tuple[str, ...] = ()) -> dict[str, Any]:
+    """Expand ``preset = "NAME"`` (recursively) into a plain merged document."""
+    name = data.get("preset")
+    if name is None:
+        return dict(data)
+    if not isinstance(name, str):
+        raise InputError("preset", name, "must be a string naming a built-in preset")
+    if name in seen:
+        raise InputError("preset", name, "must not form a cycle", " -> ".join(seen + (name,)))
+    base = resolve_presets(_parse(preset_text(name), f"preset {name}"), seen + (name,))
+    body = {k: v for k, v in data.items() if k != "preset"}
+    merged = merge(base, body)
+    merged["preset"] = name
+    return merged
+
+
+def scene_from_dict(data: Mapping[str, Any], source: str = "<dict>") -> Scene:
+    """Validate a parsed scene document (presets expanded here)."""
+    resolved = resolve_presets(data)
+    validated = validate(SCENE, resolved)
+    return Scene(data=Node(validated), kind=scene_kind(validated), source=source)
+
+
+def load_scene(spec: str | Path, overrides: Mapping[str, Any] | None = None) -> Scene:
+    """Load a scene from a TOML file or a preset name.
+
+    Parameters
+    ----------
+    spec : str or Path
+        A path to a ``.toml`` file, or the name of a built-in preset.
+    overrides : mapping, optional
+        Nested keys merged over the file's content before validation.
+    """
+    path = Path(spec)
+    if path.suffix == ".toml" or path.exists():
+        if not path.is_file():
+            raise InputError("SCENE", str(spec), "must be an existing TOML file or a preset name",
+                             "see `cvtfem scenes` for presets")
+        data, source = _parse(path.read_text(encoding="utf-8"), str(path)), str(path)
+    else:
+        preset_text(str(spec))  # raises a clear error for an unknown name
+        data, source = {"preset": str(spec)}, f"preset:{spec}"
+    return scene_from_dict(merge(data, overrides or {}), source=source)

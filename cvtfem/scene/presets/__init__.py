@@ -1,0 +1,1 @@
+"""Built-in scene presets (TOML files beside this module)."""

@@ -1,0 +1,34 @@
+"""Scene keys shared by every kind of machine: identity, solver, output."""
+from __future__ import annotations
+
+from cvtfem.scene.schema.base import Key, Table
+
+#: Method names understood by ``cvtfem.integrate.solve`` (plus scipy's).
+METHODS = (
+    "euler", "rk4", "dopri45", "dopri56", "dopri78", "gbs", "euler-extrapolation",
+    "sw24", "w1", "theta", "trapezoidal", "dumka3", "rock2", "rock4", "rkc",
+    "RK23", "RK45", "DOP853", "Radau", "BDF", "LSODA",
+)
+
+SOLVER = Table("solver", "Time integration settings (used by `cvtfem run`).", (
+    Key("method", "str", "Integration method.", "", "Radau", choices=METHODS),
+    Key("t_end", "float", "Simulated time to reach.", "s", 1.0, gt=0.0),
+    Key("h", "float", "Fixed step, or initial step of adaptive methods (0: automatic).", "s", 0.0, ge=0.0),
+    Key("rtol", "float", "Relative tolerance of adaptive methods.", "-", 1e-6, gt=0.0, lt=1.0),
+    Key("atol", "float", "Absolute tolerance of adaptive methods.", "-", 1e-9, gt=0.0),
+    Key("max_steps", "int", "Step budget; the run fails with a clear message past it.", "-", 10_000_000, ge=1),
+))
+
+OUTPUT = Table("output", "What a run writes and how often.", (
+    Key("step", "float", "Output sampling interval of time histories.", "s", 1e-3, gt=0.0),
+    Key("names", "str[]", "Outputs to record (empty: all the model offers; see `cvtfem describe`).", "", ()),
+    Key("flush_interval", "float", "Wall time between flushes of the results file.", "s", 2.0, gt=0.0),
+    Key("checkpoint_interval", "float", "Simulated time between full-state checkpoints (0: none).", "s", 0.0, ge=0.0),
+))
+
+IDENTITY = (
+    Key("title", "str", "Short name of the scene.", "", ""),
+    Key("description", "str", "One-line description (shown by `cvtfem scenes` for presets).", "", ""),
+    Key("preset", "str", "Built-in preset this scene starts from (its keys can be overridden).", "", ""),
+    Key("seed", "int", "Seed of every random choice (e.g. the long/short link pattern).", "-", 0, ge=0),
+)
