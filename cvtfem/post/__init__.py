@@ -1,0 +1,1 @@
+"""Post-processing and plots (matplotlib is imported lazily inside functions)."""
