@@ -18,5 +18,5 @@ def progress(total: float, unit: str = "s", desc: str = "") -> Any:
 
     Call ``bar.update(delta)`` as the analysis advances and ``bar.close()`` at the end.
     """
-    return tqdm(total=total, unit=unit, desc=desc, disable=not progress_enabled(), leave=False,
+    return tqdm(total=total, unit=unit, desc=desc, disable=not progress_enabled(), leave=False, file=sys.stderr,
                 bar_format="{desc} {percentage:3.0f}%|{bar}| {n:.4g}/{total:.4g} {unit} [{elapsed}<{remaining}]")
