@@ -36,7 +36,7 @@ class InputError(CvtfemError, ValueError):
         text = f"`{where}` {rule}, got {value!r}"
         if hint:
             text += f" ({hint})"
-        super().__init__(text)
+        super().__init__(" ".join(text.splitlines()))  # one line, whatever the value holds
 
 
 class NumericalError(CvtfemError, RuntimeError):
