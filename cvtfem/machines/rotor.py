@@ -1,21 +1,169 @@
-"""Layout of a rotor scene: shaft beam elements, disks, bearings (6 DOF per node)."""
+"""Rotor scenes -> layout and linear model (sparse M, K, C, G).
+
+Nodes are numbered from 0 at the left end of the first shaft element; each
+node has the 6 DOF ``(u1, u2, u3, theta1, theta2, phi)``.  Disks with an
+elastic connection get their own node after the shaft nodes.  Equation of
+motion (spec §12.6): ``M q'' + (C + Omega G) q' + K q = 0``.
+"""
 from __future__ import annotations
 
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+
+from cvtfem.assembly import assemble
 from cvtfem.elements.base import Layout, OutputSpec
+from cvtfem.elements.beam import BeamFamily, BeamOptions
+from cvtfem.elements.bearing import BearingFamily, RadialLaw
+from cvtfem.elements.disk import DiskFamily, connection_stiffness, disc_profile, sheave_profile
 from cvtfem.scene.loader import Scene
+
+#: Names of the 6 DOF of a node, in order.
+DOF_NAMES = ("u1", "u2", "u3", "theta1", "theta2", "phi")
+
+
+@dataclass(frozen=True)
+class RotorModel:
+    """Linear rotor model.
+
+    Attributes
+    ----------
+    M, K, C, G : scipy.sparse.csr_matrix (n, n)
+        Mass, stiffness, damping, gyroscopic per unit spin speed (skew).
+    z : array (n_nodes,)
+        Axial node positions, m (elastic-connection disk nodes sit at their shaft node).
+    beam, disks, bearings : element families
+        For rendering and outputs.
+    """
+
+    M: sp.csr_matrix
+    K: sp.csr_matrix
+    C: sp.csr_matrix
+    G: sp.csr_matrix
+    z: np.ndarray
+    beam: BeamFamily
+    disks: DiskFamily
+    bearings: BearingFamily
+
+    @property
+    def n_dof(self) -> int:
+        return self.M.shape[0]
+
+    @property
+    def dof_kind(self) -> np.ndarray:
+        """Index into :data:`DOF_NAMES` of every DOF."""
+        return np.tile(np.arange(6), self.n_dof // 6)
+
+
+def _shaft_arrays(scene: Scene) -> dict[str, np.ndarray]:
+    mats = {m.name: m for m in scene.material}
+    rows = [s for s in scene.shaft for _ in range(s.repeat)]
+    return {"L": np.array([s.length for s in rows]),
+            "Do": np.array([s.outer_diameter for s in rows]),
+            "Di": np.array([s.inner_diameter for s in rows]),
+            "E": np.array([mats[s.material].E for s in rows]),
+            "G": np.array([mats[s.material].G for s in rows]),
+            "rho": np.array([mats[s.material].rho for s in rows])}
+
+
+def _disk_properties(scene: Scene) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    mats = {m.name: m for m in scene.material}
+    m, Id, Ip = [], [], []
+    for d in scene.disk:
+        if d.geometry:
+            from cvtfem.elements.disk import axisymmetric_properties
+
+            if d.geometry == "disc":
+                prof = disc_profile(d.width, d.inner_diameter, d.outer_diameter)
+            else:
+                prof = sheave_profile(d.inner_diameter, d.outer_diameter, d.hub_diameter, d.hub_length,
+                                      d.rim_thickness, d.cone_angle, d.face, d.torus_radius)
+            p = axisymmetric_properties(*prof, mats[d.material].rho)
+            m.append(p.m), Id.append(p.Id), Ip.append(p.Ip)
+        else:
+            m.append(d.mass), Id.append(d.Id), Ip.append(d.Ip)
+    return np.array(m), np.array(Id), np.array(Ip)
+
+
+def _bearings(scene: Scene) -> BearingFamily:
+    entries = []
+    for b in scene.bearing:
+        e = {k: b[k] for k in ("kxx", "kxy", "kyx", "kyy", "cxx", "cxy", "cyx", "cyy", "kzz", "czz",
+                               "ktt", "ctt", "kphi", "cphi", "Id", "Ip")}
+        e["m"] = b.mass
+        if b.law != "linear":
+            law = RadialLaw(u=b.table_u, f=b.table_f) if b.law == "table" else RadialLaw(coeffs=b.coeffs)
+            Kt = law.tangent(np.array(b.u0))
+            e.update(kxx=Kt[0, 0], kxy=Kt[0, 1], kyx=Kt[1, 0], kyy=Kt[1, 1])
+        entries.append(e)
+    return BearingFamily.from_dicts(np.array([b.node for b in scene.bearing], dtype=np.int64), entries)
+
+
+def build_model(scene: Scene) -> RotorModel:
+    """Assemble the linear rotor model of a rotor scene.
+
+    Parameters
+    ----------
+    scene : Scene
+        A scene with ``kind == "rotor"``.
+
+    Returns
+    -------
+    RotorModel
+    """
+    opts = scene.rotor
+    theory = opts.theory if opts else "timoshenko"
+    arrays = _shaft_arrays(scene)
+    n_el = len(arrays["L"])
+    kappa = None
+    if opts and opts.shear_coefficient > 0:
+        kappa = np.full(n_el, opts.shear_coefficient)
+    beam = BeamFamily(nodes=np.stack([np.arange(n_el), np.arange(1, n_el + 1)], axis=1), kappa=kappa,
+                      options=BeamOptions(shear=theory == "timoshenko",
+                                          rotary_inertia=opts.rotary_inertia if opts else True,
+                                          gyroscopic=opts.gyroscopic if opts else True), **arrays)
+    n_shaft = n_el + 1
+    elastic = [i for i, d in enumerate(scene.disk) if d.connection == "elastic"]
+    disk_nodes = np.array([d.node for d in scene.disk], dtype=np.int64)
+    disk_nodes[elastic] = n_shaft + np.arange(len(elastic))
+    m, Id, Ip = _disk_properties(scene)
+    disks = DiskFamily(disk_nodes, m, Id, Ip)
+    bearings = _bearings(scene)
+    n = 6 * (n_shaft + len(elastic))
+    Kshaft = beam.stiffness(opts.axial_force if opts else 0.0)
+    conn_dofs = np.zeros((0, 12), dtype=np.int64)
+    conn = np.zeros((0, 12, 12))
+    if elastic:
+        ds = [scene.disk[i] for i in elastic]
+        conn = connection_stiffness(*(np.array([d[k] for d in ds]) for k in ("c_u", "c_theta", "c_3", "c_phi")))
+        shaft_nodes = np.array([d.node for d in ds], dtype=np.int64)
+        conn_dofs = np.concatenate([shaft_nodes[:, None] * 6 + np.arange(6), disks.dofs[elastic]], axis=1)
+    M = assemble(n, [(beam.mass(), beam.dofs), (disks.mass(), disks.dofs), (bearings.mass(), bearings.dofs)])
+    K = assemble(n, [(Kshaft, beam.dofs), (bearings.stiffness(), bearings.dofs), (conn, conn_dofs)])
+    beta = opts.damping_beta if opts else 0.0
+    C = assemble(n, [(bearings.damping(), bearings.dofs), (beta * Kshaft, beam.dofs)])
+    G = assemble(n, [(beam.gyroscopic(), beam.dofs), (disks.gyroscopic(), disks.dofs),
+                     (bearings.gyroscopic(), bearings.dofs)])
+    z = np.concatenate([[0.0], np.cumsum(arrays["L"]), np.zeros(len(elastic))])
+    z[n_shaft:] = z[[scene.disk[i].node for i in elastic]]
+    return RotorModel(M, K, C, G, z, beam, disks, bearings)
 
 
 def layout(scene: Scene) -> tuple[Layout, ...]:
     """Components of a rotor model: the beam carries all nodal DOFs."""
     n_elements = sum(s.repeat for s in scene.shaft)
     nodes = n_elements + 1
-    parts = [Layout("shaft", "timoshenko-beam", 6 * nodes,
+    theory = scene.rotor.theory if scene.rotor else "timoshenko"
+    parts = [Layout("shaft", f"{theory}-beam", 6 * nodes,
                     outputs=(OutputSpec("shaft.displacement", "m", "Nodal displacements and rotations.", 6 * nodes),),
                     note=f"{nodes} nodes x 6")]
     if scene.disk:
-        parts.append(Layout("disks", "rigid-disk", 0, note=f"{len(scene.disk)} disks on shaft nodes"))
+        extra = sum(d.connection == "elastic" for d in scene.disk)
+        parts.append(Layout("disks", "rigid-disk", 6 * extra,
+                            note=f"{len(scene.disk)} disks on shaft nodes, {extra} elastically connected"))
     if scene.bearing:
-        parts.append(Layout("bearings", "linear-bearing", 0,
+        parts.append(Layout("bearings", "bearing", 0,
                             outputs=(OutputSpec("bearing.force", "N", "Bearing forces x, y.", 2 * len(scene.bearing)),),
                             note=f"{len(scene.bearing)} bearings on shaft nodes"))
     return tuple(parts)

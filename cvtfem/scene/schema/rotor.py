@@ -27,24 +27,98 @@ SHAFT = TableArray("shaft", "Shaft elements in order along the axis.", Table("sh
     Key("repeat", "int", "Number of identical consecutive elements this entry stands for.", "-", 1, ge=1),
 ), checks=(lambda t, p: _check_section(t, p),)))
 
-DISK = TableArray("disk", "Rigid disks on shaft nodes.", Table("disk", "A rigid disk.", (
-    Key("node", "int", "Shaft node the disk sits on.", "-", ge=0),
-    Key("mass", "float", "Mass.", "kg", gt=0.0),
-    Key("Id", "float", "Diametral moment of inertia.", "kg m^2", gt=0.0),
-    Key("Ip", "float", "Polar moment of inertia.", "kg m^2", gt=0.0),
-)))
+ROTOR = Table("rotor", "Rotor model options (beam theory, switches, damping, analysis defaults).", (
+    Key("theory", "str", "Beam theory of the shaft elements.", "", "timoshenko",
+        choices=("timoshenko", "euler-bernoulli")),
+    Key("rotary_inertia", "bool", "Rotary inertia of the shaft sections.", "", True),
+    Key("gyroscopic", "bool", "Shaft gyroscopic matrix (disks always have theirs).", "", True),
+    Key("shear_coefficient", "float", "Timoshenko shear coefficient; 0: Cowper's formula per section.", "-",
+        0.0, ge=0.0, le=1.0),
+    Key("axial_force", "float", "Axial force in the whole shaft (tension > 0) for the geometric stiffness.",
+        "N", 0.0),
+    Key("damping_beta", "float", "Stiffness-proportional shaft damping C = beta K_shaft.", "s", 0.0, ge=0.0),
+    Key("speed", "float", "Default spin speed of `cvtfem modes`.", "rad/s", 0.0),
+    Key("n_modes", "int", "Default number of modes reported.", "-", 12, ge=1),
+), optional=True)
 
-BEARING = TableArray("bearing", "Linear bearings on shaft nodes.", Table("bearing", "A linear bearing.", (
+DISK = TableArray("disk", "Rigid disks / sheaves on shaft nodes.", Table("disk", "A rigid disk or sheave.", (
+    Key("node", "int", "Shaft node the disk sits on.", "-", ge=0),
+    Key("mass", "float", "Mass (0: from `geometry`).", "kg", 0.0, ge=0.0),
+    Key("Id", "float", "Diametral moment of inertia (0: from `geometry`).", "kg m^2", 0.0, ge=0.0),
+    Key("Ip", "float", "Polar moment of inertia (0: from `geometry`).", "kg m^2", 0.0, ge=0.0),
+    Key("geometry", "str", "Compute mass properties from a section: '' (use mass/Id/Ip), 'disc' or 'sheave'.",
+        "", "", choices=("", "disc", "sheave")),
+    Key("material", "str", "Material of a geometric disk (name of a `[[material]]`).", "", ""),
+    Key("width", "float", "Disc width (geometry = 'disc').", "m", 0.0, ge=0.0),
+    Key("inner_diameter", "float", "Bore diameter.", "m", 0.0, ge=0.0),
+    Key("outer_diameter", "float", "Outer diameter.", "m", 0.0, ge=0.0),
+    Key("hub_diameter", "float", "Sheave hub outer diameter.", "m", 0.0, ge=0.0),
+    Key("hub_length", "float", "Sheave hub length behind the disc.", "m", 0.0, ge=0.0),
+    Key("rim_thickness", "float", "Sheave thickness at the outer diameter.", "m", 0.0, ge=0.0),
+    Key("cone_angle", "float", "Sheave face angle from the radial plane.", "rad", 0.192, ge=0.0, lt=1.5),
+    Key("face", "str", "Sheave contact face generatrix.", "", "conical", choices=("conical", "toroidal")),
+    Key("torus_radius", "float", "Toroidal face arc radius.", "m", 0.0, ge=0.0),
+    Key("connection", "str", "Sheave-shaft connection: rigid (same node) or elastic (own node, springs).", "",
+        "rigid", choices=("rigid", "elastic")),
+    Key("c_u", "float", "Elastic connection radial stiffness.", "N/m", 0.0, ge=0.0),
+    Key("c_theta", "float", "Elastic connection tilt stiffness.", "N m/rad", 0.0, ge=0.0),
+    Key("c_3", "float", "Elastic connection axial stiffness.", "N/m", 0.0, ge=0.0),
+    Key("c_phi", "float", "Elastic connection torsional stiffness.", "N m/rad", 0.0, ge=0.0),
+), checks=(lambda t, p: _check_disk(t, p),)))
+
+BEARING = TableArray("bearing", "Bearings (supports to ground) on shaft nodes.", Table("bearing", "A bearing.", (
     Key("node", "int", "Shaft node the bearing supports.", "-", ge=0),
-    *(Key(f"k{ij}", "float", f"Stiffness coefficient {ij}.", "N/m", 0.0) for ij in ("xx", "yy", "xy", "yx")),
-    *(Key(f"c{ij}", "float", f"Damping coefficient {ij}.", "N s/m", 0.0) for ij in ("xx", "yy", "xy", "yx")),
-)))
+    *(Key(f"k{ij}", "float", f"Lateral stiffness coefficient {ij}.", "N/m", 0.0) for ij in ("xx", "yy", "xy", "yx")),
+    *(Key(f"c{ij}", "float", f"Lateral damping coefficient {ij}.", "N s/m", 0.0) for ij in ("xx", "yy", "xy", "yx")),
+    Key("kzz", "float", "Axial stiffness.", "N/m", 0.0),
+    Key("czz", "float", "Axial damping.", "N s/m", 0.0),
+    Key("ktt", "float", "Tilting stiffness (both tilts).", "N m/rad", 0.0),
+    Key("ctt", "float", "Tilting damping.", "N m s/rad", 0.0),
+    Key("kphi", "float", "Torsional stiffness to ground.", "N m/rad", 0.0),
+    Key("cphi", "float", "Torsional damping to ground.", "N m s/rad", 0.0),
+    Key("mass", "float", "Lumped bearing mass.", "kg", 0.0, ge=0.0),
+    Key("Id", "float", "Lumped diametral inertia.", "kg m^2", 0.0, ge=0.0),
+    Key("Ip", "float", "Lumped polar inertia.", "kg m^2", 0.0, ge=0.0),
+    Key("law", "str", "Lateral law: linear (kxx..) or the isotropic radial law f_r(u) as table or polynomial.",
+        "", "linear", choices=("linear", "table", "polynomial")),
+    Key("table_u", "float[]", "Radial deflections of the table law, from 0, increasing.", "m", ()),
+    Key("table_f", "float[]", "Radial forces of the table law, from 0.", "N", ()),
+    Key("coeffs", "float[]", "Polynomial law f_r = c1 u + c2 u^2 + ...", "N/m^n", ()),
+    Key("u0", "float[]", "Operating lateral deflection (u1, u2) for the tangent stiffness.", "m", (0.0, 0.0),
+        length=2),
+), checks=(lambda t, p: _check_bearing(t, p),)))
 
 
 def _check_section(table: Mapping[str, Any], path: str) -> None:
     if table["inner_diameter"] >= table["outer_diameter"]:
         raise InputError(f"{path}.inner_diameter", table["inner_diameter"],
                          f"must be smaller than `outer_diameter` = {table['outer_diameter']} m")
+
+
+def _check_disk(table: Mapping[str, Any], path: str) -> None:
+    if not table["geometry"]:
+        for key in ("mass", "Id", "Ip"):
+            if table[key] <= 0:
+                raise InputError(f"{path}.{key}", table[key], "must be > 0 unless `geometry` is given")
+        return
+    if not table["material"]:
+        raise InputError(f"{path}.material", "", "is required with `geometry` (name of a `[[material]]`)")
+    if table["outer_diameter"] <= table["inner_diameter"]:
+        raise InputError(f"{path}.outer_diameter", table["outer_diameter"],
+                         f"must exceed `inner_diameter` = {table['inner_diameter']} m")
+    if table["geometry"] == "disc" and table["width"] <= 0:
+        raise InputError(f"{path}.width", table["width"], "must be > 0 for geometry = 'disc'")
+    if table["geometry"] == "sheave" and not (table["inner_diameter"] < table["hub_diameter"]
+                                              < table["outer_diameter"]):
+        raise InputError(f"{path}.hub_diameter", table["hub_diameter"],
+                         "must lie between `inner_diameter` and `outer_diameter` for geometry = 'sheave'")
+
+
+def _check_bearing(table: Mapping[str, Any], path: str) -> None:
+    if table["law"] == "table" and (len(table["table_u"]) < 2 or len(table["table_u"]) != len(table["table_f"])):
+        raise InputError(f"{path}.table_u", table["table_u"], "needs >= 2 values and as many `table_f` values")
+    if table["law"] == "polynomial" and not table["coeffs"]:
+        raise InputError(f"{path}.coeffs", table["coeffs"], "needs at least one coefficient for law = 'polynomial'")
 
 
 def check_rotor(scene: Mapping[str, Any], path: str) -> None:
@@ -55,7 +129,11 @@ def check_rotor(scene: Mapping[str, Any], path: str) -> None:
             from cvtfem.scene.schema.base import _suggest
 
             raise InputError(f"shaft[{i}].material", shaft["material"], "must name a `[[material]]`",
-                             _suggest(shaft["material"], names) or f"defined: {', '.join(names) or 'none'}")
+                             _suggest(shaft["material"], names) or f"defined: {', '.join(map(repr, names)) or 'none'}")
+    for i, disk in enumerate(scene["disk"]):
+        if disk["geometry"] and disk["material"] not in names:
+            raise InputError(f"disk[{i}].material", disk["material"], "must name a `[[material]]`",
+                             f"defined: {', '.join(map(repr, names)) or 'none'}")
     n_nodes = sum(s["repeat"] for s in scene["shaft"]) + 1
     for table in ("disk", "bearing"):
         for i, entry in enumerate(scene[table]):
@@ -66,5 +144,5 @@ def check_rotor(scene: Mapping[str, Any], path: str) -> None:
         raise InputError("shaft", [], "needs at least one entry when disks or bearings are given")
 
 
-ROOT_ITEMS = (MATERIAL, SHAFT, DISK, BEARING)
+ROOT_ITEMS = (ROTOR, MATERIAL, SHAFT, DISK, BEARING)
 ROOT_CHECKS = (check_rotor,)

@@ -1,0 +1,156 @@
+"""Shaft supports (bearings) to ground: linear coefficients and the nonlinear radial law.
+
+Linear bearing (per node, DOF ``(u1, u2, u3, theta1, theta2, phi)``): lateral
+stiffness/damping ``[[kxx, kxy], [kyx, kyy]]``, axial ``kzz``, tilt ``ktt``
+(isotropic), torsional ``kphi``, and a lumped rigid body ``(m, Id, Ip)`` at the
+attachment point (spec §5.4 with ``eta* = 0``).
+
+Nonlinear isotropic radial law (spec §5.3, (1.274)-(1.277)): the radial force
+magnitude ``f_r(u)`` of the radial deflection ``u = |u_perp|``, given as a
+table (monotone cubic interpolation) or a polynomial ``sum c_n u^n``.  Modal
+analysis uses its tangent stiffness at the operating deflection (spec §12.4):
+``K_t = f_r'(u) e e^T + f_r(u)/u (I - e e^T)``, with ``K_t = f_r'(0) I`` at
+``u = 0``; the damping ``beta C^perp e e^T`` is radial only.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from cvtfem.errors import InputError
+
+#: Names of the per-bearing coefficient arrays of :class:`BearingFamily`.
+COEFFICIENTS = ("kxx", "kxy", "kyx", "kyy", "cxx", "cxy", "cyx", "cyy", "kzz", "czz",
+                "ktt", "ctt", "kphi", "cphi", "m", "Id", "Ip")
+
+
+@dataclass(frozen=True)
+class RadialLaw:
+    """Isotropic radial force characteristic ``f_r(u)`` (N) of a bearing.
+
+    Parameters
+    ----------
+    u, f : arrays, optional
+        Table of deflections (m, increasing, starting at 0) and forces (N, f(0) = 0);
+        interpolated by a monotone cubic (PCHIP).
+    coeffs : array, optional
+        Polynomial coefficients ``c_1 .. c_n`` of ``f_r = sum c_n u^n`` (N/m^n).
+    """
+
+    u: tuple[float, ...] = ()
+    f: tuple[float, ...] = ()
+    coeffs: tuple[float, ...] = ()
+
+    def __post_init__(self) -> None:
+        if bool(self.coeffs) == bool(self.u):
+            raise InputError("radial law", self, "needs either a table (u, f) or polynomial coefficients")
+        if self.u:
+            u, f = np.asarray(self.u, float), np.asarray(self.f, float)
+            if u.shape != f.shape or len(u) < 2 or u[0] != 0 or f[0] != 0 or np.any(np.diff(u) <= 0):
+                raise InputError("radial law table", (self.u, self.f),
+                                 "must be >= 2 increasing deflections from 0 with forces from 0, same length")
+
+    def force(self, u: np.ndarray) -> np.ndarray:
+        """f_r(u), N (u >= 0, m)."""
+        if self.coeffs:
+            return np.polynomial.polynomial.polyval(u, (0.0, *self.coeffs))
+        return self._spline()(u)
+
+    def slope(self, u: np.ndarray) -> np.ndarray:
+        """f_r'(u), N/m."""
+        if self.coeffs:
+            return np.polynomial.polynomial.polyval(u, np.polynomial.polynomial.polyder((0.0, *self.coeffs)))
+        return self._spline().derivative()(u)
+
+    def _spline(self):  # noqa: ANN202 - scipy interpolator
+        from scipy.interpolate import PchipInterpolator
+
+        return PchipInterpolator(self.u, self.f, extrapolate=True)
+
+    def tangent(self, u_perp: np.ndarray) -> np.ndarray:
+        """2x2 tangent stiffness at the lateral deflection ``u_perp = (u1, u2)``, N/m (spec §12.4)."""
+        u_perp = np.asarray(u_perp, dtype=float)
+        u = float(np.hypot(*u_perp))
+        if u == 0.0:
+            return float(self.slope(0.0)) * np.eye(2)
+        e = u_perp / u
+        ee = np.outer(e, e)
+        return float(self.slope(u)) * ee + float(self.force(u)) / u * (np.eye(2) - ee)
+
+    def reaction(self, u_perp: np.ndarray) -> np.ndarray:
+        """Elastic reaction on the shaft ``-f_r(u) e_u`` (spec (1.277)), N."""
+        u_perp = np.asarray(u_perp, dtype=float)
+        u = float(np.hypot(*u_perp))
+        return np.zeros(2) if u == 0 else -float(self.force(u)) * u_perp / u
+
+
+@dataclass(frozen=True)
+class BearingFamily:
+    """Linear bearings to ground (tangent matrices of nonlinear ones) on nodes.
+
+    Parameters
+    ----------
+    nodes : int array (n,)
+    kxx ... Ip : arrays (n,)
+        See :data:`COEFFICIENTS` (N/m, N s/m, N m/rad, N m s/rad, kg, kg m^2).
+    """
+
+    nodes: np.ndarray
+    kxx: np.ndarray
+    kxy: np.ndarray
+    kyx: np.ndarray
+    kyy: np.ndarray
+    cxx: np.ndarray
+    cxy: np.ndarray
+    cyx: np.ndarray
+    cyy: np.ndarray
+    kzz: np.ndarray
+    czz: np.ndarray
+    ktt: np.ndarray
+    ctt: np.ndarray
+    kphi: np.ndarray
+    cphi: np.ndarray
+    m: np.ndarray
+    Id: np.ndarray
+    Ip: np.ndarray
+
+    @classmethod
+    def from_dicts(cls, nodes: np.ndarray, entries: list[dict[str, float]]) -> BearingFamily:
+        """Family from per-bearing dicts; absent coefficients are 0."""
+        cols = {k: np.array([float(e.get(k, 0.0)) for e in entries]) for k in COEFFICIENTS}
+        return cls(np.asarray(nodes, dtype=np.int64), **cols)
+
+    @property
+    def dofs(self) -> np.ndarray:
+        """Global DOF map, shape (n, 6)."""
+        return np.asarray(self.nodes, dtype=np.int64)[:, None] * 6 + np.arange(6)
+
+    def _blocks(self, xx: str, xy: str, yx: str, yy: str, zz: str, tt: str, ph: str) -> np.ndarray:
+        n = len(self.nodes)
+        B = np.zeros((n, 6, 6))
+        B[:, 0, 0], B[:, 0, 1] = getattr(self, xx), getattr(self, xy)
+        B[:, 1, 0], B[:, 1, 1] = getattr(self, yx), getattr(self, yy)
+        B[:, 2, 2] = getattr(self, zz)
+        B[:, 3, 3] = B[:, 4, 4] = getattr(self, tt)
+        B[:, 5, 5] = getattr(self, ph)
+        return B
+
+    def stiffness(self) -> np.ndarray:
+        """(n, 6, 6) stiffness blocks to ground."""
+        return self._blocks("kxx", "kxy", "kyx", "kyy", "kzz", "ktt", "kphi")
+
+    def damping(self) -> np.ndarray:
+        """(n, 6, 6) damping blocks to ground."""
+        return self._blocks("cxx", "cxy", "cyx", "cyy", "czz", "ctt", "cphi")
+
+    def mass(self) -> np.ndarray:
+        """(n, 6, 6) lumped rigid-body mass at the attachment point (spec §5.4)."""
+        d = np.stack([self.m, self.m, self.m, self.Id, self.Id, self.Ip], axis=1)
+        return d[:, :, None] * np.eye(6)
+
+    def gyroscopic(self) -> np.ndarray:
+        """(n, 6, 6) gyroscopic blocks of the lumped mass per unit spin speed."""
+        G = np.zeros((len(self.nodes), 6, 6))
+        G[:, 3, 4], G[:, 4, 3] = self.Ip, -self.Ip
+        return G

@@ -1,0 +1,163 @@
+"""Campbell diagrams: modes over a speed range, MAC tracking, excitation orders, crossings.
+
+An excitation line is a frequency proportional to the spin speed,
+``w_exc = factor * Omega`` (rad/s): shaft orders ``k Omega``; for a CVT with
+chain speed ``v = Omega r`` the chain orders ``k f_chain`` and link orders
+``k/3 f_link`` (spec §11, §12.7) with ``f = v / l`` (Hz, so
+``factor = 2 pi r k / l``).  A crossing of a tracked mode's damped frequency
+with a line is a critical speed.
+"""
+from __future__ import annotations
+
+import csv
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+from scipy.optimize import linear_sum_assignment
+
+from cvtfem.errors import InputError
+from cvtfem.modal.eigen import ModalProblem, Modes
+from cvtfem.modal.whirl import mac
+
+
+def shaft_orders(k: tuple[float, ...] = (1.0,)) -> tuple[tuple[str, float], ...]:
+    """Lines ``k Omega``: ``(("1x", 1.0), ...)``."""
+    return tuple((f"{kk:g}x", float(kk)) for kk in k)
+
+
+def chain_orders(radius: float, chain_length: float, link_length: float, k_chain: int = 3,
+                 k_link: int = 3) -> tuple[tuple[str, float], ...]:
+    """CVT excitation lines for a chain running at ``v = Omega * radius`` (spec §11).
+
+    Parameters
+    ----------
+    radius : float, m
+        Contact (pitch) radius on the analysed shaft.
+    chain_length, link_length : float, m
+    k_chain, k_link : int
+        Lines ``k f_chain`` for k = 1..k_chain and ``k/3 f_link`` for k = 1..k_link.
+    """
+    for name, v in (("radius", radius), ("chain_length", chain_length), ("link_length", link_length)):
+        if not v > 0:
+            raise InputError(name, v, "must be > 0 m")
+    lines = [(f"{k} f_chain", 2 * np.pi * radius * k / chain_length) for k in range(1, k_chain + 1)]
+    lines += [(f"{k}/3 f_link", 2 * np.pi * radius * k / (3 * link_length)) for k in range(1, k_link + 1)]
+    return tuple(lines)
+
+
+@dataclass(frozen=True)
+class Campbell:
+    """Tracked modes over speeds.
+
+    Attributes
+    ----------
+    speeds : array (s,), rad/s
+    wd, wn, damping_ratio : arrays (s, k)
+        Tracked mode ``j`` is column ``j`` (identity kept by MAC across speeds).
+    whirl : array of str (s, k)
+    modes : tuple of Modes
+        Per speed, ascending in wd (untracked order).
+    orders : tuple of (label, factor)
+    crossings : tuple of dict
+        ``{"mode", "whirl", "order", "speed_rad_s", "frequency_rad_s"}``.
+    """
+
+    speeds: np.ndarray
+    wd: np.ndarray
+    wn: np.ndarray
+    damping_ratio: np.ndarray
+    whirl: np.ndarray
+    modes: tuple[Modes, ...]
+    orders: tuple[tuple[str, float], ...]
+    crossings: tuple[dict[str, object], ...]
+
+    def to_dict(self) -> dict[str, object]:
+        """JSON-ready data: per-speed mode lists, tracked curves, orders, crossings."""
+        return {"speeds_rad_s": self.speeds.tolist(),
+                "per_speed": [m.to_dict() for m in self.modes],
+                "tracked": {"wd_rad_s": self.wd.tolist(), "wn_rad_s": self.wn.tolist(),
+                            "damping_ratio": self.damping_ratio.tolist(), "whirl": self.whirl.tolist()},
+                "orders": [{"label": lab, "factor": f} for lab, f in self.orders],
+                "crossings": list(self.crossings)}
+
+    def write_csv(self, path: Path) -> None:
+        """One row per (speed, tracked mode): speed, mode, wd, wn, zeta, whirl."""
+        with open(path, "w", newline="") as fh:
+            w = csv.writer(fh)
+            w.writerow(["speed_rad_s", "mode", "wd_rad_s", "wn_rad_s", "damping_ratio", "whirl"])
+            for i, s in enumerate(self.speeds):
+                for j in range(self.wd.shape[1]):
+                    w.writerow([f"{s:.9g}", j, f"{self.wd[i, j]:.9g}", f"{self.wn[i, j]:.9g}",
+                                f"{self.damping_ratio[i, j]:.6g}", self.whirl[i, j]])
+
+
+def track(modes: list[Modes], n_modes: int) -> np.ndarray:
+    """Column permutations that follow mode identity across speeds by MAC.
+
+    Parameters
+    ----------
+    modes : list of Modes
+        Each with at least ``n_modes`` modes, ascending in wd.
+
+    Returns
+    -------
+    int array (s, n_modes)
+        ``index[i, j]``: which mode at speed ``i`` is tracked mode ``j``.
+    """
+    index = np.zeros((len(modes), n_modes), dtype=int)
+    index[0] = np.arange(n_modes)
+    ref = modes[0].shapes[:, :n_modes]
+    for i in range(1, len(modes)):
+        cand = modes[i].shapes
+        _, col = linear_sum_assignment(1.0 - mac(ref, cand))
+        index[i] = col
+        ref = cand[:, col]
+    return index
+
+
+def crossings(speeds: np.ndarray, wd: np.ndarray, whirl: np.ndarray,
+              orders: tuple[tuple[str, float], ...]) -> tuple[dict[str, object], ...]:
+    """Speeds where tracked curves cross excitation lines (linear interpolation)."""
+    out = []
+    for label, factor in orders:
+        d = wd - factor * speeds[:, None]
+        for j in range(wd.shape[1]):
+            hits = np.flatnonzero(np.sign(d[:-1, j]) * np.sign(d[1:, j]) < 0)
+            for i in hits:
+                t = d[i, j] / (d[i, j] - d[i + 1, j])
+                s = speeds[i] + t * (speeds[i + 1] - speeds[i])
+                out.append({"mode": j, "whirl": str(whirl[i, j]), "order": label, "speed_rad_s": float(s),
+                            "frequency_rad_s": float(factor * s)})
+    return tuple(sorted(out, key=lambda c: c["speed_rad_s"]))
+
+
+def campbell(problem: ModalProblem, speeds: np.ndarray, n_modes: int,
+             orders: tuple[tuple[str, float], ...] = shaft_orders(), extra: int = 4) -> Campbell:
+    """Solve at every speed, track modes by MAC and find the critical speeds.
+
+    Parameters
+    ----------
+    problem : ModalProblem
+    speeds : array (s,), rad/s
+        Increasing spin speeds.
+    n_modes : int
+        Tracked modes (the lowest ``n_modes`` at the first speed).
+    orders : tuple of (label, factor)
+        Excitation lines ``w = factor * Omega``.
+    extra : int
+        Additional modes solved per speed so that curves can re-order.
+    """
+    speeds = np.asarray(speeds, dtype=float)
+    if speeds.ndim != 1 or len(speeds) < 1 or np.any(np.diff(speeds) <= 0):
+        raise InputError("speeds", speeds.tolist()[:5], "must be one or more increasing speeds")
+    modes = [problem.solve(s, n_modes + extra) for s in speeds]
+    idx = track(modes, n_modes)
+    rows = np.arange(len(speeds))[:, None]
+    wd = np.array([m.wd for m in modes])[rows, idx]
+    wn = np.array([m.wn for m in modes])[rows, idx]
+    zeta = np.array([m.damping_ratio for m in modes])[rows, idx]
+    whirl = np.array([m.whirl for m in modes])[rows, idx]
+    trimmed = tuple(Modes(m.speed, m.eigenvalues[:n_modes], m.shapes[:, :n_modes], m.whirl[:n_modes],
+                          m.whirl_ratio[:n_modes]) for m in modes)
+    return Campbell(speeds, wd, wn, zeta, whirl, trimmed, tuple(orders), crossings(speeds, wd, whirl, orders))
