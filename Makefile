@@ -29,3 +29,16 @@ test-all: $(STAMP)
 
 docs: $(STAMP)
 	$(BIN)/cvtfem docs scenes --out docs/scenes.md
+
+# Optional slepc4py backend (issue 3): PETSc and SLEPc build from source (~45 min on 2 cores without
+# pip's wheel cache, seconds with it). CUDA must be off: the machine has nvcc but no GPU.
+SLEPC_ENV := PETSC_CONFIGURE_OPTIONS="--with-mpi=0 --with-fc=0 --with-debugging=0 --with-cuda=0 --with-hip=0 --with-x=0"
+.PHONY: install-slepc test-slepc
+install-slepc: $(STAMP)
+	command -v apt-get >/dev/null && [ "$$(id -u)" = 0 ] && { dpkg -s libopenblas-dev liblapack-dev >/dev/null 2>&1 || \
+	  { apt-get update -qq && apt-get install -y -qq libopenblas-dev liblapack-dev; }; } || true
+	$(BIN)/python -m pip install -q cython numpy setuptools wheel
+	for p in petsc petsc4py slepc slepc4py; do $(SLEPC_ENV) $(BIN)/python -m pip install -q --no-build-isolation $$p || exit 1; done
+
+test-slepc: install-slepc
+	$(BIN)/python -m pytest -m slepc -q
