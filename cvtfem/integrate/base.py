@@ -1,0 +1,99 @@
+"""Base of every one-step method, in the spirit of ``scipy.integrate.OdeSolver`` (spec §6).
+
+A stepper turns ``(t, x, h)`` into an :class:`Attempt` (new state, optional error vector);
+the driver decides acceptance, events and output, and calls :meth:`Stepper.accept`.
+RHS calls go through :meth:`Stepper.f`, which counts and times them.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from cvtfem.integrate.stats import Stats
+from cvtfem.integrate.system import OdeSystem
+
+__all__ = ["Attempt", "Stepper", "StepFailure", "hermite"]
+
+
+class StepFailure(Exception):
+    """A step could not be computed (Newton divergence, singular matrix); the driver
+    rejects it (adaptive) or stops with a failure status (fixed step)."""
+
+
+@dataclass
+class Attempt:
+    """One attempted step ``t0 -> t0 + h``.
+
+    ``err`` is the local error estimate vector (None for methods without one); ``f0`` and
+    ``f1`` are ``F`` at both ends when already known (for dense output and FSAL).
+    """
+
+    t0: float
+    x0: np.ndarray
+    h: float
+    x1: np.ndarray
+    err: np.ndarray | None = None
+    f0: np.ndarray | None = None
+    f1: np.ndarray | None = None
+
+
+class Stepper:
+    """A one-step method; subclasses implement :meth:`attempt`.
+
+    Class attributes: ``order`` (propagated order), ``error_order`` (order ``q`` of the
+    solution the error estimate refers to, None without estimate; the controller uses
+    exponent ``1/(q+1)``), ``OPTIONS`` (keyword options the method accepts).
+    """
+
+    name = "stepper"
+    order = 1
+    error_order: int | None = None
+    OPTIONS: frozenset[str] = frozenset()
+    stages = 1
+    #: Set by the driver: False in fixed-step runs, so methods skip optional error estimates.
+    need_error = True
+    #: Set by the driver in adaptive runs: ``(rtol, atol)`` (implicit methods tie Newton to it).
+    tolerances: tuple | None = None
+
+    def __init__(self, system: OdeSystem, stats: Stats | None = None) -> None:
+        self.system = system
+        self.stats = stats if stats is not None else Stats()
+        self._cache: tuple[float, np.ndarray, np.ndarray] | None = None
+
+    def f(self, t: float, x: np.ndarray) -> np.ndarray:
+        """Counted, timed ``F(t, x)``; repeated calls at the last point are served from cache."""
+        c = self._cache
+        if c is not None and c[0] == t and np.array_equal(c[1], x):
+            return c[2]
+        st = self.stats
+        st.counts["nfev"] += 1
+        with st.timer("t_rhs"):
+            y = np.asarray(self.system.fun(t, x))
+        self._cache = (t, x.copy(), y)
+        return y
+
+    def attempt(self, t: float, x: np.ndarray, h: float) -> Attempt:  # pragma: no cover
+        raise NotImplementedError
+
+    def accept(self, att: Attempt) -> None:
+        """Commit an accepted step; an FSAL slope becomes the cached ``F`` at the new point."""
+        if att.f1 is not None:
+            self._cache = (att.t0 + att.h, att.x1.copy(), att.f1)
+
+    def reset(self) -> None:
+        """Forget the history (after an event switch changes the state or ``phi``)."""
+
+
+def hermite(att: Attempt, f1: np.ndarray, t: np.ndarray | float) -> np.ndarray:
+    """Cubic Hermite interpolant of a step, ``(n,)`` or ``(n, len(t))``; order 3 in ``h``."""
+    h = att.h
+    s = (np.asarray(t, dtype=float) - att.t0) / h
+    h00 = (1 + 2 * s) * (1 - s) ** 2
+    h10 = s * (1 - s) ** 2
+    h01 = s * s * (3 - 2 * s)
+    h11 = s * s * (s - 1)
+    x0, x1, f0 = att.x0, att.x1, att.f0
+    if np.ndim(s) == 0:
+        return h00 * x0 + h10 * h * f0 + h01 * x1 + h11 * h * f1
+    return (np.outer(x0, h00) + np.outer(h * f0, h10) + np.outer(x1, h01) + np.outer(h * f1, h11))

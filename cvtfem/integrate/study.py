@@ -1,0 +1,128 @@
+"""Study tools (spec §3.3, §9.4, §9.6): stability regions, effective order, work-precision.
+
+Everything here runs the real steppers: a stability region is one step of ``h = 1`` on
+``x' = diag(z) x`` for a whole grid of complex ``z`` at once (brute force, spec §3.3, valid
+for extrapolated, W- and stabilized methods too); local errors are single steps compared
+with a reference.
+"""
+from __future__ import annotations
+
+import statistics
+import time
+
+import numpy as np
+import scipy.sparse as sp
+
+from cvtfem.integrate.driver import solve
+
+__all__ = ["amplification", "real_stability_length", "local_errors", "effective_order",
+           "work_precision", "signed_log", "signed_log_inverse"]
+
+
+def amplification(method: str, z: np.ndarray, **options) -> np.ndarray:
+    """``|R(z)|``: one step ``h = 1`` of ``method`` on ``x' = z x``, all ``z`` at once.
+
+    The Jacobian ``diag(z)`` is given analytically, so implicit and W-methods use it exactly.
+    """
+    z = np.asarray(z, dtype=complex)
+    shape = z.shape
+    zf = z.ravel()
+    D = sp.diags(zf, format="csr")
+    with np.errstate(all="ignore"):
+        res = solve(lambda t, x: zf * x, (0.0, 1.0), np.ones_like(zf), method=method, h=1.0,
+                    jac=lambda t, x: D, **options)
+        out = np.abs(res.y[:, -1]) if res.success else np.full(zf.shape, np.inf)
+    return np.where(np.isfinite(out), out, np.inf).reshape(shape)
+
+
+def real_stability_length(method: str, x_max: float = 1e5, n: int = 200_000, **options) -> float:
+    """Largest ``beta`` with ``|R(-x)| <= 1`` on all of ``[0, beta]`` (sampled, then bisected)."""
+    x = np.linspace(0.0, x_max, n)
+    r = amplification(method, -x, **options)
+    bad = np.flatnonzero(r > 1 + 1e-12)
+    if not len(bad):
+        return x_max
+    lo, hi = x[bad[0] - 1], x[bad[0]]
+    for _ in range(50):
+        mid = 0.5 * (lo + hi)
+        if amplification(method, np.array([-mid]), **options)[0] <= 1 + 1e-12:
+            lo = mid
+        else:
+            hi = mid
+    return lo
+
+
+def local_errors(problem, method: str, hs, reference=None, **options) -> np.ndarray:
+    """Local error ``e(h) = ||x(t0 + h) - x1||_inf`` of one step from the problem's start.
+
+    ``reference(h)`` gives the true ``x(t0 + h)``: the problem's closed form by default,
+    else DOP853 at ``rtol = 1e-13``.
+    """
+    t0 = problem.t_span[0]
+    if reference is None:
+        if problem.exact is not None:
+            reference = problem.exact
+        else:
+            def reference(t):
+                return solve(problem.fun, (t0, t), problem.y0, "DOP853", rtol=1e-13,
+                             atol=1e-15).y[:, -1]
+    kw = problem.solve_kwargs()
+    errs = []
+    for h in hs:
+        kw["t_span"] = (t0, t0 + h)
+        res = solve(**kw, method=method, h=h, **options)
+        errs.append(np.max(np.abs(res.y[:, -1] - reference(t0 + h))))
+    return np.array(errs)
+
+
+def effective_order(hs, errs) -> np.ndarray:
+    """``p~ = d ln e / d ln h - 1`` (spec (2.8)) by finite differences between samples."""
+    hs, errs = np.asarray(hs, float), np.asarray(errs, float)
+    return np.diff(np.log(errs)) / np.diff(np.log(hs)) - 1
+
+
+def work_precision(problem, runs, repeats: int = 3, error=None):
+    """Error vs cost for a list of runs ``(label, method, options)`` on ``problem``.
+
+    ``error(res)`` defaults to the max relative error at ``t_end`` against
+    ``problem.reference()`` (the components in ``ref_index``). Wall time is the median of
+    ``repeats`` runs. Returns a list of row dicts (label, method, error, nfev, time, ...).
+    """
+    ref = problem.reference()
+    idx = problem.ref_index if problem.ref_index is not None else slice(None)
+    if error is None:
+        def error(res):
+            return float(np.max(np.abs(res.y[idx, -1] - ref) / np.maximum(np.abs(ref), 1e-300)))
+    rows = []
+    for label, method, options in runs:
+        times, res = [], None
+        for _ in range(repeats):
+            t0 = time.perf_counter()
+            res = solve(**problem.solve_kwargs(), method=method, **options)
+            times.append(time.perf_counter() - t0)
+        st = res.stats
+        rows.append({"label": label, "method": method, "error": error(res) if res.success else np.inf,
+                     "nfev": st["nfev"], "njev": st["njev"], "nlu": st["nlu"], "nsteps": st["nsteps"],
+                     "time": statistics.median(times), "status": res.status,
+                     **{k: v for k, v in options.items() if isinstance(v, (int, float, str))}})
+    return rows
+
+
+def signed_log(x, x_star: float = 1e-3, xt_star: float = 1.0, c: float | None = None):
+    """The source's signed "logarithmic" axis map (spec §2.3): linear for ``|x| <= x*``."""
+    c = xt_star if c is None else c
+    x = np.asarray(x, dtype=float)
+    ax = np.abs(x)
+    with np.errstate(divide="ignore"):
+        out = np.where(ax <= x_star, xt_star * x / x_star,
+                       np.sign(x) * (xt_star + c * np.log(np.maximum(ax, x_star) / x_star)))
+    return out
+
+
+def signed_log_inverse(xt, x_star: float = 1e-3, xt_star: float = 1.0, c: float | None = None):
+    """Inverse of :func:`signed_log` (for rasterising on a log-mapped grid)."""
+    c = xt_star if c is None else c
+    xt = np.asarray(xt, dtype=float)
+    a = np.abs(xt)
+    return np.where(a <= xt_star, x_star * xt / xt_star,
+                    np.sign(xt) * x_star * np.exp((a - xt_star) / c))
