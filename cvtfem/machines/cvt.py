@@ -7,7 +7,10 @@ chain models (chain-models-2.md section 0: 2/3/5/10/21 per pin), shafts
 """
 from __future__ import annotations
 
+from typing import Any
+
 from cvtfem.elements.base import Layout, OutputSpec
+from cvtfem.errors import InputError
 from cvtfem.scene.loader import Scene
 
 #: Generalized coordinates per pin of each discrete chain model.
@@ -18,15 +21,18 @@ CHAIN_COORDS_PER_PIN = {"chain-S1": 2, "chain-S2": 3, "chain-S3": 5, "chain-A1":
 CONTROLLER_STATES = 4
 
 
-def _band(model: str, ritz_order: int) -> Layout:
-    outputs = [OutputSpec("band.span_angle", "rad", "Span angle phi of the band."),
-               OutputSpec("band.tension", "N", "Band tension in the two spans.", 2)]
+def _band(model: str, ritz_order: int, nodes: int) -> Layout:
+    outputs = [OutputSpec("band.span_angle", "rad", "Span angle phi of the band.")]
     if model == "band-1dof":
         return Layout("band", model, 1, outputs=tuple(outputs), note="equilibrium angle phi only (static)")
-    outputs += [OutputSpec("band.slip_speed", "m/s", "Mean slip speed on each pulley.", 2)]
+    outputs += [OutputSpec("band.slip_speed", "m/s", "Circumferential slip speed at the middle of each arc.", 2),
+                OutputSpec("band.slip_max", "m/s", "Largest slip speed along each arc.", 2),
+                OutputSpec("band.mean_normal_force", "N/m", "Mean normal force per sheave on each arc.", 2)]
     if model == "band-4dof":
         return Layout("band", model, 2, outputs=tuple(outputs), note="phi, sigma")
-    outputs += [OutputSpec("band.normal_force", "N/m", "Normal force along each contact arc.", 2 * 32)]
+    outputs += [OutputSpec("band.normal_force", "N/m",
+                           f"Normal force per sheave at the {nodes} Gauss nodes of each arc (arc 1, then arc 2).",
+                           2 * nodes)]
     return Layout("band", model, 2 + 2 * ritz_order, outputs=tuple(outputs),
                   note=f"phi, sigma and {ritz_order} Ritz coefficients per arc")
 
@@ -79,7 +85,7 @@ def layout(scene: Scene) -> tuple[Layout, ...]:
     cvt = scene.cvt
     model = cvt.model
     band = model.startswith("band")
-    parts = [_band(model, cvt.ritz_order) if band else _chain(scene),
+    parts = [_band(model, cvt.ritz_order, cvt.quadrature_nodes) if band else _chain(scene),
              _shaft("driving", scene, model), _shaft("driven", scene, model)]
     if cvt.effects.stabilisation and model != "band-1dof":
         parts.append(Layout("stabilisation", "speed-ratio-control", 0, n1=CONTROLLER_STATES,
@@ -87,7 +93,72 @@ def layout(scene: Scene) -> tuple[Layout, ...]:
                                      OutputSpec("control.resistance", "N m s", "Driven-shaft resistance b2.")),
                             note="smoothed speeds, F1 integral, b2 integral"))
     parts.append(Layout("transmission", "derived", 0,
-                        outputs=(OutputSpec("efficiency", "-", "Output over input power."),
-                                 OutputSpec("ratio", "-", "Speed ratio omega1 / omega2.")),
+                        outputs=(OutputSpec("efficiency", "-", "Output over input power (instantaneous)."),
+                                 OutputSpec("ratio", "-", "Speed ratio omega1 / omega2."),
+                                 OutputSpec("power", "W", "Input, output, dissipated and clamping power.", 4),
+                                 OutputSpec("work", "J", "Input, output, dissipated and clamping work since t = 0.", 4),
+                                 OutputSpec("energy", "J", "Kinetic plus elastic energy of the model.")),
                         note="derived outputs"))
     return tuple(parts)
+
+
+def band_params(scene: Scene, **overrides: Any):
+    """:class:`~cvtfem.elements.band.params.BandParams` of a band-model CVT scene (``overrides`` replace fields)."""
+    from cvtfem.elements.band.geometry import Sheave
+    from cvtfem.elements.band.params import BandParams
+    from cvtfem.scene.schema.cvt import mean_chain_length
+
+    cvt = scene.cvt
+    g, ch, eff = cvt.geometry, cvt.chain, cvt.effects
+    sheave = Sheave(g.sheave_profile, g.flank_angle, g.torus_radius, g.torus_offset, ch.half_width)
+    shafts = (cvt.driving, cvt.driven)
+    values = dict(
+        length=mean_chain_length(ch), L=g.centre_distance, w=ch.half_width, mass=ch.mass, sheaves=(sheave, sheave),
+        J=tuple(s.inertia for s in shafts), m_sheave=tuple(s.sheave_mass for s in shafts),
+        Theta=tuple(s.sheave_transverse_inertia for s in shafts), c_U=tuple(s.radial_stiffness for s in shafts),
+        c_psi=tuple(s.tilt_stiffness for s in shafts), f0=cvt.friction.f0, v0=cvt.friction.v0, law=cvt.friction.law,
+        c=ch.band_transverse_stiffness, damping_ratio=ch.damping_ratio, n_ritz=cvt.ritz_order,
+        n_gauss=cvt.quadrature_nodes, friction=eff.friction, damping=eff.damping, gyroscopic=eff.gyroscopic,
+        source_literal=cvt.source_literal)
+    values.update(overrides)
+    return BandParams(**values)
+
+
+def band_model(scene: Scene, **overrides: Any):
+    """The dynamic band model a scene calls for (``band-4dof``, ``band-6+2n``, ``band-6+2n+8``).
+
+    Raises InputError for the static ``band-1dof`` and for discrete-chain models (not available yet).
+    """
+    from cvtfem.elements.band import model_for
+
+    model = scene.cvt.model
+    if model.startswith("chain"):
+        raise InputError("cvt.model", model, "is a discrete-chain model, which is not available yet",
+                         "use one of band-4dof, band-6+2n, band-6+2n+8 (e.g. `preset = \"band-4dof\"`)")
+    if model == "band-1dof":
+        raise InputError("cvt.model", model, "is the static equilibrium model and has no time run",
+                         "use a dynamic band model (band-4dof, band-6+2n, band-6+2n+8)")
+    return model_for(model, band_params(scene, **overrides))
+
+
+def closed_loop(scene: Scene, **overrides: Any):
+    """Scene -> :class:`~cvtfem.control.closed_loop.ClosedLoop` (model, clamping schedule, regime, loops)."""
+    from cvtfem.control.closed_loop import Clamping, ClosedLoop
+    from cvtfem.control.regimes import Regime
+    from cvtfem.control.stabilisation import Stabilisation, StabilisationParams
+    from cvtfem.elements.band.geometry import phi_for_ratio, radii
+
+    cvt = scene.cvt
+    model = band_model(scene, **overrides)
+    p = model.p
+    rg = cvt.regime
+    regime = Regime(rg.kind, rg.input_speed, rg.torque, rg.ratio, rg.end_value, rg.ramp_time)
+    clamping = Clamping(p, rg.clamping_safety, rg.clamping_split)
+    control = None
+    if cvt.effects.stabilisation:
+        c = cvt.control
+        r2 = radii(phi_for_ratio(rg.ratio, p.length, p.L), p.length, p.L)[0][1]
+        J_sigma = p.J[0] * rg.ratio ** 2 + p.J[1] + p.mass * r2 ** 2
+        control = Stabilisation(StabilisationParams(c.tau_omega, c.eps, c.i_min, c.i_max, c.k_sat, c.c_f0, c.c_f1,
+                                                    c.c_sat, c.tau, c.nu, J_sigma))
+    return ClosedLoop(model, clamping, regime, control)

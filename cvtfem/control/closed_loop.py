@@ -1,0 +1,135 @@
+"""A band (or any) model closed by the stabilisation systems and driven by a regime.
+
+State ``x = [q, v, z, W]``: coordinates and velocities of the model, the controller state
+``z`` (section 5.5; absent when stabilisation is off) and four work integrals
+``W = [input, output, dissipated, clamping]`` (J) used for the efficiency and the power balance
+``d(T + V)/dt = M1 w1 + M2 w2 + P_clamp - D``.
+
+The model must offer ``n2``, ``speed_indices()``, ``accel(q, v, F, M) -> (a, info)`` with
+``info["dissipation"]`` and ``info["clamp_power"]``, ``kinetic_energy(q, v)`` and
+``elastic_energy(q)``; nothing else is assumed, so discrete-chain models can plug in later.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from cvtfem.control.regimes import Regime
+from cvtfem.control.stabilisation import Stabilisation
+from cvtfem.elements.band.estimates import min_clamping_force
+from cvtfem.elements.band.equilibrium import forces_for_angle
+from cvtfem.elements.band.geometry import phi_for_ratio, radii
+from cvtfem.elements.band.params import BandParams
+from cvtfem.errors import InputError
+
+SPLITS = ("equilibrium", "per-shaft")
+
+
+@dataclass(frozen=True)
+class Clamping:
+    """Prescribed clamping forces ``F_appl(M1, i)`` from the estimate (1.13) times a safety factor.
+
+    ``split = "per-shaft"`` applies (1.13) to each pulley separately (spec section 3.1).
+    ``split = "equilibrium"`` keeps the force ratio ``F1/F2`` of the equilibrium span angle of the
+    target ratio (section 4.2) and scales the pair until each pulley has at least ``safety`` times
+    its estimate: the band models hold a ratio only at that force ratio (friction has no steady
+    phi-component), so this starts the ratio loop at its working point.
+    """
+
+    p: BandParams
+    safety: float
+    split: str = "equilibrium"
+    _table: tuple[np.ndarray, np.ndarray] = field(init=False, repr=False)
+
+    def __post_init__(self) -> None:
+        if self.split not in SPLITS:
+            raise InputError("regime.clamping_split", self.split, "must be one of " + ", ".join(SPLITS))
+        ratios = np.geomspace(0.3, 3.5, 400)
+        phis = np.array([phi_for_ratio(i, self.p.length, self.p.L) for i in ratios])
+        object.__setattr__(self, "_table", (np.log(ratios), phis))
+
+    def span_angle(self, ratio: float) -> float:
+        """Span angle of the geometric ratio (tabulated for speed; exact solve outside 0.3..3.5)."""
+        x, y = self._table
+        lr = np.log(ratio)
+        if x[0] <= lr <= x[-1]:
+            return float(np.interp(lr, x, y))
+        return phi_for_ratio(ratio, self.p.length, self.p.L)
+
+    def estimates(self, M1: float, ratio: float) -> np.ndarray:
+        """Per-pulley estimates (1.13) at the target ratio, N (``|M2| = M1 i``)."""
+        phi = self.span_angle(ratio)
+        r, _, _ = radii(phi, self.p.length, self.p.L)
+        g = [self.p.sheaves[k].gamma_at(r[k]) for k in range(2)]
+        return np.array([min_clamping_force(M1, r[0], self.p.f0, g[0]),
+                         min_clamping_force(M1 * ratio, r[1], self.p.f0, g[1])])
+
+    def forces(self, M1: float, ratio: float) -> np.ndarray:
+        """``F_appl = (F1, F2)``, N."""
+        est = self.estimates(M1, ratio)
+        if self.split == "per-shaft":
+            return self.safety * est
+        rho = forces_for_angle(self.span_angle(ratio), self.p.sheaves, self.p.length, self.p.L)
+        F2 = self.safety * max(est[1], est[0] / rho)
+        return np.array([rho * F2, F2])
+
+
+@dataclass(frozen=True)
+class ClosedLoop:
+    """Model + clamping + regime (+ stabilisation) as one first-order ODE ``x' = rhs(t, x)``."""
+
+    model: Any
+    clamping: Clamping
+    regime: Regime
+    control: Stabilisation | None = None
+
+    @property
+    def n_ctrl(self) -> int:
+        return 0 if self.control is None else 4
+
+    @property
+    def size(self) -> int:
+        return 2 * self.model.n2 + self.n_ctrl + 4
+
+    def split(self, x):
+        """Views ``q, v, z, W`` of a state vector."""
+        n = self.model.n2
+        return x[:n], x[n:2 * n], x[2 * n:2 * n + self.n_ctrl], x[2 * n + self.n_ctrl:]
+
+    def initial_state(self) -> np.ndarray:
+        """Band at the span angle of the target ratio, shafts at the target speeds, no slip on pulley 1."""
+        w1, M1, i = self.regime.targets(0.0)
+        phi = self.clamping.span_angle(i)
+        F = self.clamping.forces(M1, i)
+        q, v = self.model.initial_state(phi, w1, w1 / i, F)
+        z = self.control.initial_state(w1, w1 / i) if self.control else np.zeros(0)
+        return np.concatenate([q, v, z, np.zeros(4)])
+
+    def evaluate(self, t: float, x):
+        """Right-hand side and everything an output needs: ``(dx, loads, info)``."""
+        q, v, z, _ = self.split(x)
+        w1d, M1, i_d = self.regime.targets(t)
+        w2d = w1d / i_d
+        F_appl = self.clamping.forces(M1, i_d)
+        k1, k2 = self.model.speed_indices()
+        w = np.array([v[k1], v[k2]])
+        if self.control is not None:
+            F, M2, dz, diag = self.control.outputs(w, z, i_d, w2d, M1, F_appl)
+        else:
+            b20 = M1 * i_d / w2d
+            F, M2, dz, diag = F_appl, -b20 * w[1], np.zeros(0), {"ratio_estimate": w[0] / w[1], "resistance": b20}
+        a, info = self.model.accel(q, v, F, np.array([M1, M2]))
+        dW = np.array([M1 * w[0], -M2 * w[1], info["dissipation"], info["clamp_power"]])
+        info.update(diag, F=F, M=np.array([M1, M2]), w=w, targets=(w1d, M1, i_d))
+        return np.concatenate([v, a, dz, dW]), info
+
+    def rhs(self, t: float, x):
+        """``dx/dt``."""
+        return self.evaluate(t, x)[0]
+
+    def energy(self, x) -> float:
+        """Kinetic plus elastic energy of the model, J."""
+        q, v, _, _ = self.split(x)
+        return float(self.model.kinetic_energy(q, v) + self.model.elastic_energy(q))

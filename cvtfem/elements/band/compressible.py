@@ -1,0 +1,304 @@
+"""The 6+2n band model (transversely compressible band, section 4.4) and its 6+2n+8 extension
+with sheave shift and tilt from shaft compliance (section 4.5).
+
+Coordinates ``q = [phi, sigma, phi1, phi2, z1, z2, h_11..h_1n, h_21..h_2n]`` and, for 6+2n+8,
+``[U_11, U_12, psi_11, psi_12, U_21, U_22, psi_21, psi_22]`` (in-plane shift and tilt of each
+sheave pair, components along i, j).
+
+* Kinetic energy ``T = q'^T M(phi) q' / 2``: the band part ``rho int |du/dq q'|^2 ds`` with the
+  Jacobian taken at ``h = 0`` (section 4.4 [C]: A(phi, 0) with Christoffel terms, M' by
+  complex step), pair masses for ``z`` and ``U``, and per shaft
+  ``J (phi_k' + k.(psi' x psi) / 2)^2 / 2 + Theta |psi'|^2 / 2`` (section 4.5 [C], reviewed factor 1/2).
+* Strain ``eps = -z0(r) + E(phi)^T x`` per arc (1.55) / (1.63) in the (1.57) sign convention, with
+  ``x_k = [z_k, h_k, U_k, psi_k]``; ``Pi = kappa sum F_k z_k + c' sum int eps^2 ds + shaft springs``,
+  ``c' = c`` (consistent, section 4.6) or ``c/2`` (source_literal: (1.56) as printed).
+* Normal force ``N = c eps / (k.p)`` clipped at 0 (lift-off), friction ``R = -f N t`` with the slip
+  ``v_r = J(phi) q'`` of the band edge against the sheave point; the same J gives the generalized
+  friction forces, so friction only dissipates (``D = -Q^f . q' >= 0``).
+* Band damping: Rayleigh function ``beta c' int eps'^2 ds`` with ``beta = 2 nu / omega_z``.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from cvtfem.elements.band.friction import friction_vector
+from cvtfem.elements.band.geometry import radii
+from cvtfem.elements.band.inertia import band_inertia
+from cvtfem.elements.band.params import BandParams, gauss_nodes
+from cvtfem.elements.band.ritz import ritz_alpha, ritz_shapes
+
+H = 1e-30  # complex step
+
+
+@dataclass(frozen=True)
+class CompressibleBand:
+    """6+2n (``shaft_compliance=False``) or 6+2n+8 band model as a kernel around :class:`BandParams`."""
+
+    p: BandParams
+    shaft_compliance: bool = False
+    _c: dict = field(init=False, repr=False, default_factory=dict)
+
+    def __post_init__(self) -> None:
+        p, n = self.p, self.p.n_ritz
+        xi, wq = gauss_nodes(p.n_gauss)
+        F, dF = ritz_shapes(xi, n)
+        r0 = radii(0.0, p.length, p.L)[0][0]
+        c_edge = p.c / 2 if p.source_literal else p.c
+        omega_z = np.sqrt(2 * c_edge * np.pi * r0 / min(p.m_sheave))
+        nx = 1 + n + (4 if self.shaft_compliance else 0)
+        self._c.update(xi=xi, wq=wq, F=F, dF=dF, nx=nx, c_edge=c_edge,
+                       beta=2 * p.damping_ratio / omega_z if p.damping else 0.0, alpha=ritz_alpha(n))
+
+    @property
+    def n2(self) -> int:
+        return 6 + 2 * self.p.n_ritz + (8 if self.shaft_compliance else 0)
+
+    @property
+    def names(self) -> tuple[str, ...]:
+        n = self.p.n_ritz
+        out = ["phi", "sigma", "phi1", "phi2", "z1", "z2"] + [f"h{k}{i}" for k in (1, 2) for i in range(1, n + 1)]
+        if self.shaft_compliance:
+            out += [f"{v}{k}{c}" for k in (1, 2) for v in ("U", "psi") for c in (1, 2)]
+        return tuple(out)
+
+    def speed_indices(self) -> tuple[int, int]:
+        return 2, 3
+
+    def arc_nodes(self, phi: float) -> np.ndarray:
+        """Local arc angles theta of the quadrature nodes, ``(2, n_gauss)``, rad."""
+        return np.stack([np.pi / 2 + phi, np.pi / 2 - phi])[:, None] * self._c["xi"]
+
+    # --- index helpers -------------------------------------------------------------------------
+    def _x(self, q, k: int):
+        """Elastic coordinates ``x_k = [z_k, h_k, U_k, psi_k]`` of arc k."""
+        n = self.p.n_ritz
+        parts = [q[4 + k:5 + k], q[6 + k * n:6 + (k + 1) * n]]
+        if self.shaft_compliance:
+            parts.append(q[6 + 2 * n + 4 * k:10 + 2 * n + 4 * k])
+        return np.concatenate(parts)
+
+    def _scatter_x(self, out, k: int, values) -> None:
+        n = self.p.n_ritz
+        out[4 + k] += values[0]
+        out[6 + k * n:6 + (k + 1) * n] += values[1:1 + n]
+        if self.shaft_compliance:
+            out[6 + 2 * n + 4 * k:10 + 2 * n + 4 * k] += values[1 + n:]
+
+    def _band_index(self) -> np.ndarray:
+        n = self.p.n_ritz
+        return np.r_[0, 1, 6:6 + 2 * n]
+
+    # --- kernels -------------------------------------------------------------------------------
+    def arcs(self, phi):
+        """Per-arc geometry at ``phi`` (complex allowed): dict of ``(2,)`` and ``(2, g)`` arrays."""
+        p, c = self.p, self._c
+        r, dr, _ = radii(phi, p.length, p.L)
+        ts = np.stack([np.pi / 2 + phi, np.pi / 2 - phi])
+        tg = np.stack([p.sheaves[k].tan_gamma(r[k]) for k in range(2)])
+        z0 = np.stack([p.sheaves[k].z0(r[k]) for k in range(2)])
+        th = ts[:, None] * c["xi"]
+        fr = -c["dF"][None] / ts[:, None, None]  # (2, n, g)
+        geo = dict(r=r, dr=dr, ts=ts, tg=tg, z0=z0, th=th, fr=fr, ds=(r * ts)[:, None] * c["wq"])
+        rows = [np.ones_like(th)[:, None], tg[:, None, None] * fr]
+        if self.shaft_compliance:
+            a = np.stack([p.sheaves[k].lever(r[k]) for k in range(2)])
+            tabs = th + np.array([0.0, np.pi])[:, None]
+            cs, sn = np.cos(tabs), np.sin(tabs)
+            lev = (r + tg * a)[:, None]
+            rows.append(np.stack([-tg[:, None] * cs, -tg[:, None] * sn, lev * sn, -lev * cs], axis=1))
+            geo.update(a=a, cs=cs, sn=sn)
+        geo["E"] = np.concatenate(rows, axis=1)  # (2, nx, g): d eps / d x_k at the nodes
+        return geo
+
+    def band_mass(self, phi, geo=None):
+        """Band block of the mass matrix over ``[phi, sigma, h1, h2]`` (may be complex), kg-based units."""
+        p, c = self.p, self._c
+        g = self.arcs(phi) if geo is None else geo
+        n, rho = p.n_ritz, p.rho
+        M = np.zeros((2 + 2 * n, 2 + 2 * n), dtype=np.result_type(phi, float))
+        M[0, 0] = band_inertia(phi, p.length, p.L, p.mass)
+        M[1, 1] = p.mass
+        for k in range(2):
+            sl = slice(2 + k * n, 2 + (k + 1) * n)
+            fr, ds = g["fr"][k], g["ds"][k]
+            M[sl, sl] = rho * ((fr * ds) @ fr.T + (c["F"] * ds) @ c["F"].T)
+            M[1, sl] = M[sl, 1] = rho * (c["F"] * ds).sum(axis=1)
+            M[0, sl] = M[sl, 0] = rho * g["dr"][k] * ((fr - g["th"][k] * c["F"]) * ds).sum(axis=1)
+        return M
+
+    def strain(self, q, geo):
+        """Band-edge strain ``eps`` at the nodes, ``(2, g)`` (1.55) / (1.63)."""
+        return np.stack([-geo["z0"][k] + self._x(q, k) @ geo["E"][k] for k in range(2)])
+
+    def accel(self, q, v, F, M):
+        """Accelerations and diagnostics (``N`` (2, g) N/m, ``dissipation``, ``clamp_power`` W, slips)."""
+        p, c = self.p, self._c
+        n, n2 = p.n_ritz, self.n2
+        phi = q[0]
+        gc = self.arcs(phi + 1j * H)
+        g = {k: (val.real if np.iscomplexobj(val) else val) for k, val in gc.items()}
+        eps_c = self.strain(q, gc)
+        eps, deps = eps_c.real, eps_c.imag / H
+        Q = np.zeros(n2)
+        # elastic band energy and its generalized forces
+        Pi_c = c["c_edge"] * np.sum(eps_c ** 2 * gc["ds"])
+        Q[0] -= Pi_c.imag / H
+        for k in range(2):
+            self._scatter_x(Q, k, -2 * c["c_edge"] * (g["E"][k] @ (eps[k] * g["ds"][k])))
+        Q[4:6] -= p.kappa * np.asarray(F)
+        if self.shaft_compliance:
+            for k in range(2):
+                b = 6 + 2 * n + 4 * k
+                Q[b:b + 2] -= p.c_U[k] * q[b:b + 2]
+                Q[b + 2:b + 4] -= p.c_psi[k] * q[b + 2:b + 4]
+        dissipation = 0.0
+        if c["beta"] > 0:
+            deps_dt = deps * v[0] + np.stack([self._x(v, k) @ g["E"][k] for k in range(2)])
+            Qd = np.zeros(n2)
+            Qd[0] = -2 * c["beta"] * c["c_edge"] * np.sum(deps_dt * deps * g["ds"])
+            for k in range(2):
+                self._scatter_x(Qd, k, -2 * c["beta"] * c["c_edge"] * (g["E"][k] @ (deps_dt[k] * g["ds"][k])))
+            dissipation -= float(Qd @ v)
+            Q += Qd
+        info = {"N": np.zeros_like(eps), "eps": eps}
+        if p.friction:
+            Qf, N, vr = self._friction(q, v, g, eps)
+            dissipation -= float(Qf @ v)
+            Q += Qf
+            info.update(N=N, slip=vr[1][:, p.n_gauss // 2], slip_max=np.sqrt((vr ** 2).sum(axis=0)).max(axis=1))
+        else:
+            vt = v[1] - g["r"] * v[2:4]
+            info.update(slip=vt, slip_max=np.abs(vt))
+        Q[2:4] += M
+        a = self._solve(q, v, Q, phi)
+        info.update(dissipation=dissipation, clamp_power=float(-p.kappa * np.dot(F, v[4:6])))
+        return a, info
+
+    def _friction(self, q, v, g, eps):
+        p, c = self.p, self._c
+        n = p.n_ritz
+        tg, th, ds = g["tg"][:, None], g["th"], g["ds"]
+        hd = np.stack([v[6:6 + n], v[6 + n:6 + 2 * n]])
+        vr_r = (g["dr"] * v[0])[:, None] + np.einsum("kng,kn->kg", g["fr"], hd)
+        vr_t = v[1] - th * (g["dr"] * v[0])[:, None] - (g["r"] * v[2:4])[:, None] + hd @ c["F"]
+        if self.shaft_compliance:
+            b = 6 + 2 * n
+            U = np.stack([v[b:b + 2], v[b + 4:b + 6]])
+            P = np.stack([v[b + 2:b + 4], v[b + 6:b + 8]])
+            cs, sn, a = g["cs"], g["sn"], g["a"][:, None]
+            vr_r = vr_r - (U[:, :1] * cs + U[:, 1:] * sn) - a * (-P[:, :1] * sn + P[:, 1:] * cs)
+            vr_t = vr_t - (-U[:, :1] * sn + U[:, 1:] * cs) + a * (P[:, :1] * cs + P[:, 1:] * sn)
+        vr = np.stack([vr_r, vr_t, tg * vr_r])
+        ft = friction_vector(vr, p.f0, p.v0, p.law)
+        cosg = 1.0 / np.sqrt(1.0 + tg ** 2)
+        N = np.maximum(0.0, -p.c * eps / (cosg + ft[2]))
+        T = ft * N * ds  # (3, 2, g): f N t ds
+        Tn = T[0] + tg * T[2]
+        Q = np.zeros(self.n2)
+        Q[0] = -2 * np.sum(g["dr"][:, None] * (Tn - th * T[1]))
+        Q[1] = -2 * np.sum(T[1])
+        Q[2:4] = 2 * g["r"] * T[1].sum(axis=1)
+        Q[6:6 + 2 * n] = (-2 * (np.einsum("kng,kg->kn", g["fr"], Tn) + T[1] @ c["F"].T)).ravel()
+        if self.shaft_compliance:
+            b = 6 + 2 * n
+            cs, sn, a = g["cs"], g["sn"], g["a"][:, None]
+            QU1 = 2 * np.sum(cs * Tn - sn * T[1], axis=1)
+            QU2 = 2 * np.sum(sn * Tn + cs * T[1], axis=1)
+            Qp1 = -2 * np.sum(a * (sn * Tn + cs * T[1]), axis=1)
+            Qp2 = 2 * np.sum(a * (cs * Tn - sn * T[1]), axis=1)
+            for k in range(2):
+                Q[b + 4 * k:b + 4 * k + 4] = [QU1[k], QU2[k], Qp1[k], Qp2[k]]
+        return Q, N, vr
+
+    def _solve(self, q, v, Q, phi):
+        p, n = self.p, self.p.n_ritz
+        a = np.empty(self.n2)
+        bi = self._band_index()
+        Mc = self.band_mass(phi + 1j * H)
+        Mb, dMb = Mc.real, Mc.imag / H
+        vb = v[bi]
+        rhs = Q[bi] - v[0] * (dMb @ vb)
+        rhs[0] += 0.5 * vb @ dMb @ vb
+        a[bi] = np.linalg.solve(Mb, rhs)
+        a[4:6] = Q[4:6] / np.asarray(p.m_sheave)
+        if not self.shaft_compliance:
+            a[2:4] = Q[2:4] / np.asarray(p.J)
+            return a
+        b = 6 + 2 * n
+        for k in range(2):
+            j = b + 4 * k
+            a[j:j + 2] = Q[j:j + 2] / p.m_sheave[k]
+            J, Th = p.J[k], p.Theta[k]
+            p1, p2 = q[j + 2], q[j + 3]
+            d1, d2 = v[j + 2], v[j + 3]
+            if p.gyroscopic:
+                w_ax = v[2 + k] + 0.5 * (d1 * p2 - d2 * p1)
+                wdot = Q[2 + k] / J
+                a[j + 2] = (Q[j + 2] - 0.5 * J * wdot * p2 - J * w_ax * d2) / Th
+                a[j + 3] = (Q[j + 3] + 0.5 * J * wdot * p1 + J * w_ax * d1) / Th
+                a[2 + k] = wdot - 0.5 * (a[j + 2] * p2 - a[j + 3] * p1)
+            else:
+                a[j + 2:j + 4] = Q[j + 2:j + 4] / Th
+                a[2 + k] = Q[2 + k] / J
+        return a
+
+    # --- energies and states -------------------------------------------------------------------
+    def kinetic_energy(self, q, v) -> float:
+        p, n = self.p, self.p.n_ritz
+        bi = self._band_index()
+        vb = v[bi]
+        T = 0.5 * vb @ self.band_mass(q[0]) @ vb + 0.5 * np.sum(np.asarray(p.m_sheave) * v[4:6] ** 2)
+        if not self.shaft_compliance:
+            return float(T + 0.5 * np.sum(np.asarray(p.J) * v[2:4] ** 2))
+        b = 6 + 2 * n
+        for k in range(2):
+            j = b + 4 * k
+            w_ax = v[2 + k] + (0.5 * (v[j + 2] * q[j + 3] - v[j + 3] * q[j + 2]) if p.gyroscopic else 0.0)
+            T += 0.5 * (p.m_sheave[k] * np.sum(v[j:j + 2] ** 2) + p.J[k] * w_ax ** 2
+                        + p.Theta[k] * np.sum(v[j + 2:j + 4] ** 2))
+        return float(T)
+
+    def elastic_energy(self, q) -> float:
+        """Band compression plus shaft springs, J (the clamping potential is not included)."""
+        p, n = self.p, self.p.n_ritz
+        g = self.arcs(q[0])
+        E = self._c["c_edge"] * np.sum(self.strain(q, g) ** 2 * g["ds"])
+        if self.shaft_compliance:
+            b = 6 + 2 * n
+            for k in range(2):
+                j = b + 4 * k
+                E += 0.5 * (p.c_U[k] * np.sum(q[j:j + 2] ** 2) + p.c_psi[k] * np.sum(q[j + 2:j + 4] ** 2))
+        return float(E)
+
+    def clamp_positions(self, q):
+        """Axial sheave coordinates ``z_k`` (2,), m."""
+        return q[4:6]
+
+    def static_state(self, phi: float, F) -> np.ndarray:
+        """Coordinates in static equilibrium of the elastic coordinates at span angle phi and forces F.
+
+        Solves ``(2 c' int E E^T ds + D) x = 2 c' int E z0 ds - kappa F e_z`` per arc (Pi is quadratic in x).
+        """
+        p, c, n = self.p, self._c, self.p.n_ritz
+        g = self.arcs(phi)
+        q = np.zeros(self.n2)
+        q[0] = phi
+        for k in range(2):
+            E, ds = g["E"][k], g["ds"][k]
+            K = 2 * c["c_edge"] * (E * ds) @ E.T
+            rhs = 2 * c["c_edge"] * (E @ (g["z0"][k] * ds))
+            rhs[0] -= p.kappa * F[k]
+            if self.shaft_compliance:
+                K[1 + n:, 1 + n:] += np.diag([p.c_U[k]] * 2 + [p.c_psi[k]] * 2)
+            self._scatter_x(q, k, np.linalg.solve(K, rhs))
+        return q
+
+    def initial_state(self, phi0: float, omega1: float, omega2: float, F) -> tuple[np.ndarray, np.ndarray]:
+        """Static elastic equilibrium at phi0, shafts at omega1, omega2 (rad/s), no slip on pulley 1."""
+        q = self.static_state(phi0, F)
+        v = np.zeros(self.n2)
+        r = radii(phi0, self.p.length, self.p.L)[0]
+        v[1:4] = r[0] * omega1, omega1, omega2
+        return q, v

@@ -1,0 +1,131 @@
+"""Four-DOF band model ``q = [phi, sigma, phi1, phi2]`` (spec section 4.3).
+
+Lagrange form (erratum 3): ``Acal phi'' + Acal' phi'^2 / 2 = kappa sum F_k tan(gamma_k) r_k' + Q_phi``,
+``m sigma'' = Q_sigma``, ``J_k phi_k'' = M_k + Q_phi_k`` with ``Acal = A(phi) + sum m_k (tan(gamma_k) r_k')^2``
+(A from the corrected (1.45)).  Friction forces (1.51, corrected: theta instead of theta/r_k,
+N_k inside the sum) are Gauss-Legendre quadratures along each arc; the normal forces N_k are
+the constraint reactions of the per-sheave axial balance, solved with the phi-equation as the
+3x3 linear system of section 4.3.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from cvtfem.elements.band.friction import friction_vector
+from cvtfem.elements.band.geometry import radii, wrap_half_angles
+from cvtfem.elements.band.inertia import band_inertia
+from cvtfem.elements.band.params import BandParams, gauss_nodes
+
+
+def arc_geometry(phi, p: BandParams):
+    """Per-pulley geometry at span angle phi: r, r', r'', tan(gamma), d tan(gamma)/dr, theta*, z0; each ``(2,)``."""
+    r, dr, ddr = radii(phi, p.length, p.L)
+    tg = np.stack([p.sheaves[k].tan_gamma(r[k]) for k in range(2)])
+    dtg = np.stack([-p.sheaves[k].d2z0(r[k]) for k in range(2)])
+    z0 = np.stack([p.sheaves[k].z0(r[k]) for k in range(2)])
+    return r, dr, ddr, tg, dtg, wrap_half_angles(phi), z0
+
+
+def generalized_inertia(phi, p: BandParams):
+    """``Acal(phi) = A(phi) + sum_k m_k (tan(gamma_k) r_k')^2``, kg m^2 (may be complex)."""
+    r, dr, _, tg, _, _, _ = arc_geometry(phi, p)
+    return band_inertia(phi, p.length, p.L, p.mass) + sum(p.m_sheave[k] * (tg[k] * dr[k]) ** 2 for k in range(2))
+
+
+@dataclass(frozen=True)
+class FourDofBand:
+    """The 4-DOF band model as a pure kernel around :class:`BandParams`."""
+
+    p: BandParams
+    names: tuple[str, ...] = ("phi", "sigma", "phi1", "phi2")
+    _xi: np.ndarray = field(init=False, repr=False)
+    _wq: np.ndarray = field(init=False, repr=False)
+
+    def __post_init__(self) -> None:
+        xi, wq = gauss_nodes(self.p.n_gauss)
+        object.__setattr__(self, "_xi", xi)
+        object.__setattr__(self, "_wq", wq)
+
+    n2 = 4
+
+    def arc_nodes(self, phi: float) -> np.ndarray:
+        """Local arc angles theta of the quadrature nodes, ``(2, n_gauss)``, rad."""
+        return wrap_half_angles(phi)[:, None] * self._xi
+
+    def accel(self, q, v, F, M):
+        """Accelerations and diagnostics.
+
+        Parameters
+        ----------
+        q, v : arrays (4,)
+            Coordinates and velocities.
+        F : (2,) N
+            Clamping force per sheave of each pulley.
+        M : (2,) N m
+            Shaft torques.
+
+        Returns
+        -------
+        a : (4,) accelerations
+        info : dict with ``N`` (2,) N/m, ``dissipation`` W, ``clamp_power`` W, ``slip`` (2,) m/s
+            (circumferential slip at the arc middles), ``slip_max`` (2,) m/s.
+        """
+        p = self.p
+        phi, dphi = q[0], v[0]
+        r, dr, ddr, tg, dtg, ts, _ = arc_geometry(phi, p)
+        Ac = generalized_inertia(phi + 1e-30j, p)
+        A, dA = Ac.real, Ac.imag / 1e-30
+        rhs_phi = p.kappa * np.sum(F * tg * dr) - 0.5 * dA * dphi ** 2
+        a = np.empty(4)
+        info = {"N": np.zeros(2), "dissipation": 0.0, "slip": v[1] - r * v[2:4], "slip_max": np.zeros(2)}
+        if p.friction:
+            th = ts[:, None] * self._xi
+            ds = (r * ts)[:, None] * self._wq  # (2, g)
+            vr = np.stack([np.broadcast_to((dr * dphi)[:, None], th.shape),
+                           v[1] - th * (dr * dphi)[:, None] - (r * v[2:4])[:, None],
+                           np.broadcast_to((tg * dr * dphi)[:, None], th.shape)])
+            ft = friction_vector(vr, p.f0, p.v0, p.law)
+            # generalized friction forces per unit N_k (1.51, corrected)
+            G_phi = -2 * dr * np.sum((ft[0] - th * ft[1] + tg[:, None] * ft[2]) * ds, axis=1)
+            G_sig = -2 * np.sum(ft[1] * ds, axis=1)
+            G_shaft = 2 * r * np.sum(ft[1] * ds, axis=1)
+            P = np.sum((-1.0 / np.sqrt(1 + tg[:, None] ** 2) - ft[2]) * ds, axis=1)  # int k.p ds
+            msh = np.asarray(p.m_sheave)
+            alpha = (0.5 * msh * (ddr * tg + dr ** 2 * dtg) * dphi ** 2 - F) / P
+            beta = 0.5 * msh * dr * tg / P
+            a[0] = (rhs_phi + np.sum(alpha * G_phi)) / (A - np.sum(beta * G_phi))
+            N = alpha + beta * a[0]
+            a[1] = np.sum(N * G_sig) / p.mass
+            a[2:4] = (M + N * G_shaft) / np.asarray(p.J)
+            Q = np.array([np.sum(N * G_phi), np.sum(N * G_sig), N[0] * G_shaft[0], N[1] * G_shaft[1]])
+            info.update(N=N, dissipation=-float(Q @ v), slip_max=np.sqrt(np.sum(vr ** 2, axis=0)).max(axis=1))
+        else:
+            a[0] = rhs_phi / A
+            a[1] = 0.0
+            a[2:4] = M / np.asarray(p.J)
+        info["clamp_power"] = float(p.kappa * np.sum(F * tg * dr) * dphi)
+        return a, info
+
+    def kinetic_energy(self, q, v) -> float:
+        """``T = (Acal phi'^2 + m sigma'^2 + sum J_k phi_k'^2) / 2``, J (1.40), (1.44)."""
+        A = generalized_inertia(q[0], self.p)
+        return 0.5 * (A * v[0] ** 2 + self.p.mass * v[1] ** 2 + np.sum(np.asarray(self.p.J) * v[2:4] ** 2))
+
+    def elastic_energy(self, q) -> float:
+        """The 4-DOF band stores no elastic energy, J."""
+        return 0.0
+
+    def clamp_positions(self, q):
+        """Axial sheave positions ``z_k = z0_k(r_k(phi))`` (2,), m; ``kappa sum F_k z_k`` is the clamping potential."""
+        return arc_geometry(q[0], self.p)[6]
+
+    def initial_state(self, phi0: float, omega1: float, omega2: float, F) -> tuple[np.ndarray, np.ndarray]:
+        """Coordinates and velocities at span angle phi0 with shaft speeds omega1, omega2 (rad/s), no slip on pulley 1."""
+        r, *_ = radii(phi0, self.p.length, self.p.L)
+        return np.array([phi0, 0.0, 0.0, 0.0]), np.array([0.0, r[0] * omega1, omega1, omega2])
+
+    def speed_indices(self) -> tuple[int, int]:
+        """Indices of the driving and driven shaft angles in q."""
+        return 2, 3
