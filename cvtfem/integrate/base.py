@@ -60,6 +60,7 @@ class Stepper:
         self.system = system
         self.stats = stats if stats is not None else Stats()
         self._cache: tuple[float, np.ndarray, np.ndarray] | None = None
+        self._start: tuple[float, np.ndarray, np.ndarray] | None = None
 
     def f(self, t: float, x: np.ndarray) -> np.ndarray:
         """Counted, timed ``F(t, x)``; repeated calls at the last point are served from cache."""
@@ -73,13 +74,22 @@ class Stepper:
         self._cache = (t, x.copy(), y)
         return y
 
+    def f0(self, t: float, x: np.ndarray) -> np.ndarray:
+        """``F`` at a step start, kept across rejected attempts and set by FSAL methods."""
+        c = self._start
+        if c is not None and c[0] == t and np.array_equal(c[1], x):
+            return c[2]
+        y = self.f(t, x)
+        self._start = (t, x.copy(), y)
+        return y
+
     def attempt(self, t: float, x: np.ndarray, h: float) -> Attempt:  # pragma: no cover
         raise NotImplementedError
 
     def accept(self, att: Attempt) -> None:
         """Commit an accepted step; an FSAL slope becomes the cached ``F`` at the new point."""
         if att.f1 is not None:
-            self._cache = (att.t0 + att.h, att.x1.copy(), att.f1)
+            self._start = (att.t0 + att.h, att.x1.copy(), att.f1)
 
     def reset(self) -> None:
         """Forget the history (after an event switch changes the state or ``phi``)."""

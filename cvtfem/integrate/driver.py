@@ -185,7 +185,8 @@ def _integrate(stepper, ctrl, system, t0, tf, y0, h, rtol, atol, t_eval, event_l
         if tf - (t + h_try) < 1e-9 * h_try:
             h_try = tf - t
         try:
-            att = stepper.attempt(t, x, h_try)
+            with np.errstate(over="ignore", invalid="ignore"):   # detected below, reported
+                att = stepper.attempt(t, x, h_try)
             failure = None if np.all(np.isfinite(att.x1)) else "non-finite state"
         except StepFailure as err:
             att, failure = None, str(err)

@@ -78,7 +78,7 @@ class Extrapolator(Stepper):
         raise NotImplementedError
 
     def attempt(self, t, x, h):
-        f0 = self.f(t, x)
+        f0 = self.f0(t, x)
         T = []
         prev_diag = None
         for j, n in enumerate(self.n_seq):

@@ -57,7 +57,7 @@ class ExplicitRK(Stepper):
         self.fsal = self.fsal and propagate == "high"
 
     def attempt(self, t, x, h):
-        f0 = self.f(t, x)
+        f0 = self.f0(t, x)
         x1, err, K = rk_step(self.f, t, x, h, self.A, self._b, self.c, f0, self._b_err)
         f1 = K[-1] if self.fsal else None
         return Attempt(t, x, h, x1, err, f0, f1)

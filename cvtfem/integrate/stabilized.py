@@ -66,9 +66,12 @@ def rkc_stability_length(s: int) -> float:
 
 def spectral_radius(f, t, x, f0, v0=None, max_iter: int = 50, rtol: float = 0.01) -> float:
     """Nonlinear power iteration for ``rho(dF/dx)`` at ``(t, x)`` (RKC's ``rkcrho``), 1/s."""
-    v = np.array(f0 if v0 is None else v0, dtype=float)
-    if not np.any(v):
-        v = np.ones_like(x)
+    if v0 is None:   # F(x) plus a fixed rough vector, so that high modes are present
+        rough = np.random.default_rng(12345).standard_normal(x.shape)
+        nf = np.linalg.norm(f0)
+        v = (f0 / nf if nf > 0 else 0.0) + rough / np.linalg.norm(rough)
+    else:
+        v = np.array(v0, dtype=float)
     xnorm = np.linalg.norm(x)
     dx = np.sqrt(np.finfo(float).eps) * max(xnorm, 1.0)
     v *= dx / np.linalg.norm(v)
@@ -102,7 +105,7 @@ class RKC(Stepper):
         self.fixed_stages = stages
         self.stages = stages or 2
         self.rho_user, self.rho_every = spectral_radius, int(rho_every)
-        self._rho, self._rho_age, self._v = None, 0, None
+        self._rho, self._rho_age = None, 0
         self._coef: dict[int, tuple] = {}
 
     def _stage_count(self, t, x, f0, h) -> int:
@@ -114,7 +117,7 @@ class RKC(Stepper):
             rho = float(self.rho_user)
         else:
             if self._rho is None or self._rho_age >= self.rho_every:
-                self._rho = RHO_SAFETY * spectral_radius(self.f, t, x, f0, self._v)
+                self._rho = RHO_SAFETY * spectral_radius(self.f, t, x, f0)
                 self._rho_age = 0
             rho = self._rho
         s = max(2, int(np.sqrt(h * rho / 0.653)))
@@ -127,7 +130,7 @@ class RKC(Stepper):
         self._rho_age += 1
 
     def attempt(self, t, x, h):
-        f0 = self.f(t, x)
+        f0 = self.f0(t, x)
         s = self.stages = self._stage_count(t, x, f0, h)
         if s not in self._coef:
             self._coef[s] = rkc_coefficients(s)

@@ -67,7 +67,7 @@ class Theta(Stepper):
 
     def attempt(self, t, x, h):
         n2, a = self.system.n2, self.alpha
-        f0 = self.f(t, x)
+        f0 = self.f0(t, x)
         t1 = t + h
         x_pred = x + h * f0
         if a == 0.0:

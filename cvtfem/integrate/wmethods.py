@@ -68,7 +68,7 @@ class SW24(_WBase):
     def attempt(self, t, x, h):
         self._refresh(t, x)
         W = self.lu(h)
-        f0 = self.f(t, x)
+        f0 = self.f0(t, x)
         hd = h * self.d
         k1 = W.solve_full(f0)
         k2 = W.solve_full(self.f(t + 2 * h / 3, x + (2 * h / 3) * k1) - (4 / 3) * hd * (self.A @ k1))
@@ -90,7 +90,7 @@ class W1(_WBase):
 
     def attempt(self, t, x, h):
         self._refresh(t, x)
-        f0 = self.f(t, x)
+        f0 = self.f0(t, x)
         return Attempt(t, x, h, x + h * self.lu(h).solve_full(f0), None, f0)
 
 
