@@ -2,7 +2,8 @@
 
 The result has the same type and ``stats`` keys as native runs; ``nfev`` is counted by a
 wrapper (scipy's own count excludes nothing it calls through ``fun``), ``njev``/``nlu`` come
-from scipy; ``nsolve``, ``nnewton`` and ``nreject`` are not reported by scipy and are -1.
+from scipy; ``nsolve``, ``nnewton``, ``nreject`` and ``nfev_jac`` (its Jacobian RHS calls
+are inside ``nfev``) are not reported by scipy and are -1.
 """
 from __future__ import annotations
 
@@ -51,7 +52,7 @@ def solve_scipy(fun, t_span, y0, method, h, rtol, atol, events, jac, jac_sparsit
     c = stats.counts
     c["njev"], c["nlu"] = int(sol.njev), int(sol.nlu)
     c["nsteps"] = len(sol.t) - 1 if t_eval is None else -1
-    for key in ("nsolve", "nnewton", "nreject"):
+    for key in ("nsolve", "nnewton", "nreject", "nfev_jac"):
         c[key] = -1
     t_ev = sol.t_events if sol.t_events is not None else []
     y_ev = sol.y_events if sol.y_events is not None else []

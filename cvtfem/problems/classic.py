@@ -26,7 +26,7 @@ def oscillator(omega: float = 1.0, t_end: float = 10.0) -> Problem:
                    jac=lambda t, x: np.array([[0.0, 1.0], [-omega ** 2, 0.0]]), exact=exact)
 
 
-def limit_cycle(r0: float = 0.5, t_end: float = 2.0) -> Problem:
+def limit_cycle(r0: float = 0.3, t_end: float = 2.0) -> Problem:
     """Nonlinear planar system with closed form, for convergence orders.
 
     ``x' = -y + x (1 - r^2)``, ``y' = x + y (1 - r^2)``: ``theta = t``,

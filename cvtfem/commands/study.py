@@ -1,0 +1,159 @@
+"""``cvtfem study stability|order|work|heat``: integrator studies (PNG + CSV).
+
+Method specs are ``NAME[:key=value...]``, e.g. ``gbs-smooth:stages=2`` or ``sw24:d=0.5``.
+"""
+from __future__ import annotations
+
+import argparse
+import platform
+
+DEFAULT_STABILITY = ("euler,rk4,dopri45,dopri56,dopri78,gbs:stages=2,gbs-smooth:stages=2,"
+                     "euler-extrapolation:stages=4,sw24:d=0.5,w1-extrapolation:d=0.5:stages=4,"
+                     "trapezoidal,rkc:stages=5")
+DEFAULT_ORDER = "euler,rk4,dopri45,dopri56,dopri78,gbs:stages=2,sw24,trapezoidal,rkc:stages=10"
+
+
+def add_parser(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser("study", help="integrator studies: stability regions, effective order, "
+                                     "work-precision, heat-equation benchmark")
+    s = p.add_subparsers(dest="study", metavar="STUDY", required=True)
+    a = s.add_parser("stability", help="stability regions of methods on the complex h*lambda plane")
+    a.add_argument("--methods", default=DEFAULT_STABILITY, help="comma-separated method specs")
+    a.add_argument("--log", action="store_true", help="signed-log axes (spec §2.3) instead of linear")
+    a.add_argument("--extent", type=float, default=6.0, help="half-width of the linear plane")
+    a.add_argument("--png", default="stability.png", help="output PNG")
+    b = s.add_parser("order", help="effective-order test: local error vs h (spec §9.4)")
+    b.add_argument("--problem", default="limit_cycle", help="problem name (cvtfem.problems.PROBLEMS)")
+    b.add_argument("--methods", default=DEFAULT_ORDER)
+    b.add_argument("--hs", default="0.4:0.0125:6", help="H_MAX:H_MIN:COUNT (log spaced)")
+    b.add_argument("--png", default="order.png")
+    b.add_argument("--csv", default="order.csv")
+    c = s.add_parser("work", help="work-precision diagram of methods on a problem")
+    c.add_argument("--problem", default="hires")
+    c.add_argument("--methods", default="trapezoidal,sw24,Radau,BDF")
+    c.add_argument("--rtols", default="1e-4,1e-5,1e-6,1e-7", help="tolerances of adaptive runs")
+    c.add_argument("--steps", default="", help="fixed steps h instead of tolerances (comma separated)")
+    c.add_argument("--repeats", type=int, default=3, help="wall time = median of this many runs")
+    c.add_argument("--png", default="work.png")
+    c.add_argument("--csv", default="work.csv")
+    d = s.add_parser("heat", help="benchmark: heat equation, RHS calls and time at a target error")
+    d.add_argument("--N", type=int, default=1000)
+    d.add_argument("--target", type=float, default=1e-4)
+    d.add_argument("--repeats", type=int, default=3)
+    d.add_argument("--methods", default="", help="subset (default: the issue's list)")
+    d.add_argument("--csv", default="heat_benchmark.csv")
+    p.set_defaults(func=run)
+
+
+def parse_method(spec: str) -> tuple[str, str, dict]:
+    """``"gbs:stages=2"`` -> ``("gbs:stages=2", "gbs", {"stages": 2})``."""
+    from cvtfem.errors import InputError
+
+    name, *pairs = spec.strip().split(":")
+    opts = {}
+    for pair in pairs:
+        key, sep, val = pair.partition("=")
+        if not sep:
+            raise InputError("--methods", spec, "options must be key=value, e.g. gbs:stages=2")
+        for conv in (int, float):
+            try:
+                opts[key] = conv(val)
+                break
+            except ValueError:
+                continue
+        else:
+            opts[key] = val
+    return spec.strip(), name, opts
+
+
+def _floats(text: str, where: str) -> list[float]:
+    from cvtfem.errors import InputError
+
+    try:
+        return [float(v) for v in text.split(",") if v.strip()]
+    except ValueError:
+        raise InputError(where, text, "must be comma-separated numbers") from None
+
+
+def _problem(name: str):
+    from cvtfem.errors import InputError
+    from cvtfem.problems import PROBLEMS
+
+    if name not in PROBLEMS:
+        raise InputError("--problem", name, f"must be one of {sorted(PROBLEMS)}")
+    return PROBLEMS[name]()
+
+
+def run(args: argparse.Namespace) -> int:
+    import numpy as np
+
+    from cvtfem.errors import InputError
+    from cvtfem.integrate import study
+    from cvtfem.integrate.methods import METHODS
+    from cvtfem.post import integrators as plots
+
+    methods = [parse_method(m) for m in getattr(args, "methods", "").split(",") if m.strip()]
+    if args.study == "stability":
+        out = plots.plot_stability(methods, args.png, extent=args.extent, log=args.log)
+        print(f"wrote {out}")
+    elif args.study == "order":
+        try:
+            hmax, hmin, n = args.hs.split(":")
+            hs = np.geomspace(float(hmax), float(hmin), int(n))
+        except ValueError:
+            raise InputError("--hs", args.hs, "must be H_MAX:H_MIN:COUNT") from None
+        problem = _problem(args.problem)
+        curves, rows = [], []
+        for label, method, opts in methods:
+            if method not in METHODS:
+                raise InputError("--methods", method, f"must be native methods {sorted(METHODS)}")
+            nominal = METHODS[method](problem_system(problem), None, **opts).order
+            errs = study.local_errors(problem, method, hs, **opts)
+            curves.append((label, hs, errs, nominal))
+            p = study.effective_order(hs, errs)
+            rows += [{"label": label, "h": h, "error": e, "p_eff": q}
+                     for h, e, q in zip(hs, errs, [np.nan, *p])]
+            print(f"{label:28s} nominal {nominal}  p~ = " + " ".join(f"{q:5.2f}" for q in p))
+        plots.plot_effective_order(curves, args.png, f"effective order on {problem.name}")
+        plots.write_csv(rows, args.csv)
+        print(f"wrote {args.png}, {args.csv}")
+    elif args.study == "work":
+        problem = _problem(args.problem)
+        steps = _floats(args.steps, "--steps")
+        settings = ([{"h": h} for h in steps] if steps else
+                    [{"rtol": r, "atol": r * 1e-3} for r in _floats(args.rtols, "--rtols")])
+        runs = [(label, method, {**opts, **s}) for label, method, opts in methods for s in settings]
+        rows = study.work_precision(problem, runs, repeats=args.repeats)
+        _print_rows(rows)
+        plots.plot_work_precision(rows, args.png, f"work-precision on {problem.name}")
+        plots.write_csv(rows, args.csv)
+        print(f"wrote {args.png}, {args.csv}")
+    elif args.study == "heat":
+        names = [m for m in args.methods.split(",") if m.strip()] or None
+        rows = study.heat_benchmark(N=args.N, target=args.target, repeats=args.repeats, methods=names)
+        print(f"heat equation N={args.N}, t=0.1, target relative error {args.target:g}; "
+              f"median of {args.repeats} runs on {platform.machine()} {platform.processor() or ''} "
+              f"Python {platform.python_version()}")
+        _print_rows(rows)
+        plots.write_csv(rows, args.csv)
+        print(f"wrote {args.csv}")
+    return 0
+
+
+def problem_system(problem):
+    """The :class:`OdeSystem` of a problem (to instantiate a stepper for its nominal order)."""
+    from cvtfem.integrate.system import as_system
+
+    kw = problem.solve_kwargs()
+    return as_system(kw.pop("fun"), kw.pop("y0"), n2=kw.pop("n2"), jac=kw.get("jac"),
+                     jac_sparsity=kw.get("jac_sparsity"))
+
+
+def _print_rows(rows) -> None:
+    print(f"{'method':28s} {'setting':22s} {'rel.error':>10s} {'RHS calls':>10s} {'time, s':>9s}  status")
+    for r in rows:
+        setting = ", ".join(f"{k}={r[k]:.3g}" for k in ("h", "rtol") if k in r)
+        status = r.get("status")
+        met = "" if "met" not in r else ("  meets target" if r["met"] else "  MISSES target")
+        print(f"{r['label']:28s} {setting:22s} {r['error']:10.2e} {r['nfev']:10d} {r['time']:9.4f}  "
+              f"{status}{met}")
