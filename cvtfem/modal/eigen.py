@@ -32,8 +32,16 @@ from cvtfem.modal.whirl import circularize, classify
 
 #: Models up to this many DOF are solved densely by ``method="auto"``.
 DENSE_LIMIT = 600
-#: Eigenvalues with |Im| below this fraction of the frequency scale count as non-oscillatory.
-ZERO_RTOL = 1e-7
+#: Dense: eigenvalues with Im below this fraction of the block's largest |lambda| count as non-oscillatory
+#: (a rigid-body Jordan pair is perturbed by about sqrt(eps) |lambda|_max).
+ZERO_RTOL = 1e-6
+#: Sparse/slepc: the same, as a fraction of the largest |lambda| computed (the band of interest).
+SPARSE_ZERO = 1e-4
+#: Default shift of the sparse backend, rad/s: a real shift below the lowest frequency of interest keeps
+#: the shift-inverted spectrum well separated (|lambda - sigma| grows with the frequency).
+SIGMA = 1.0
+#: Relative real parts below this count as round-off in undamped problems.
+ROUNDOFF = 1e-9
 
 
 @dataclass(frozen=True)
@@ -72,7 +80,7 @@ class Modes:
     @property
     def damping_ratio(self) -> np.ndarray:
         """``-Re lambda / |lambda|``."""
-        return -self.eigenvalues.real / np.abs(self.eigenvalues)
+        return -self.eigenvalues.real / np.abs(self.eigenvalues) + 0.0
 
     @property
     def log_dec(self) -> np.ndarray:
@@ -110,97 +118,126 @@ class ModalProblem:
         self.kind = np.asarray(dof_kind)
         self.mdiag = self.M.diagonal()
         self.method = ("dense" if self.n <= DENSE_LIMIT else "sparse") if method == "auto" else method
-        kd = np.abs(self.K.diagonal())
-        self.scale = float(np.sqrt(kd.max() / self.mdiag[self.mdiag > 0].min())) if kd.max() > 0 else 1.0
-        self._dense = None
+        pattern = abs(self.M) + abs(self.K) + abs(self.C) + abs(self.G)
+        n_blocks, label = connected_components(pattern, directed=False)
+        self.blocks = [np.flatnonzero(label == b) for b in range(n_blocks)]
+        self._dense: dict[int, tuple[np.ndarray, np.ndarray, np.ndarray | None]] = {}
+        self._cache: dict[tuple[int, int], tuple[np.ndarray, np.ndarray]] = {}
 
-    def _dense_blocks(self) -> list[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray | None]]:
-        """Independent DOF blocks with ``(dofs, M^-1 K, M^-1 C, M^-1 G or None)`` (Cholesky once)."""
-        if self._dense is None:
-            pattern = abs(self.M) + abs(self.K) + abs(self.C) + abs(self.G)
-            n_blocks, label = connected_components(pattern, directed=False)
-            self._dense = []
-            for b in range(n_blocks):
-                dofs = np.flatnonzero(label == b)
-                sub = [X[dofs][:, dofs].toarray() for X in (self.M, self.K, self.C, self.G)]
-                try:
-                    cho = sla.cho_factor(sub[0])
-                except np.linalg.LinAlgError:
-                    raise NumericalError("mass matrix is not positive definite (a DOF without inertia?)",
-                                         component="modal.dense") from None
-                MK, MC = sla.cho_solve(cho, sub[1]), sla.cho_solve(cho, sub[2])
-                MG = sla.cho_solve(cho, sub[3]) if np.any(sub[3]) else None
-                self._dense.append((dofs, MK, MC, MG))
-            self._cache: dict[int, tuple[np.ndarray, np.ndarray]] = {}
-        return self._dense
+    def _sub(self, b: int) -> list[sp.csr_matrix]:
+        dofs = self.blocks[b]
+        return [X[dofs][:, dofs] for X in (self.M, self.K, self.C, self.G)]
 
     def solve(self, speed: float, n_modes: int, sigma: float | None = None) -> Modes:
-        """Lowest ``n_modes`` oscillatory modes at ``speed`` (rad/s)."""
+        """Lowest ``n_modes`` oscillatory modes at ``speed`` (rad/s).
+
+        Independent DOF blocks (connected components of the sparsity of
+        M + K + C + G) are solved separately; blocks without gyroscopic coupling
+        do not depend on the speed and are solved once and reused.
+        """
         if n_modes < 1:
             raise InputError("n_modes", n_modes, "must be >= 1")
-        if self.method == "dense":
-            lam, Z = self._solve_dense(speed)
+        lams, vecs = [], []
+        for b, dofs in enumerate(self.blocks):
+            gyro = self.G[dofs].nnz > 0
+            key = (b, n_modes)
+            if not gyro and key in self._cache:
+                lam, Zb = self._cache[key]
+            else:
+                lam, Zb = self._solve_block(b, speed if gyro else 0.0, n_modes, sigma)
+                if not gyro:
+                    self._cache[key] = (lam, Zb)
+            Z = np.zeros((self.n, len(lam)), dtype=complex)
+            Z[dofs] = Zb
+            lams.append(lam)
+            vecs.append(Z)
+        return self._finish(speed, np.concatenate(lams), np.concatenate(vecs, axis=1), n_modes)
+
+    def _solve_block(self, b: int, speed: float, n_modes: int,
+                     sigma: float | None) -> tuple[np.ndarray, np.ndarray]:
+        """Oscillatory eigenpairs (Im lambda > threshold) of one block."""
+        m = len(self.blocks[b])
+        if self.method == "dense" or (self.method == "sparse" and m <= DENSE_LIMIT):
+            lam, Z = self._solve_dense(b, speed)
+            thr = ZERO_RTOL * np.abs(lam).max(initial=0.0)
         elif self.method == "sparse":
-            lam, Z = self._solve_sparse(speed, n_modes, sigma)
+            lam, Z = self._solve_sparse(b, speed, n_modes, sigma)
+            thr = SPARSE_ZERO * np.abs(lam).max(initial=0.0)
         else:
             from cvtfem.modal.slepc_backend import solve_pep
 
-            lam, Z = solve_pep(self.M, self.K, self.C + speed * self.G, n_modes, sigma)
-        return self._finish(speed, lam, Z, n_modes)
+            M, K, C, G = self._sub(b)
+            lam, Z = solve_pep(M, K, C + speed * G, min(n_modes + 4, m), -SIGMA if sigma is None else sigma)
+            thr = SPARSE_ZERO * np.abs(lam).max(initial=0.0)
+        keep = lam.imag > thr
+        return lam[keep], Z[:, keep]
 
-    def _solve_dense(self, speed: float) -> tuple[np.ndarray, np.ndarray]:
-        lams, vecs = [], []
-        for b, (dofs, MK, MC, MG) in enumerate(self._dense_blocks()):
-            if MG is None and b in self._cache:  # speed-independent block: reuse
-                lam, Z = self._cache[b]
-            else:
-                m = len(dofs)
-                A = np.zeros((2 * m, 2 * m))
-                A[:m, m:] = np.eye(m)
-                A[m:, :m] = -MK
-                A[m:, m:] = -MC if MG is None else -(MC + speed * MG)
-                lam, Zb = sla.eig(A, overwrite_a=True, check_finite=False)
-                keep = lam.imag > 0
-                lam, Z = lam[keep], np.zeros((self.n, keep.sum()), dtype=complex)
-                Z[dofs] = Zb[:m, keep]
-                if MG is None:
-                    self._cache[b] = (lam, Z)
-            lams.append(lam)
-            vecs.append(Z)
-        return np.concatenate(lams), np.concatenate(vecs, axis=1)
+    def _solve_dense(self, b: int, speed: float) -> tuple[np.ndarray, np.ndarray]:
+        if b not in self._dense:  # one Cholesky of the block mass matrix, reused for every speed
+            M, K, C, G = (X.toarray() for X in self._sub(b))
+            try:
+                cho = sla.cho_factor(M)
+            except np.linalg.LinAlgError:
+                raise NumericalError("mass matrix is not positive definite (a DOF without inertia?)",
+                                     component="modal.dense") from None
+            self._dense[b] = (sla.cho_solve(cho, K), sla.cho_solve(cho, C),
+                              sla.cho_solve(cho, G) if np.any(G) else None)
+        MK, MC, MG = self._dense[b]
+        m = MK.shape[0]
+        A = np.zeros((2 * m, 2 * m))
+        A[:m, m:] = np.eye(m)
+        A[m:, :m] = -MK
+        A[m:, m:] = -MC if MG is None else -(MC + speed * MG)
+        lam, Z = sla.eig(A, overwrite_a=True, check_finite=False)
+        return lam, Z[:m]
 
-    def _solve_sparse(self, speed: float, n_modes: int, sigma: float | None) -> tuple[np.ndarray, np.ndarray]:
-        n = self.n
-        s = -1e-3 * self.scale if sigma is None else float(sigma)
-        D = (self.C + speed * self.G).tocsc()
-        P = (self.K + s * D + s * s * self.M).tocsc()
+    def _solve_sparse(self, b: int, speed: float, n_modes: int,
+                      sigma: float | None) -> tuple[np.ndarray, np.ndarray]:
+        M, K, C, G = self._sub(b)
+        n = M.shape[0]
+        s = -SIGMA if sigma is None else float(sigma)
+        if C.nnz == 0 and (G.nnz == 0 or speed == 0):
+            return self._solve_symmetric(M, K, n_modes, s)
+        D = (C + speed * G).tocsc()
+        P = (K + s * D + s * s * M).tocsc()
         try:
             lu = spla.splu(P)
         except RuntimeError as err:
             raise NumericalError(f"shift-invert factorisation failed at sigma = {s:g} ({err})",
                                  component="modal.sparse") from None
-        DsM = (D + s * self.M).tocsr()
-        M = self.M
+        DsM = (D + s * M).tocsr()
 
         def op(w: np.ndarray) -> np.ndarray:
-            a, b = w[:n], M @ w[n:]
-            x = -lu.solve(b + DsM @ a)
+            a, c = w[:n], M @ w[n:]
+            x = -lu.solve(c + DsM @ a)
             return np.concatenate([x, a + s * x])
 
-        k = min(2 * n_modes + 10, 2 * n - 2)
+        k = min(2 * n_modes + 6, 2 * n - 2)
         A = spla.LinearOperator((2 * n, 2 * n), matvec=op, dtype=float)
         try:
-            mu, Z = spla.eigs(A, k=k, which="LM", ncv=min(2 * n, max(2 * k + 1, 40)), tol=1e-12)
+            mu, Z = spla.eigs(A, k=k, which="LM", ncv=min(2 * n, 2 * k + 1), tol=1e-12)
         except spla.ArpackNoConvergence as err:
             raise NumericalError(f"ARPACK did not converge at Omega = {speed:g} rad/s ({err})",
                                  component="modal.sparse") from None
         return s + 1.0 / mu, Z[:n]
 
+    @staticmethod
+    def _solve_symmetric(M: sp.csr_matrix, K: sp.csr_matrix, n_modes: int,
+                         s: float) -> tuple[np.ndarray, np.ndarray]:
+        """Undamped, non-gyroscopic block: ``K x = w^2 M x`` (Lanczos, shift ``-s^2``); rigid modes stay simple."""
+        k = min(n_modes + 4, M.shape[0] - 1)
+        try:
+            w2, X = spla.eigsh(K.tocsc(), k=k, M=M.tocsc(), sigma=-s * s, which="LM", tol=1e-12)
+        except spla.ArpackNoConvergence as err:
+            raise NumericalError(f"ARPACK (Lanczos) did not converge ({err})", component="modal.sparse") from None
+        return 1j * np.sqrt(np.clip(w2, 0.0, None)), X.astype(complex)
+
     def _finish(self, speed: float, lam: np.ndarray, X: np.ndarray, n_modes: int) -> Modes:
         if not np.all(np.isfinite(lam)):
             raise NumericalError("non-finite eigenvalues", component="modal")
-        keep = lam.imag > ZERO_RTOL * self.scale
-        lam, X = lam[keep], X[:, keep]
+        if self.C.nnz == 0:  # conservative gyroscopic system: the spectrum is imaginary, drop round-off
+            lam = lam.copy()
+            lam.real[np.abs(lam.real) < ROUNDOFF * np.abs(lam)] = 0.0
         order = np.argsort(lam.imag)[:n_modes + 2]
         lam, X = lam[order], X[:, order]
         if len(lam) < n_modes:

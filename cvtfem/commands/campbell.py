@@ -1,0 +1,73 @@
+"""``cvtfem campbell SCENE --speeds 0:4000rpm:51 [--json OUT] [--png OUT]``: Campbell diagram."""
+from __future__ import annotations
+
+import argparse
+
+
+def add_parser(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser("campbell", help="Campbell diagram of a rotor scene: tracked modes, orders, critical speeds")
+    p.add_argument("scene", metavar="SCENE", help="rotor scene file (.toml) or preset name")
+    p.add_argument("--speeds", required=True, help="START:STOP<unit>:COUNT, unit rpm, rad/s or Hz (0:4000rpm:51)")
+    p.add_argument("--n-modes", type=int, help="tracked modes (default [rotor].n_modes)")
+    p.add_argument("--orders", default="1", help="shaft orders k (lines k x speed), comma separated")
+    p.add_argument("--chain", metavar="R,LCHAIN,LLINK",
+                   help="CVT lines k f_chain and k/3 f_link for contact radius R, chain and link length (m)")
+    p.add_argument("--method", default="auto", choices=("auto", "dense", "sparse", "slepc"))
+    p.add_argument("--json", metavar="OUT", help="write per-speed modes, tracked curves, crossings as JSON")
+    p.add_argument("--csv", metavar="OUT", help="write tracked curves as CSV")
+    p.add_argument("--png", metavar="OUT", help="plot the diagram")
+    p.set_defaults(func=run)
+
+
+def _orders(args: argparse.Namespace) -> tuple[tuple[str, float], ...]:
+    from cvtfem.errors import InputError
+    from cvtfem.modal import chain_orders, shaft_orders
+
+    try:
+        ks = tuple(float(k) for k in args.orders.split(",") if k.strip())
+    except ValueError:
+        raise InputError("--orders", args.orders, "must be comma-separated numbers, e.g. 1,2") from None
+    lines = shaft_orders(ks)
+    if args.chain:
+        try:
+            r, lc, ll = (float(v) for v in args.chain.split(","))
+        except ValueError:
+            raise InputError("--chain", args.chain, "must be three numbers R,LCHAIN,LLINK in m") from None
+        lines += chain_orders(r, lc, ll)
+    return lines
+
+
+def run(args: argparse.Namespace) -> int:
+    import json
+
+    import numpy as np
+
+    from cvtfem.commands.modes import load_rotor
+    from cvtfem.modal import ModalProblem, campbell
+    from cvtfem.modal.speeds import parse_speeds
+
+    speeds = parse_speeds(args.speeds)
+    scene, model = load_rotor(args.scene)
+    n_modes = args.n_modes or (scene.rotor.n_modes if scene.rotor else 12)
+    problem = ModalProblem(model.M, model.K, model.C, model.G, model.dof_kind, args.method)
+    result = campbell(problem, speeds, n_modes, _orders(args))
+    print(f"{scene.title or scene.source}: {len(speeds)} speeds x {n_modes} modes, backend {problem.method}")
+    print("critical speeds (mode crossing an excitation line):")
+    for c in result.crossings:
+        print(f"  {c['order']:>12}  mode {c['mode']:>2} ({c['whirl']:<9}) at {c['speed_rad_s']:10.4g} rad/s "
+              f"= {c['speed_rad_s'] * 30 / np.pi:9.5g} rpm")
+    if not result.crossings:
+        print("  none in the speed range")
+    if args.json:
+        with open(args.json, "w") as fh:
+            json.dump({"scene": scene.source, "backend": problem.method, **result.to_dict()}, fh)
+        print(f"wrote {args.json}")
+    if args.csv:
+        result.write_csv(args.csv)
+        print(f"wrote {args.csv}")
+    if args.png:
+        from cvtfem.post.campbell import plot_campbell
+
+        plot_campbell(result, args.png, title=scene.title or scene.source)
+        print(f"wrote {args.png}")
+    return 0

@@ -1,0 +1,77 @@
+"""Campbell: MAC tracking, excitation lines, critical speeds, speed parsing, CLI."""
+import json
+
+import numpy as np
+import pytest
+
+from cvtfem.errors import InputError
+from cvtfem.machines.rotor import build_model
+from cvtfem.modal import ModalProblem, campbell, chain_orders, shaft_orders
+from cvtfem.modal.speeds import parse_speed, parse_speeds
+from cvtfem.scene.loader import load_scene
+
+
+@pytest.fixture(scope="module")
+def friswell():
+    m = build_model(load_scene("friswell_5_9_1"))
+    return ModalProblem(m.M, m.K, m.C, m.G, m.dof_kind)
+
+
+def test_tracking_follows_whirl_through_crossing_curves(friswell):
+    """The backward 3rd pair and the (gyro-free) torsional mode cross near 3000 rpm; MAC keeps identities."""
+    res = campbell(friswell, np.linspace(0, 4000 * np.pi / 30, 26), 8)
+    for j in range(8):
+        assert len(set(res.whirl[1:, j])) == 1          # each tracked curve keeps its class over speed
+    tors = np.flatnonzero(res.whirl[-1] == "torsional")[0]
+    assert np.ptp(res.wd[:, tors]) < 1e-8 * res.wd[0, tors]    # torsion does not depend on speed
+    fw = res.whirl[-1] == "forward"
+    assert np.all(np.diff(res.wd[:, fw], axis=0) > 0)     # forward branches rise (spec §4.4)
+
+
+def test_critical_speeds_lie_on_the_lines(friswell):
+    res = campbell(friswell, np.linspace(0, 4000 * np.pi / 30, 41), 4, shaft_orders((1.0, 2.0)))
+    assert len(res.crossings) == 8
+    for c in res.crossings:
+        k = float(c["order"].rstrip("x"))
+        modes = friswell.solve(c["speed_rad_s"], 4)
+        err = np.min(np.abs(modes.wd - k * c["speed_rad_s"])) / c["frequency_rad_s"]
+        assert err < 2e-3, c                               # linear interpolation between 41 speeds
+
+
+def test_chain_orders():
+    lines = dict(chain_orders(radius=0.05, chain_length=0.8, link_length=0.009, k_chain=2, k_link=3))
+    assert lines["1 f_chain"] == pytest.approx(2 * np.pi * 0.05 / 0.8)
+    assert lines["3/3 f_link"] == pytest.approx(2 * np.pi * 0.05 / 0.009)
+    with pytest.raises(InputError, match="link_length"):
+        chain_orders(0.05, 0.8, 0.0)
+
+
+def test_speed_parsing():
+    assert parse_speed("4000rpm") == pytest.approx(4000 * np.pi / 30)
+    assert parse_speed("10 rad/s") == 10.0
+    assert parse_speeds("0:4000rpm:51")[-1] == pytest.approx(4000 * np.pi / 30)
+    for bad in ("4000", "fast", "12furlongs"):
+        with pytest.raises(InputError, match="--speed"):
+            parse_speed(bad)
+    with pytest.raises(InputError, match="--speeds"):
+        parse_speeds("100:0rpm:5")
+
+
+def test_cli_modes_and_campbell(cli, tmp_path):
+    out = tmp_path / "m.json"
+    r = cli("modes", "friswell_5_9_1", "--speed", "4000rpm", "--json", str(out))
+    assert r.returncode == 0, r.stderr
+    data = json.loads(out.read_text())
+    for key in ("speed_rad_s", "wn_rad_s", "wd_rad_s", "damping_ratio", "whirl"):
+        assert key in data
+    assert data["wd_rad_s"] == sorted(data["wd_rad_s"])
+    np.testing.assert_allclose(data["wd_rad_s"][:2], [85.39, 87.80], rtol=1e-3)
+    js, csv = tmp_path / "c.json", tmp_path / "c.csv"
+    r = cli("campbell", "friswell_5_9_1", "--speeds", "0:4000rpm:11", "--n-modes", "4", "--json", str(js),
+            "--csv", str(csv))
+    assert r.returncode == 0, r.stderr
+    c = json.loads(js.read_text())
+    assert len(c["per_speed"]) == 11 and "whirl" in c["per_speed"][0]
+    assert len(csv.read_text().splitlines()) == 1 + 11 * 4
+    r = cli("campbell", "friswell_5_9_1", "--speeds", "0:4000:11")
+    assert r.returncode == 2 and "--speeds" in r.stderr
