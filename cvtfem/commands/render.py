@@ -1,0 +1,48 @@
+"""``cvtfem render SCENE [--mode K] --png OUT``: off-screen rendering of a rotor or one of its modes."""
+from __future__ import annotations
+
+import argparse
+
+
+def add_parser(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser("render", help="render a rotor scene or a mode shape off-screen (PNG, GIF, VTU)")
+    p.add_argument("scene", metavar="SCENE", help="rotor scene file (.toml) or preset name")
+    p.add_argument("--mode", type=int, help="mode index (ascending damped frequency); omit for the geometry")
+    p.add_argument("--speed", help="spin speed with unit (default [rotor].speed)")
+    p.add_argument("--scale", type=float, help="displacement scale (default: 8 %% of the shaft length)")
+    p.add_argument("--png", metavar="OUT", help="PNG file")
+    p.add_argument("--gif", metavar="OUT", help="animated GIF of the mode over one period")
+    p.add_argument("--vtu", metavar="OUT", help="VTU file (meshio) with all computed modes for ParaView")
+    p.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    from cvtfem.commands.modes import load_rotor
+    from cvtfem.errors import InputError
+
+    if not (args.png or args.gif or args.vtu):
+        raise InputError("--png/--gif/--vtu", None, "needs at least one output file")
+    scene, model = load_rotor(args.scene)
+    from cvtfem.render import rotor as r
+
+    if args.mode is None:
+        if args.gif or args.vtu:
+            raise InputError("--mode", None, "is required for --gif and --vtu")
+        print(f"wrote {r.render_rotor(model, args.png)}")
+        return 0
+    from cvtfem.modal import ModalProblem
+    from cvtfem.modal.speeds import parse_speed
+
+    if args.mode < 0:
+        raise InputError("--mode", args.mode, "must be >= 0")
+    speed = parse_speed(args.speed) if args.speed else (scene.rotor.speed if scene.rotor else 0.0)
+    modes = ModalProblem(model.M, model.K, model.C, model.G, model.dof_kind).solve(speed, args.mode + 1)
+    k = args.mode
+    print(f"mode {k}: wd = {modes.wd[k]:.6g} rad/s, {modes.whirl[k]}")
+    if args.png:
+        print(f"wrote {r.render_mode(model, modes, k, args.png, args.scale)}")
+    if args.gif:
+        print(f"wrote {r.write_mode_gif(model, modes, k, args.gif, scale=args.scale)}")
+    if args.vtu:
+        print(f"wrote {r.write_mode_vtu(model, modes, args.vtu)}")
+    return 0

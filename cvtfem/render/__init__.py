@@ -1,0 +1,1 @@
+"""Off-screen pyvista renderings (pyvista is imported inside the functions)."""
