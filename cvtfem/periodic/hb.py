@@ -202,17 +202,28 @@ def _symmetrize(a: np.ndarray) -> np.ndarray:
     return (a + np.conj(a[:, ::-1])) / 2
 
 
-def newton_step(net, omega, a, p, M, topo, D, method="auto"):
-    """One Newton-Kantorovich correction (B:(29)): returns ``(delta, r, method_used)``."""
+def linearize(net: TorsionalNetwork, omega: float, a: np.ndarray, p: np.ndarray, M: int, D):
+    """Residual ``r`` (S, K) and Jacobian blocks: node ``N`` (S, 1, K, K), link ``L`` (E, 1, K, K).
+
+    ``L_e`` is the Toeplitz matrix of B:(38) (Fourier coefficients of
+    ``f_e'(l_e(t))`` by FFT, ``(L_e)_{nm} = c_e^(n-m)``) plus ``i n omega d_e``.
+    """
     N = (a.shape[1] - 1) // 2
     n = np.arange(-N, N + 1)
+    K = len(n)
     r, df = residual(net, omega, a, p, M, D)
     chat = np.fft.fft(df, axis=-1) / M
-    L = chat[:, (n[:, None] - n[None, :]) % M]  # Toeplitz B:(38), (E, K, K)
-    L = L + np.eye(len(n)) * (1j * n * omega)[None, :] * net.d[:, None, None]
-    Nb = np.zeros((net.n_nodes, 1, len(n), len(n)), complex)
-    Nb[:, 0, np.arange(len(n)), np.arange(len(n))] = _node_term(net, omega, n)
-    delta, used = solve_blocks(Nb, L[:, None], net.i, net.j, -r[:, None], topo, method)
+    L = chat[:, (n[:, None] - n[None, :]) % M]
+    L[:, np.arange(K), np.arange(K)] += (1j * n * omega)[None, :] * net.d[:, None]
+    Nb = np.zeros((net.n_nodes, 1, K, K), complex)
+    Nb[:, 0, np.arange(K), np.arange(K)] = _node_term(net, omega, n)
+    return r, Nb, L[:, None]
+
+
+def newton_step(net, omega, a, p, M, topo, D, method="auto"):
+    """One Newton-Kantorovich correction (B:(29)): returns ``(delta, r, method_used)``."""
+    r, Nb, L = linearize(net, omega, a, p, M, D)
+    delta, used = solve_blocks(Nb, L, net.i, net.j, -r[:, None], topo, method)
     return _symmetrize(delta[:, 0]), r, used
 
 

@@ -156,6 +156,8 @@ def apply(N: np.ndarray, L: np.ndarray, i: np.ndarray, j: np.ndarray, a: np.ndar
     """Matrix-vector product of the block system with ``a`` (S, B, K)."""
     out = np.einsum("sbkl,sbl->sbk", diagonal_blocks(N, L, i, j), a)
     inner = j >= 0
+    if not inner.any():
+        return out
     Li, ii, jj = L[inner], i[inner], j[inner]
     coupled = np.concatenate([np.einsum("ebkl,ebl->ebk", Li, a[jj]), np.einsum("ebkl,ebl->ebk", Li, a[ii])])
     return out - (_scatter(np.concatenate([ii, jj]), a.shape[0]) @ coupled.reshape(len(coupled), -1)).reshape(a.shape)

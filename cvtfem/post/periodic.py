@@ -1,0 +1,91 @@
+"""Plots of periodic responses (matplotlib, imported lazily)."""
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from cvtfem.periodic.response import SAMPLES, ResponseSweep
+
+
+def _pyplot():
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def plot_summary(sweep: ResponseSweep, probe: int, path: Path, point: int | None = None) -> Path:
+    """Two panels: peak moment of link ``probe`` vs frequency, and its moment over one period.
+
+    Parameters
+    ----------
+    sweep : ResponseSweep
+    probe : int
+        Link index.
+    path : Path
+        PNG file to write.
+    point : int, optional
+        Sweep point shown over one period (default: largest response with backlash).
+    """
+    plt = _pyplot()
+    name = sweep.nonlinear[0].network.link_names[probe]
+    f = sweep.omega / (2 * np.pi)
+    pk_nl = sweep.peaks("nonlinear")[:, probe]
+    pk_lin = sweep.peaks("linear")[:, probe]
+    if point is None:
+        point = int(np.nanargmax(pk_nl)) if np.isfinite(pk_nl).any() else 0
+    fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(11, 4.2))
+    if len(f) > 1:
+        ax1.plot(f, pk_nl, "o-", ms=3, label="with backlash")
+        ax1.plot(f, pk_lin, "s--", ms=3, label="without backlash")
+        bad = ~np.isfinite(pk_nl)
+        if bad.any():
+            ax1.plot(f[bad], np.full(bad.sum(), np.nanmax(pk_lin)), "rx", label="not converged")
+        ax1.set_xlabel("cycle frequency, Hz")
+        ax1.set_ylabel(f"peak moment {name}, N m")
+        ax1.set_title("frequency response")
+        ax1.legend()
+        ax1.grid(alpha=0.3)
+    else:
+        ax1.bar(["with backlash", "without"], [pk_nl[0], pk_lin[0]], color=["C0", "C1"])
+        ax1.set_ylabel(f"peak moment {name}, N m")
+        ax1.set_title(f"ratio {pk_nl[0] / pk_lin[0]:.2f}")
+    phase = np.arange(SAMPLES) / SAMPLES * 360
+    for sol, label, style in ((sweep.nonlinear[point], "with backlash", "-"),
+                              (sweep.linear[point], "without backlash", "--")):
+        if sol.converged:
+            ax2.plot(phase, sol.link_moments(SAMPLES)[probe], style, label=label)
+    ax2.set_xlabel("cycle phase, deg")
+    ax2.set_ylabel(f"moment {name}, N m")
+    ax2.set_title(f"one period at {f[point]:.3g} Hz")
+    ax2.legend()
+    ax2.grid(alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return Path(path)
+
+
+def plot_branch(omega: np.ndarray, amplitude: np.ndarray, stable: np.ndarray | None, path: Path,
+                ylabel: str = "peak deflection, m", up_down: tuple | None = None) -> Path:
+    """Continuation branch (amplitude vs frequency), stable/unstable points marked, optional up/down sweeps."""
+    plt = _pyplot()
+    fig, ax = plt.subplots(figsize=(6.5, 4.2))
+    ax.plot(omega, amplitude, "-", color="0.6", lw=1, label="arclength continuation")
+    if stable is not None:
+        ax.plot(omega[stable], amplitude[stable], "o", ms=3, color="C0", label="stable (Floquet)")
+        ax.plot(omega[~stable], amplitude[~stable], "o", ms=3, color="C3", label="unstable (Floquet)")
+    if up_down is not None:
+        for (w, amp), label, marker in zip(up_down, ("sweep up", "sweep down"), ("^", "v")):
+            ax.plot(w, amp, marker, ms=5, mfc="none", label=label)
+    ax.set_xlabel("forcing frequency, rad/s")
+    ax.set_ylabel(ylabel)
+    ax.grid(alpha=0.3)
+    ax.legend()
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return Path(path)
