@@ -21,6 +21,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     a.add_argument("--methods", default=DEFAULT_STABILITY, help="comma-separated method specs")
     a.add_argument("--log", action="store_true", help="signed-log axes (spec §2.3) instead of linear")
     a.add_argument("--extent", type=float, default=6.0, help="half-width of the linear plane")
+    a.add_argument("--n", type=int, default=401, help="pixels per axis")
     a.add_argument("--png", default="stability.png", help="output PNG")
     b = s.add_parser("order", help="effective-order test: local error vs h (spec §9.4)")
     b.add_argument("--problem", default="limit_cycle", help="problem name (cvtfem.problems.PROBLEMS)")
@@ -94,7 +95,7 @@ def run(args: argparse.Namespace) -> int:
 
     methods = [parse_method(m) for m in getattr(args, "methods", "").split(",") if m.strip()]
     if args.study == "stability":
-        out = plots.plot_stability(methods, args.png, extent=args.extent, log=args.log)
+        out = plots.plot_stability(methods, args.png, extent=args.extent, log=args.log, n=args.n)
         print(f"wrote {out}")
     elif args.study == "order":
         try:
