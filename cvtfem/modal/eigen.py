@@ -105,6 +105,7 @@ class ModalProblem:
     dof_kind : int array (n,)
         Node-DOF kind 0..5 of every DOF (``u1 u2 u3 theta1 theta2 phi``).
     method : {"auto", "dense", "sparse", "slepc"}
+        "auto" picks dense for blocks up to :data:`DENSE_LIMIT` DOF, sparse above.
     damped : bool
         False drops C (undamped analysis; G is kept).
     """
@@ -117,10 +118,13 @@ class ModalProblem:
         self.n = self.M.shape[0]
         self.kind = np.asarray(dof_kind)
         self.mdiag = self.M.diagonal()
-        self.method = ("dense" if self.n <= DENSE_LIMIT else "sparse") if method == "auto" else method
         pattern = abs(self.M) + abs(self.K) + abs(self.C) + abs(self.G)
         n_blocks, label = connected_components(pattern, directed=False)
         self.blocks = [np.flatnonzero(label == b) for b in range(n_blocks)]
+        #: backend of each block ("auto": dense up to DENSE_LIMIT DOF, else sparse)
+        self.block_methods = [("dense" if len(d) <= DENSE_LIMIT else "sparse") if method == "auto" else method
+                              for d in self.blocks]
+        self.method = "+".join(sorted(set(self.block_methods)))
         self._dense: dict[int, tuple[np.ndarray, np.ndarray, np.ndarray | None]] = {}
         self._cache: dict[tuple[int, int], tuple[np.ndarray, np.ndarray]] = {}
 
@@ -157,17 +161,21 @@ class ModalProblem:
                      sigma: float | None) -> tuple[np.ndarray, np.ndarray]:
         """Oscillatory eigenpairs (Im lambda > threshold) of one block."""
         m = len(self.blocks[b])
-        if self.method == "dense" or (self.method == "sparse" and m <= DENSE_LIMIT):
+        if self.block_methods[b] == "dense":
             lam, Z = self._solve_dense(b, speed)
             thr = ZERO_RTOL * np.abs(lam).max(initial=0.0)
-        elif self.method == "sparse":
+        elif self.block_methods[b] == "sparse":
             lam, Z = self._solve_sparse(b, speed, n_modes, sigma)
             thr = SPARSE_ZERO * np.abs(lam).max(initial=0.0)
         else:
-            from cvtfem.modal.slepc_backend import solve_pep
+            from cvtfem.modal.slepc_backend import solve_gep, solve_pep
 
             M, K, C, G = self._sub(b)
-            lam, Z = solve_pep(M, K, C + speed * G, min(n_modes + 4, m), -SIGMA if sigma is None else sigma)
+            s = -SIGMA if sigma is None else sigma
+            if C.nnz == 0 and (G.nnz == 0 or speed == 0):
+                lam, Z = solve_gep(M, K, n_modes, s)
+            else:
+                lam, Z = solve_pep(M, K, C + speed * G, min(n_modes + 4, m), s)
             thr = SPARSE_ZERO * np.abs(lam).max(initial=0.0)
         keep = lam.imag > thr
         return lam[keep], Z[:, keep]

@@ -79,3 +79,42 @@ def solve_pep(M: sp.spmatrix, K: sp.spmatrix, D: sp.spmatrix, n_eig: int, sigma:
         X[:, i] = xr.getArray() + 1j * xi.getArray() if np.isrealobj(xr.getArray()) else xr.getArray()
     pep.destroy()
     return lam, X
+
+
+def solve_gep(M: sp.spmatrix, K: sp.spmatrix, n_eig: int, sigma: float,
+              tol: float = 1e-13) -> tuple[np.ndarray, np.ndarray]:
+    """Undamped, gyroscope-free block: ``K x = w^2 M x`` by EPS (GHEP, shift-invert at ``-sigma^2``).
+
+    Returns ``lambda = i w`` and real eigenvectors, like the quadratic solver (rigid modes stay simple).
+    """
+    if not available():
+        raise InputError("method", "slepc", "needs slepc4py and petsc4py (pip install 'cvtfem[slepc]')")
+    import slepc4py
+
+    slepc4py.init()
+    from petsc4py import PETSc
+    from slepc4py import SLEPc
+
+    eps = SLEPc.EPS().create(comm=PETSc.COMM_SELF)
+    eps.setOperators(_petsc(K), _petsc(M))
+    eps.setProblemType(SLEPc.EPS.ProblemType.GHEP)
+    eps.setDimensions(nev=min(n_eig + 4, M.shape[0] - 1))
+    eps.setTarget(-sigma * sigma)
+    eps.setWhichEigenpairs(SLEPc.EPS.Which.TARGET_MAGNITUDE)
+    st = eps.getST()
+    st.setType(SLEPc.ST.Type.SINVERT)
+    st.getKSP().setType("preonly")
+    st.getKSP().getPC().setType("lu")
+    eps.setTolerances(tol=tol, max_it=1000)
+    eps.solve()
+    nconv = eps.getConverged()
+    if nconv == 0:
+        raise NumericalError("SLEPc EPS found no eigenpairs", component="modal.slepc")
+    xr, xi = eps.getOperators()[0].createVecs()
+    w2 = np.empty(nconv)
+    X = np.empty((M.shape[0], nconv), dtype=complex)
+    for i in range(nconv):
+        w2[i] = eps.getEigenpair(i, xr, xi).real
+        X[:, i] = xr.getArray()
+    eps.destroy()
+    return 1j * np.sqrt(np.clip(w2, 0.0, None)), X

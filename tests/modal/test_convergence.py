@@ -62,3 +62,23 @@ def test_timoshenko_short_shaft(Di, speed):
     # Euler-Bernoulli over-estimates a thick shaft: shear and rotary inertia matter at L/D = 5
     eb, _ = lowest(32, L, Do, Di, speed=speed, shear=False, rotary_inertia=False)
     assert np.all(eb.wd > r.wd * 1.02)
+
+
+@pytest.mark.parametrize("P", [5e4, -2e3])
+def test_axial_force_geometric_stiffness(P):
+    """Euler-Bernoulli string-beam: w^2 = (EI k^4 + P k^2) / (rho A) for a simply supported shaft."""
+    from cvtfem.assembly import assemble
+
+    from .helpers import restrict, uniform_shaft
+
+    n, L, D = 16, 2.0, 0.05
+    b, M, K, G, kind = uniform_shaft(n, L, D, shear=False, rotary_inertia=False, gyroscopic=False)
+    K = assemble(M.shape[0], [(b.stiffness(P), b.dofs)])
+    node = np.repeat(np.arange(n + 1), 6)
+    keep = np.flatnonzero(np.isin(kind, [0, 1, 3, 4]) & ~(np.isin(kind, [0, 1]) & ((node == 0) | (node == n))))
+    M, K, G = restrict(keep, M, K, G)
+    r = ModalProblem(M, K, 0 * K, G, kind[keep], method="dense").solve(0.0, 6)
+    A, I = np.pi * D**2 / 4, np.pi * D**4 / 64
+    k = np.repeat(np.arange(1, 4) * np.pi / L, 2)
+    exact = np.sqrt((STEEL["E"] * I * k**4 + P * k**2) / (STEEL["rho"] * A))
+    np.testing.assert_allclose(r.wd, exact, rtol=2e-4)
