@@ -13,6 +13,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
                    help="eigen-solver backend")
     p.add_argument("--undamped", action="store_true", help="ignore damping matrices")
     p.add_argument("--json", metavar="OUT", help="write the modes as JSON")
+    p.add_argument("--shapes", action="store_true", help="include the mode shapes (per node, 6 DOF) in the JSON")
     p.set_defaults(func=run)
 
 
@@ -54,6 +55,6 @@ def run(args: argparse.Namespace) -> int:
               f"{modes.damping_ratio[i]:>10.3g} {modes.log_dec[i]:>10.3g}  {modes.whirl[i]}")
     if args.json:
         with open(args.json, "w") as fh:
-            json.dump({"scene": scene.source, "backend": problem.method, **modes.to_dict()}, fh, indent=1)
+            json.dump({"scene": scene.source, "backend": problem.method, **modes.to_dict(shapes=args.shapes)}, fh, indent=1)
         print(f"wrote {args.json}")
     return 0

@@ -88,11 +88,20 @@ class Modes:
         z = np.clip(self.damping_ratio, -0.999999, 0.999999)
         return 2 * np.pi * z / np.sqrt(1 - z**2)
 
-    def to_dict(self) -> dict[str, object]:
-        """JSON-ready summary (one entry per mode)."""
-        return {"speed_rad_s": float(self.speed), "wn_rad_s": self.wn.tolist(), "wd_rad_s": self.wd.tolist(),
-                "damping_ratio": self.damping_ratio.tolist(), "log_dec": self.log_dec.tolist(),
-                "whirl": list(self.whirl), "whirl_ratio": self.whirl_ratio.tolist()}
+    def to_dict(self, shapes: bool = False) -> dict[str, object]:
+        """JSON-ready summary (one entry per mode); ``shapes=True`` adds the mode shapes.
+
+        Shapes are ``shape_real`` / ``shape_imag``: per mode a list of nodes, each
+        ``[u1, u2, u3, theta1, theta2, phi]`` (normalised to unit peak modulus).
+        """
+        out: dict[str, object] = {
+            "speed_rad_s": float(self.speed), "wn_rad_s": self.wn.tolist(), "wd_rad_s": self.wd.tolist(),
+            "damping_ratio": self.damping_ratio.tolist(), "log_dec": self.log_dec.tolist(),
+            "whirl": list(self.whirl), "whirl_ratio": self.whirl_ratio.tolist()}
+        if shapes:
+            X = self.shapes.T.reshape(self.shapes.shape[1], -1, 6)
+            out["shape_real"], out["shape_imag"] = X.real.tolist(), X.imag.tolist()
+        return out
 
 
 class ModalProblem:

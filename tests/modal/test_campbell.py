@@ -59,13 +59,16 @@ def test_speed_parsing():
 
 def test_cli_modes_and_campbell(cli, tmp_path):
     out = tmp_path / "m.json"
-    r = cli("modes", "friswell_5_9_1", "--speed", "4000rpm", "--json", str(out))
+    r = cli("modes", "friswell_5_9_1", "--speed", "4000rpm", "--json", str(out), "--shapes")
     assert r.returncode == 0, r.stderr
     data = json.loads(out.read_text())
     for key in ("speed_rad_s", "wn_rad_s", "wd_rad_s", "damping_ratio", "whirl"):
         assert key in data
     assert data["wd_rad_s"] == sorted(data["wd_rad_s"])
     np.testing.assert_allclose(data["wd_rad_s"][:2], [85.39, 87.80], rtol=1e-3)
+    shape = np.array(data["shape_real"][1]) + 1j * np.array(data["shape_imag"][1])
+    assert shape.shape == (7, 6) and np.max(np.abs(shape)) == pytest.approx(1.0)
+    assert np.imag(np.vdot(shape[:, 0], shape[:, 1])) < 0          # forward orbit: Im(conj(u1) u2) < 0
     js, csv = tmp_path / "c.json", tmp_path / "c.csv"
     r = cli("campbell", "friswell_5_9_1", "--speeds", "0:4000rpm:11", "--n-modes", "4", "--json", str(js),
             "--csv", str(csv))
