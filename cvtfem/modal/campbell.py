@@ -151,7 +151,7 @@ def campbell(problem: ModalProblem, speeds: np.ndarray, n_modes: int,
     speeds = np.asarray(speeds, dtype=float)
     if speeds.ndim != 1 or len(speeds) < 1 or np.any(np.diff(speeds) <= 0):
         raise InputError("speeds", speeds.tolist()[:5], "must be one or more increasing speeds")
-    modes = [problem.solve(s, n_modes + extra) for s in speeds]
+    modes = [problem.solve(s, n_modes + extra, min_modes=n_modes) for s in speeds]
     idx = track(modes, n_modes)
     rows = np.arange(len(speeds))[:, None]
     wd = np.array([m.wd for m in modes])[rows, idx]

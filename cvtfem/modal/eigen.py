@@ -141,8 +141,11 @@ class ModalProblem:
         dofs = self.blocks[b]
         return [X[dofs][:, dofs] for X in (self.M, self.K, self.C, self.G)]
 
-    def solve(self, speed: float, n_modes: int, sigma: float | None = None) -> Modes:
+    def solve(self, speed: float, n_modes: int, sigma: float | None = None, min_modes: int | None = None) -> Modes:
         """Lowest ``n_modes`` oscillatory modes at ``speed`` (rad/s).
+
+        ``min_modes`` (default ``n_modes``): fewer oscillatory modes than this is a
+        :class:`NumericalError`; between ``min_modes`` and ``n_modes`` all found are returned.
 
         Independent DOF blocks (connected components of the sparsity of
         M + K + C + G) are solved separately; blocks without gyroscopic coupling
@@ -164,7 +167,8 @@ class ModalProblem:
             Z[dofs] = Zb
             lams.append(lam)
             vecs.append(Z)
-        return self._finish(speed, np.concatenate(lams), np.concatenate(vecs, axis=1), n_modes)
+        return self._finish(speed, np.concatenate(lams), np.concatenate(vecs, axis=1), n_modes,
+                            n_modes if min_modes is None else min_modes)
 
     def _solve_block(self, b: int, speed: float, n_modes: int,
                      sigma: float | None) -> tuple[np.ndarray, np.ndarray]:
@@ -249,7 +253,7 @@ class ModalProblem:
             raise NumericalError(f"ARPACK (Lanczos) did not converge ({err})", component="modal.sparse") from None
         return 1j * np.sqrt(np.clip(w2, 0.0, None)), X.astype(complex)
 
-    def _finish(self, speed: float, lam: np.ndarray, X: np.ndarray, n_modes: int) -> Modes:
+    def _finish(self, speed: float, lam: np.ndarray, X: np.ndarray, n_modes: int, min_modes: int) -> Modes:
         if not np.all(np.isfinite(lam)):
             raise NumericalError("non-finite eigenvalues", component="modal")
         if self.C.nnz == 0:  # conservative gyroscopic system: the spectrum is imaginary, drop round-off
@@ -257,8 +261,8 @@ class ModalProblem:
             lam.real[np.abs(lam.real) < ROUNDOFF * np.abs(lam)] = 0.0
         order = np.argsort(lam.imag)[:n_modes + 2]
         lam, X = lam[order], X[:, order]
-        if len(lam) < n_modes:
-            raise NumericalError(f"found only {len(lam)} oscillatory modes, {n_modes} requested",
+        if len(lam) < min_modes:
+            raise NumericalError(f"found only {len(lam)} oscillatory modes, {min_modes} requested",
                                  component="modal")
         X = circularize(lam, X, self.kind, self.mdiag)
         peak = X[np.argmax(np.abs(X), axis=0), np.arange(X.shape[1])]

@@ -50,3 +50,15 @@ def test_overhung_disk_whirl(speed):
         np.testing.assert_allclose(got, exact[label], rtol=1e-6)
     if speed:
         assert r.wd[np.array(r.whirl) == "forward"][0] > r.wd[np.array(r.whirl) == "backward"][0]
+
+
+def test_campbell_of_a_small_model_tracks_all_its_modes():
+    """4 DOF give 4 oscillatory modes: the Campbell sweep asks for spares but must not fail."""
+    from cvtfem.modal import campbell
+
+    (M, K, G), kind = model()
+    res = campbell(ModalProblem(M, K, 0 * K, G, kind, method="dense"), np.linspace(0, 3000, 7), 4)
+    for i, s in enumerate(res.speeds):
+        exact = closed_form(s)
+        np.testing.assert_allclose(np.sort(res.wd[i]), np.sort(np.concatenate([exact["forward"],
+                                                                               exact["backward"]])), rtol=1e-6)
