@@ -37,6 +37,8 @@ CASES = [  # method, options, nominal order, step sizes
     ("theta", {"alpha": 0.3}, 1, [0.02, 0.01]),
     ("rkc", {"stages": 5}, 2, [0.05, 0.025]),
     ("rkc", {"stages": 20}, 2, [0.1, 0.05]),
+    ("rock2", {"stages": 5}, 2, [0.1, 0.05]),
+    ("rock2", {"stages": 50}, 2, [0.1, 0.05]),
 ]
 
 
