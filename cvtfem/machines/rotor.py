@@ -35,6 +35,8 @@ class RotorModel:
         Axial node positions, m (elastic-connection disk nodes sit at their shaft node).
     beam, disks, bearings : element families
         For rendering and outputs.
+    profiles : tuple
+        Per disk its (r, z) section polygon relative to the centre of mass (m), or None.
     """
 
     M: sp.csr_matrix
@@ -45,6 +47,7 @@ class RotorModel:
     beam: BeamFamily
     disks: DiskFamily
     bearings: BearingFamily
+    profiles: tuple = ()
 
     @property
     def n_dof(self) -> int:
@@ -67,9 +70,9 @@ def _shaft_arrays(scene: Scene) -> dict[str, np.ndarray]:
             "rho": np.array([mats[s.material].rho for s in rows])}
 
 
-def _disk_properties(scene: Scene) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _disk_properties(scene: Scene) -> tuple[np.ndarray, np.ndarray, np.ndarray, tuple]:
     mats = {m.name: m for m in scene.material}
-    m, Id, Ip = [], [], []
+    m, Id, Ip, profiles = [], [], [], []
     for d in scene.disk:
         if d.geometry:
             from cvtfem.elements.disk import axisymmetric_properties
@@ -79,11 +82,15 @@ def _disk_properties(scene: Scene) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
             else:
                 prof = sheave_profile(d.inner_diameter, d.outer_diameter, d.hub_diameter, d.hub_length,
                                       d.rim_thickness, d.cone_angle, d.face, d.torus_radius)
+                if d.facing == "-z":
+                    prof = (prof[0], -prof[1])
             p = axisymmetric_properties(*prof, mats[d.material].rho)
             m.append(p.m), Id.append(p.Id), Ip.append(p.Ip)
+            profiles.append((prof[0], prof[1] - p.zc))
         else:
             m.append(d.mass), Id.append(d.Id), Ip.append(d.Ip)
-    return np.array(m), np.array(Id), np.array(Ip)
+            profiles.append(None)
+    return np.array(m), np.array(Id), np.array(Ip), tuple(profiles)
 
 
 def _bearings(scene: Scene) -> BearingFamily:
@@ -127,7 +134,7 @@ def build_model(scene: Scene) -> RotorModel:
     elastic = [i for i, d in enumerate(scene.disk) if d.connection == "elastic"]
     disk_nodes = np.array([d.node for d in scene.disk], dtype=np.int64)
     disk_nodes[elastic] = n_shaft + np.arange(len(elastic))
-    m, Id, Ip = _disk_properties(scene)
+    m, Id, Ip, profiles = _disk_properties(scene)
     disks = DiskFamily(disk_nodes, m, Id, Ip)
     bearings = _bearings(scene)
     n = 6 * (n_shaft + len(elastic))
@@ -147,7 +154,7 @@ def build_model(scene: Scene) -> RotorModel:
                      (bearings.gyroscopic(), bearings.dofs)])
     z = np.concatenate([[0.0], np.cumsum(arrays["L"]), np.zeros(len(elastic))])
     z[n_shaft:] = z[[scene.disk[i].node for i in elastic]]
-    return RotorModel(M, K, C, G, z, beam, disks, bearings)
+    return RotorModel(M, K, C, G, z, beam, disks, bearings, profiles)
 
 
 def layout(scene: Scene) -> tuple[Layout, ...]:

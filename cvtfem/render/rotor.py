@@ -65,12 +65,16 @@ def _scene_meshes(model: RotorModel, shape: np.ndarray | None, phase: float, sca
         line = pv.lines_from_points(pts[elem == e])
         meshes.append(("shaft", line.tube(radius=b.Do[e] / 2, n_sides=24, capping=True)))
     d = np.zeros(model.n_dof) if shape is None else scale * np.real(shape * np.exp(1j * phase))
-    for node, m, Ip in zip(model.disks.nodes, model.disks.m, model.disks.Ip):
+    profiles = model.profiles or (None,) * len(model.disks.m)
+    for node, m, Ip, prof in zip(model.disks.nodes, model.disks.m, model.disks.Ip, profiles):
         u1, u2, _, t1, t2, _ = d[6 * node:6 * node + 6]
-        r, w = _disk_size(m, Ip)
         axis = np.array([1.0, -t1, t2])     # tilted normal: (z, u2, u1) view components of e3 + theta x e3
         centre = _to_view(np.array([model.z[node]]), np.array([u1]), np.array([u2]))[0]
-        meshes.append(("disk", pv.Cylinder(center=centre, direction=axis, radius=r, height=w, resolution=48)))
+        if prof is None:
+            r, w = _disk_size(m, Ip)
+            meshes.append(("disk", pv.Cylinder(center=centre, direction=axis, radius=r, height=w, resolution=48)))
+        else:
+            meshes.append(("disk", _revolved(prof, centre, axis)))
     for node in model.bearings.nodes if shape is None else ():   # bearings stay on the ground
         u1, u2 = d[6 * node], d[6 * node + 1]
         r = b.Do[min(node, len(b.L) - 1)]
@@ -78,6 +82,25 @@ def _scene_meshes(model: RotorModel, shape: np.ndarray | None, phase: float, sca
         meshes.append(("bearing", pv.Cone(center=tip - np.array([0, 0, r]), direction=(0, 0, 1), height=2 * r,
                                           radius=r, resolution=24)))
     return meshes
+
+
+def _revolved(profile: tuple[np.ndarray, np.ndarray], centre: np.ndarray, axis: np.ndarray):  # noqa: ANN202
+    """Solid of revolution of an (r, z) section polygon about ``axis`` through ``centre``."""
+    import pyvista as pv
+
+    r, z = profile
+    pts = np.column_stack([np.append(z, z[0]), np.append(r, r[0]), np.zeros(len(r) + 1)])
+    grid = pv.lines_from_points(pts).extrude_rotate(resolution=72, rotation_axis=(1, 0, 0), capping=False)
+    grid = grid.compute_normals(split_vertices=True, feature_angle=40.0, auto_orient_normals=True)
+    a = axis / np.linalg.norm(axis)
+    rot = np.eye(3)
+    if not np.allclose(a, [1.0, 0.0, 0.0]):
+        v = np.cross([1.0, 0.0, 0.0], a)
+        c = a[0]
+        vx = np.array([[0, -v[2], v[1]], [v[2], 0, -v[0]], [-v[1], v[0], 0]])
+        rot = np.eye(3) + vx + vx @ vx / (1 + c)
+    grid.points = grid.points @ rot.T + centre
+    return grid
 
 
 _COLORS = {"shaft": "lightsteelblue", "disk": "goldenrod", "bearing": "dimgray"}
@@ -98,7 +121,7 @@ def render_rotor(model: RotorModel, path: str | Path, size: tuple[int, int] = (1
     for kind, mesh in _scene_meshes(model, None, 0.0, 0.0):
         p.add_mesh(mesh, color=_COLORS[kind], smooth_shading=True)
     p.view_isometric()
-    p.camera.zoom(1.6)
+    p.camera.zoom(1.25)
     p.add_text("rotor: shaft (blue), disks (gold), bearings (grey)", font_size=10, color="black")
     p.screenshot(str(path))
     p.close()

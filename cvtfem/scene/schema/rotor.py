@@ -58,6 +58,8 @@ DISK = TableArray("disk", "Rigid disks / sheaves on shaft nodes.", Table("disk",
     Key("cone_angle", "float", "Sheave face angle from the radial plane.", "rad", 0.192, ge=0.0, lt=1.5),
     Key("face", "str", "Sheave contact face generatrix.", "", "conical", choices=("conical", "toroidal")),
     Key("torus_radius", "float", "Toroidal face arc radius.", "m", 0.0, ge=0.0),
+    Key("facing", "str", "Direction the sheave face looks along the axis (the two sheaves of a pulley face "
+        "each other).", "", "+z", choices=("+z", "-z")),
     Key("connection", "str", "Sheave-shaft connection: rigid (same node) or elastic (own node, springs).", "",
         "rigid", choices=("rigid", "elastic")),
     Key("c_u", "float", "Elastic connection radial stiffness.", "N/m", 0.0, ge=0.0),
