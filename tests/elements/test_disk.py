@@ -73,3 +73,14 @@ def test_connection_stiffness_is_symmetric_with_six_rigid_modes():
     assert np.allclose(K, K.T)
     ev = np.linalg.eigvalsh(K)
     assert np.sum(np.abs(ev) < 1e-9 * ev.max()) == 6
+
+
+def test_family_from_geometry_uses_the_section():
+    profiles = [disc_profile(0.07, 0.05, 0.28), sheave_profile(0.04, 0.2, 0.08, 0.03, 0.01, 0.2, "toroidal", 0.3)]
+    fam = DiskFamily.from_geometry(np.array([2, 5]), profiles, np.array([7810.0, 7850.0]))
+    ref = [axisymmetric_properties(*profiles[0], 7810.0), axisymmetric_properties(*profiles[1], 7850.0)]
+    np.testing.assert_allclose(fam.m, [p.m for p in ref])
+    np.testing.assert_allclose(fam.Id, [p.Id for p in ref])
+    assert fam.dofs.tolist()[1] == list(range(30, 36))
+    M = fam.mass()[0]
+    assert np.diag(M).tolist() == [fam.m[0]] * 3 + [fam.Id[0]] * 2 + [fam.Ip[0]]

@@ -81,3 +81,24 @@ def test_bad_scenes_name_the_key(change, where):
     data.update(change)
     with pytest.raises(InputError, match=where.replace("[", r"\[").replace("]", r"\]")):
         scene_from_dict(data)
+
+
+def test_shear_coefficient_option():
+    """kappa = Cowper's value reproduces the default; a smaller kappa (more shear) lowers the frequencies."""
+    from cvtfem.elements.beam import cowper_kappa
+
+    data = friswell_dict()
+    base = modes(scene_from_dict(data), 0.0, 6)
+    data["rotor"]["shear_coefficient"] = float(cowper_kappa(2.11e11 / (2 * 8.12e10) - 1, 0.0))
+    np.testing.assert_allclose(modes(scene_from_dict(data), 0.0, 6).wd, base.wd, rtol=1e-12)
+    data["rotor"]["shear_coefficient"] = 0.3
+    assert np.all(modes(scene_from_dict(data), 0.0, 6).wd[[0, 1, 2, 3, 5]] < base.wd[[0, 1, 2, 3, 5]])
+    data["rotor"]["theory"] = "euler-bernoulli"
+    assert np.all(modes(scene_from_dict(data), 0.0, 6).wd[[0, 2, 5]] > base.wd[[0, 2, 5]])
+
+
+def test_too_many_modes_is_a_numerical_error(cli):
+    r = cli("modes", "friswell_5_9_1", "--n-modes", "500")
+    assert r.returncode == 3 and "oscillatory modes" in r.stderr
+    r = cli("modes", "reference_cvt")
+    assert r.returncode == 2 and "rotor scene" in r.stderr
