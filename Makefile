@@ -38,7 +38,8 @@ install-slepc: $(STAMP)
 	command -v apt-get >/dev/null && [ "$$(id -u)" = 0 ] && { dpkg -s libopenblas-dev liblapack-dev >/dev/null 2>&1 || \
 	  { apt-get update -qq && apt-get install -y -qq libopenblas-dev liblapack-dev; }; } || true
 	$(BIN)/python -m pip install -q cython numpy setuptools wheel
-	for p in petsc petsc4py slepc slepc4py; do $(SLEPC_ENV) $(BIN)/python -m pip install -q --no-build-isolation $$p || exit 1; done
+	$(SLEPC_ENV) $(BIN)/python -m pip install -q petsc
+	for p in petsc4py slepc slepc4py; do $(SLEPC_ENV) $(BIN)/python -m pip install -q --no-build-isolation $$p || exit 1; done
 
 test-slepc: install-slepc
 	$(BIN)/python -m pytest -m slepc -q
