@@ -134,6 +134,7 @@ class ModalProblem:
         self.block_methods = [("dense" if len(d) <= DENSE_LIMIT else "sparse") if method == "auto" else method
                               for d in self.blocks]
         self.method = "+".join(sorted(set(self.block_methods)))
+        self._gyro = [self.G[d].nnz > 0 for d in self.blocks]
         self._dense: dict[int, tuple[np.ndarray, np.ndarray, np.ndarray | None]] = {}
         self._cache: dict[tuple[int, int], tuple[np.ndarray, np.ndarray]] = {}
 
@@ -155,7 +156,7 @@ class ModalProblem:
             raise InputError("n_modes", n_modes, "must be >= 1")
         lams, vecs = [], []
         for b, dofs in enumerate(self.blocks):
-            gyro = self.G[dofs].nnz > 0
+            gyro = self._gyro[b]
             key = (b, n_modes)
             if not gyro and key in self._cache:
                 lam, Zb = self._cache[key]
