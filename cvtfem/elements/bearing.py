@@ -78,6 +78,20 @@ class RadialLaw:
         ee = np.outer(e, e)
         return float(self.slope(u)) * ee + float(self.force(u)) / u * (np.eye(2) - ee)
 
+    def damping(self, u_perp: np.ndarray, beta: float) -> np.ndarray:
+        """2x2 damping ``beta f_r'(0) e e^T`` (radial rate only, spec (1.275), §12.4), N s/m.
+
+        At ``u = 0`` the direction is undefined; ``beta f_r'(0) I`` is used there
+        (the isotropic choice the spec allows).
+        """
+        u_perp = np.asarray(u_perp, dtype=float)
+        u = float(np.hypot(*u_perp))
+        c = beta * float(self.slope(0.0))
+        if u == 0.0:
+            return c * np.eye(2)
+        e = u_perp / u
+        return c * np.outer(e, e)
+
     def reaction(self, u_perp: np.ndarray) -> np.ndarray:
         """Elastic reaction on the shaft ``-f_r(u) e_u`` (spec (1.277)), N."""
         u_perp = np.asarray(u_perp, dtype=float)

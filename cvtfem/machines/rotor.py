@@ -102,7 +102,9 @@ def _bearings(scene: Scene) -> BearingFamily:
         if b.law != "linear":
             law = RadialLaw(u=b.table_u, f=b.table_f) if b.law == "table" else RadialLaw(coeffs=b.coeffs)
             Kt = law.tangent(np.array(b.u0))
-            e.update(kxx=Kt[0, 0], kxy=Kt[0, 1], kyx=Kt[1, 0], kyy=Kt[1, 1])
+            Dt = law.damping(np.array(b.u0), b.beta)
+            e.update(kxx=Kt[0, 0], kxy=Kt[0, 1], kyx=Kt[1, 0], kyy=Kt[1, 1], cxx=e["cxx"] + Dt[0, 0],
+                     cxy=e["cxy"] + Dt[0, 1], cyx=e["cyx"] + Dt[1, 0], cyy=e["cyy"] + Dt[1, 1])
         entries.append(e)
     return BearingFamily.from_dicts(np.array([b.node for b in scene.bearing], dtype=np.int64), entries)
 

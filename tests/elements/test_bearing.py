@@ -39,3 +39,12 @@ def test_linear_blocks():
 def test_bad_table_is_input_error():
     with pytest.raises(InputError, match="radial law table"):
         RadialLaw(u=(0.0, 2e-5, 1e-5), f=(0.0, 1.0, 2.0))
+
+
+def test_radial_damping_is_radial_only():
+    law = LAWS[0]
+    D = law.damping(np.array([3e-5, 4e-5]), beta=1e-4)
+    e = np.array([0.6, 0.8])
+    np.testing.assert_allclose(D, 1e-4 * 2e7 * np.outer(e, e))
+    np.testing.assert_allclose(D @ np.array([-0.8, 0.6]), 0.0, atol=1e-12)      # no circumferential damping
+    np.testing.assert_allclose(law.damping(np.zeros(2), 1e-4), 1e-4 * 2e7 * np.eye(2))

@@ -88,6 +88,8 @@ BEARING = TableArray("bearing", "Bearings (supports to ground) on shaft nodes.",
     Key("coeffs", "float[]", "Polynomial law f_r = c1 u + c2 u^2 + ...", "N/m^n", ()),
     Key("u0", "float[]", "Operating lateral deflection (u1, u2) for the tangent stiffness.", "m", (0.0, 0.0),
         length=2),
+    Key("beta", "float", "Radial damping beta f_r'(0) e e^T of a nonlinear law (added to cxx..).", "s", 0.0,
+        ge=0.0),
 ), checks=(lambda t, p: _check_bearing(t, p),)))
 
 
