@@ -126,6 +126,13 @@ class ModalProblem:
         self.C = sp.csr_matrix(C) if damped else sp.csr_matrix(self.M.shape)
         self.n = self.M.shape[0]
         self.kind = np.asarray(dof_kind)
+        for name, X in (("M", self.M), ("K", self.K), ("C", self.C), ("G", self.G)):
+            if X.shape != (self.n, self.n):
+                raise InputError(name, X.shape, f"must be a square matrix of the size of M, ({self.n}, {self.n})")
+            if not np.all(np.isfinite(X.data)):
+                raise InputError(name, "non-finite entries", "must be finite")
+        if self.kind.shape != (self.n,) or np.any((self.kind < 0) | (self.kind > 5)):
+            raise InputError("dof_kind", self.kind.shape, f"must hold {self.n} DOF kinds in 0..5")
         self.mdiag = self.M.diagonal()
         pattern = abs(self.M) + abs(self.K) + abs(self.C) + abs(self.G)
         n_blocks, label = connected_components(pattern, directed=False)
@@ -268,7 +275,7 @@ class ModalProblem:
         X = circularize(lam, X, self.kind, self.mdiag)
         peak = X[np.argmax(np.abs(X), axis=0), np.arange(X.shape[1])]
         X = X / peak
-        labels, ratio = classify(X, self.mdiag, self.kind)
+        labels, ratio = classify(X, self.mdiag, self.kind, spin_sign=-1.0 if speed < 0 else 1.0)
         # repeated frequencies (clusters): backward before forward, the order they take for Omega > 0
         cluster = np.concatenate([[0], np.cumsum(np.diff(lam.imag) > 1e-7 * lam.imag[1:])])
         order = np.lexsort((ratio, cluster))[:n_modes]

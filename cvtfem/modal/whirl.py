@@ -65,7 +65,8 @@ def circularize(lam: np.ndarray, X: np.ndarray, kind: np.ndarray, mdiag: np.ndar
     return X
 
 
-def classify(X: np.ndarray, M_diag_blocks: np.ndarray, kind: np.ndarray) -> tuple[list[str], np.ndarray]:
+def classify(X: np.ndarray, M_diag_blocks: np.ndarray, kind: np.ndarray,
+             spin_sign: float = 1.0) -> tuple[list[str], np.ndarray]:
     """Whirl labels and whirl ratios of mode shapes.
 
     Parameters
@@ -75,6 +76,8 @@ def classify(X: np.ndarray, M_diag_blocks: np.ndarray, kind: np.ndarray) -> tupl
     M_diag_blocks : array (n,)
         Diagonal of the mass matrix.
     kind : int array (n,)
+    spin_sign : float
+        Sign of the spin speed: whirl is forward when the orbit turns with the spin.
 
     Returns
     -------
@@ -91,7 +94,7 @@ def classify(X: np.ndarray, M_diag_blocks: np.ndarray, kind: np.ndarray) -> tupl
     lateral = total - w[kind == PHI].sum(axis=0) - w[kind == U3].sum(axis=0)
     a, b, wab = _pairs(kind, M_diag_blocks)
     s = (2 * wab[:, None] * np.imag(X[a].conj() * X[b])).sum(axis=0)
-    ratio = np.where(lateral > 0, -s / np.where(lateral > 0, lateral, 1.0), 0.0)
+    ratio = spin_sign * np.where(lateral > 0, -s / np.where(lateral > 0, lateral, 1.0), 0.0)
     labels = []
     for k in range(X.shape[1]):
         if tors[k] > 0.5:

@@ -55,3 +55,20 @@ def test_damped_bearings_give_positive_damping_and_log_dec():
     np.testing.assert_allclose(r.wn * np.sqrt(1 - r.damping_ratio**2), r.wd, rtol=1e-12)
     undamped = ModalProblem(m.M, m.K, m.C, m.G, m.dof_kind, damped=False).solve(2000 * RPM, 4)
     assert np.all(undamped.damping_ratio == pytest.approx(0.0, abs=1e-9))
+
+
+def test_negative_speed_mirrors_whirl(problem):
+    """Whirl is relative to the spin: reversing the spin gives the same frequencies and labels."""
+    pos, neg = problem.solve(4000 * RPM, 6), problem.solve(-4000 * RPM, 6)
+    np.testing.assert_allclose(neg.wd, pos.wd, rtol=1e-12)
+    assert neg.whirl == pos.whirl
+
+
+def test_bad_matrices_are_input_errors():
+    from cvtfem.errors import InputError
+
+    M = np.eye(4)
+    with pytest.raises(InputError, match="`K`"):
+        ModalProblem(M, np.eye(3), M, M, np.arange(4))
+    with pytest.raises(InputError, match="dof_kind"):
+        ModalProblem(M, M, M, M, np.arange(3))
