@@ -27,7 +27,12 @@ def _petsc(A: sp.spmatrix):  # noqa: ANN202 - PETSc.Mat
     from petsc4py import PETSc
 
     A = sp.csr_matrix(A, dtype=PETSc.ScalarType)
-    return PETSc.Mat().createAIJ(size=A.shape, csr=(A.indptr, A.indices, A.data))
+    A.sort_indices()
+    mat = PETSc.Mat().createAIJ(size=A.shape, csr=(A.indptr.astype(PETSc.IntType),
+                                                   A.indices.astype(PETSc.IntType), A.data),
+                                comm=PETSc.COMM_SELF)
+    mat.assemble()
+    return mat
 
 
 def solve_pep(M: sp.spmatrix, K: sp.spmatrix, D: sp.spmatrix, n_eig: int, sigma: float,
@@ -59,7 +64,10 @@ def solve_pep(M: sp.spmatrix, K: sp.spmatrix, D: sp.spmatrix, n_eig: int, sigma:
     pep.setOperators([_petsc(K), _petsc(D), _petsc(M)])
     pep.setProblemType(SLEPc.PEP.ProblemType.GENERAL)
     pep.setType(SLEPc.PEP.Type.TOAR)
-    pep.setDimensions(nev=min(2 * n_eig + 6, 2 * M.shape[0] - 2))
+    n = M.shape[0]
+    nev = min(2 * n_eig + 6, 2 * n - 2)
+    pep.setDimensions(nev=nev, ncv=min(2 * n, max(2 * nev, nev + 15)))
+    pep.setScale(SLEPc.PEP.Scale.SCALAR)      # K and M differ by many orders of magnitude
     pep.setTarget(sigma)
     pep.setWhichEigenpairs(SLEPc.PEP.Which.TARGET_MAGNITUDE)
     st = pep.getST()
@@ -98,7 +106,9 @@ def solve_gep(M: sp.spmatrix, K: sp.spmatrix, n_eig: int, sigma: float,
     eps = SLEPc.EPS().create(comm=PETSc.COMM_SELF)
     eps.setOperators(_petsc(K), _petsc(M))
     eps.setProblemType(SLEPc.EPS.ProblemType.GHEP)
-    eps.setDimensions(nev=min(n_eig + 4, M.shape[0] - 1))
+    n = M.shape[0]
+    nev = min(n_eig + 4, n - 1)
+    eps.setDimensions(nev=nev, ncv=min(n, max(2 * nev, nev + 15)))
     eps.setTarget(-sigma * sigma)
     eps.setWhichEigenpairs(SLEPc.EPS.Which.TARGET_MAGNITUDE)
     st = eps.getST()
