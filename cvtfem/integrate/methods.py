@@ -12,14 +12,13 @@ METHODS = MappingProxyType({cls.name: cls for cls in (
     extrapolation.EulerExtrapolation, extrapolation.GBS, extrapolation.GBSSmooth,
     wmethods.SW24, wmethods.W1, wmethods.W1Extrapolation,
     theta.Theta, theta.Trapezoidal, theta.ImplicitEuler,
-    stabilized.RKC, rock.ROCK2)})
+    stabilized.RKC, rock.ROCK2, rock.ROCK4)})
 SCIPY_METHODS = frozenset({"RK23", "RK45", "DOP853", "Radau", "BDF", "LSODA"})
 #: Names from the issue that are not implemented, with the reason (shown in the InputError).
 _TABLES = ("its stability polynomials come from published coefficient tables ({}) that are "
            "not vendored in cvtfem yet; use 'rkc' (analytic coefficients) meanwhile")
 UNAVAILABLE = MappingProxyType({
     "dumka3": _TABLES.format("Medovikov 1998, 14 polynomials; the public port is GPL-3"),
-    "rock4": _TABLES.format("Abdulle 2002, recf4/fpa/fpb/fpbe for 50 degrees"),
 })
 
 

@@ -1,18 +1,18 @@
-"""ROCK2 (Abdulle & Medovikov, Numer. Math. 90, 2001): orthogonal Runge-Kutta-Chebyshev, order 2.
+"""ROCK2 and ROCK4: orthogonal Runge-Kutta-Chebyshev methods (spec §11.6).
 
-Stability polynomial ``R_s(z) = w(z) P_m(z)``, ``s = m + 2`` stages, with the quadratic factor
-``w(z) = 1 + 2 sigma z + tau z^2`` and ``P_m`` from a family orthogonal with respect to
-``w(z(x))^2 / sqrt(1 - x^2)`` on ``z(x) = -eps + ell (x - 1)/2``, ``x`` in [-1, 1]. The
-published data are ``sigma`` (``FP1``) and ``tau/sigma - sigma`` (``FP2``) for 46 degrees
-``MS`` (from Abdulle's ROCK2 code, as tabulated in the MIT-licensed OrdinaryDiffEq.jl);
-the recurrence coefficients ``recf`` are *regenerated* here: for each degree the two
-unknowns ``(ell, eps)`` are fixed by the order conditions ``R'(0) = 1``, ``R''(0) = 1``,
-then a discretised Stieltjes procedure on Gauss-Chebyshev nodes gives the three-term
-recurrence ``P_j = mu_j z P_{j-1} + (1 + kappa_j) P_{j-1} - kappa_j P_{j-2}``
-(checked against the published ``recf`` to 1e-12 in the tests).
-Stages: ``g_j = h mu_j F(g_{j-1}) + (1 + kappa_j) g_{j-1} - kappa_j g_{j-2}``; finishing
-``g_{s-1} = g_{s-2} + h sigma F(g_{s-2})``, ``g* = g_{s-1} + h sigma F(g_{s-1})``,
-``x1 = g* + h FP2 (F(g_{s-1}) - F(g_{s-2}))``; the last term is the error estimate.
+ROCK2 (Abdulle & Medovikov, Numer. Math. 90, 2001), order 2, ``s = m + 2`` stages, and
+ROCK4 (Abdulle, SIAM J. Sci. Comput. 23, 2002), order 4, ``s = m + 4``. Their stability
+polynomials are ``R(z) = w(z) P_m(z)``: ``w`` is the stability polynomial of the finishing
+procedure (a quadratic for ROCK2, a quartic for ROCK4) and ``P_m`` belongs to the family
+orthogonal for ``w(z(x))^2 / sqrt(1 - x^2)``, ``z(x) = -eps + ell (x - 1)/2``, x in [-1, 1].
+Only the finishing data are published tables (:mod:`cvtfem.integrate.rock_data`); the
+recurrence ``P_j = mu_j z P_{j-1} + (1 + kappa_j) P_{j-1} - kappa_j P_{j-2}`` is regenerated:
+for each degree ``(ell, eps)`` solve ``R'(0) = 1``, ``R''(0) = 1`` and a discretised
+Stieltjes procedure on Gauss-Chebyshev nodes gives ``(mu_j, kappa_j)``. This reproduces the
+published recurrence tables to ~1e-13, and for ROCK4 the third- and fourth-order conditions
+then hold as well (tests), which also validates the transcribed tables.
+Stages: ``g_j = h mu_j F(g_{j-1}) + (1 + kappa_j) g_{j-1} - kappa_j g_{j-2}``, then the
+finishing procedure on ``g_m``.
 """
 from __future__ import annotations
 
@@ -22,51 +22,43 @@ import numpy as np
 from scipy.optimize import fsolve
 
 from cvtfem.errors import InputError
+from cvtfem.integrate import rock_data as D
 from cvtfem.integrate.base import Attempt, Stepper
 from cvtfem.integrate.stabilized import spectral_radius
 
-__all__ = ["ROCK2", "rock2_recurrence", "rock2_stability_length", "MS"]
+__all__ = ["ROCK2", "ROCK4", "recurrence", "stability_length", "finishing_polynomial"]
 
-MS = (1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 16, 17, 18, 19, 20, 22, 24, 26, 28, 30, 33,
-      36, 39, 43, 47, 51, 56, 61, 66, 72, 78, 85, 93, 102, 112, 123, 135, 148, 163, 180, 198)
-FP1 = (0.4102693550421609, 0.3889624104727243, 0.3804692420283886, 0.3760815680865637,
-       0.3735177579729938, 0.3719340231904236, 0.3708571145968057, 0.3700947006022557,
-       0.3695328931459086, 0.3691085831661758, 0.368781324965233, 0.3685244707068931,
-       0.3683185599507446, 0.3681542178682514, 0.3680181997765286, 0.3679084456991284,
-       0.3678181571053212, 0.3678314333608541, 0.3677897070402892, 0.3681800192470787,
-       0.3681272993461229, 0.3680840569645587, 0.3680522380648169, 0.3680263578626069,
-       0.3680061275157194, 0.3679837719607466, 0.3679668653311732, 0.3679542340323301,
-       0.367942933258425, 0.3679349432021754, 0.3679290943359695, 0.3679242023884676,
-       0.3679207541681089, 0.3679185472223537, 0.367916869013064, 0.3679158588043139,
-       0.3679154592969145, 0.3679154025286917, 0.3679157536198652, 0.3679163676763697,
-       0.3679171904021983, 0.3679181786833088, 0.3679192462983425, 0.367920432307971,
-       0.3679216942157868, 0.3679229127010114)
-FP2 = (0.4495196112243335, 0.4219428123056774, 0.4084335547255627, 0.4009301129475925,
-       0.3963598727888637, 0.3934034185789226, 0.3913676516238603, 0.3899091428928617,
-       0.388827696299666, 0.3880048656683555, 0.3873650613539532, 0.3868583585730354,
-       0.3864499054795832, 0.3861178821587815, 0.3858426294881124, 0.3856144554520791,
-       0.3854228843194507, 0.3853156085078759, 0.3851902798680153, 0.3853705093720269,
-       0.3851957294861824, 0.3850587241670235, 0.3849515900397918, 0.3848648995575697,
-       0.38479450822313, 0.38471172244074, 0.384647872630907, 0.3845979020112835,
-       0.3845472492329918, 0.3845088319509754, 0.3844789634065264, 0.3844504092359686,
-       0.3844285235163634, 0.3844115660464609, 0.3843957877945634, 0.3843835767106759,
-       0.3843727001444428, 0.3843632394180673, 0.3843553120908175, 0.3843487746818896,
-       0.3843434800804404, 0.3843392605995229, 0.3843359163858929, 0.3843331309176606,
-       0.3843309056586355, 0.3843292556220249)
+_NPV = np.polynomial.polynomial
 
 
-def _recurrence(m: int, sigma: float, tau: float, ell: float, eps: float) -> np.ndarray:
+def finishing_polynomial(family: int, k: int) -> np.ndarray:
+    """Coefficients (ascending) of ``w(z)`` for ROCK``family`` degree index ``k``."""
+    if family == 2:
+        sigma = D.FP1[k]
+        return np.array([1.0, 2 * sigma, sigma * (sigma + D.FP2[k])])
+    a21, a31, a32, a41, a42, a43 = D.FPA[k]
+    A = np.array([[0, 0, 0, 0], [a21, 0, 0, 0], [a31, a32, 0, 0], [a41, a42, a43, 0.0]])
+    b, v, c = np.array(D.FPB[k]), np.ones(4), [1.0]
+    for _ in range(4):
+        c.append(b @ v)
+        v = A @ v
+    return np.array(c)
+
+
+def _degrees(family: int):
+    return D.MS2 if family == 2 else D.MS4
+
+
+def _stieltjes(m: int, wc: np.ndarray, ell: float, eps: float) -> np.ndarray:
     """``[mu_1, mu_2, kappa_2, ..., mu_m, kappa_m]`` for the interval ``(ell, eps)``."""
-    M = 4 * m + 40
+    M = 4 * m + 60
     x = np.cos((2 * np.arange(1, M + 1) - 1) * np.pi / (2 * M))
-    z = -eps + ell * (x - 1) / 2
-    x0 = 1 + 2 * eps / ell          # where z = 0 (normalisation P_j(0) = 1)
-    wt = (1 + 2 * sigma * z + tau * z * z) ** 2
+    x0 = 1 + 2 * eps / ell                         # where z = 0: normalisation P_j(0) = 1
+    wt = _NPV.polyval(-eps + ell * (x - 1) / 2, wc) ** 2
     out = np.empty(2 * m - 1)
     p2, p1 = None, np.ones(M)
     for j in range(1, m + 1):
-        n1 = wt @ (p1 * p1)
-        a = (wt * x) @ (p1 * p1) / n1
+        a = (wt * x) @ (p1 * p1) / (wt @ (p1 * p1))
         if j == 1:
             q1 = x0 - a
             p = (x - a) / q1
@@ -80,92 +72,95 @@ def _recurrence(m: int, sigma: float, tau: float, ell: float, eps: float) -> np.
     return out
 
 
-def _taylor(recf: np.ndarray) -> tuple[float, float]:
-    """``P_m'(0)`` and ``P_m''(0)/2`` from the recurrence."""
-    d2, d1, e2, e1 = 0.0, recf[0], 0.0, 0.0
+def _taylor(recf: np.ndarray, n: int = 5) -> np.ndarray:
+    """First ``n`` Taylor coefficients of ``P_m`` from its recurrence."""
+    p2 = np.zeros(n)
+    p2[0] = 1.0
+    p1 = p2.copy()
+    p1[1] = recf[0]
     for i in range(1, len(recf), 2):
         mu, ka = recf[i], recf[i + 1]
-        d2, d1, e2, e1 = d1, mu + (1 + ka) * d1 - ka * d2, e1, mu * d1 + (1 + ka) * e1 - ka * e2
-    return d1, e1
+        p2, p1 = p1, mu * np.concatenate([[0.0], p1[:-1]]) + (1 + ka) * p1 - ka * p2
+    return p1
 
 
 @lru_cache(maxsize=None)
-def _interval(k: int) -> tuple[float, float]:
-    """``(ell, eps)`` of degree index ``k`` by continuation from degree 3 (solved once)."""
+def _interval(family: int, k: int) -> tuple[float, float]:
+    """``(ell, eps)`` of degree index ``k >= 2``, by continuation from ``m = 3``."""
+    ms, extra = _degrees(family), family
     if k == 2:
-        guess = (19.0, 0.09)
-    elif k < 2:
-        ell3, eps3 = _interval(2)
-        guess = (ell3 * ((MS[k] + 2) / 5) ** 2, eps3)
+        guess = (19.0, 0.09) if family == 2 else (14.6, -0.17)
     else:
-        ell, eps = _interval(k - 1)
-        guess = (ell * ((MS[k] + 2) / (MS[k - 1] + 2)) ** 2, eps)
-    m, sigma = MS[k], FP1[k]
-    tau = sigma * (sigma + FP2[k])
+        ell, eps = _interval(family, k - 1)
+        guess = (ell * ((ms[k] + extra) / (ms[k - 1] + extra)) ** 2, eps)
+    wc = finishing_polynomial(family, k)
 
     def conditions(p):
-        d, e = _taylor(_recurrence(m, sigma, tau, p[0], p[1]))
-        return [d + 2 * sigma - 1, e + 2 * sigma * d + tau - 0.5]
+        c = _NPV.polymul(wc, _taylor(_stieltjes(ms[k], wc, p[0], p[1]), 3))
+        return [c[1] - 1.0, c[2] - 0.5]
 
     sol, info, ok, msg = fsolve(conditions, guess, full_output=True, xtol=1e-13)
     if ok != 1 or max(abs(v) for v in info["fvec"]) > 1e-10:
-        raise RuntimeError(f"ROCK2 degree {m}: order conditions not solved ({msg})")
+        raise RuntimeError(f"ROCK{family} degree {ms[k]}: order conditions not solved ({msg})")
     return float(sol[0]), float(sol[1])
 
 
 @lru_cache(maxsize=None)
-def rock2_recurrence(k: int) -> np.ndarray:
-    """Recurrence coefficients of degree index ``k`` (``m = MS[k]``, ``s = m + 2`` stages)."""
-    sigma = FP1[k]
-    if MS[k] == 1:   # P_1 = 1 + mu z, fixed by R'(0) = 1 alone
-        return np.array([1 - 2 * sigma])
-    ell, eps = _interval(k)
-    return _recurrence(MS[k], sigma, sigma * (sigma + FP2[k]), ell, eps)
+def recurrence(family: int, k: int) -> np.ndarray:
+    """Recurrence coefficients of ROCK``family`` degree index ``k`` (regenerated)."""
+    wc = finishing_polynomial(family, k)
+    m = _degrees(family)[k]
+    if m == 1:   # P_1 = 1 + mu z, fixed by R'(0) = 1 alone
+        return np.array([1.0 - wc[1]])
+    if m == 2:   # one free parameter: the published choice
+        return np.array(D.RECF_M2[family])
+    return _stieltjes(m, wc, *_interval(family, k))
 
 
-def _R(k: int, z: np.ndarray) -> np.ndarray:
-    recf, sigma = rock2_recurrence(k), FP1[k]
-    tau = sigma * (sigma + FP2[k])
+def _R(family: int, k: int, z: np.ndarray) -> np.ndarray:
+    recf = recurrence(family, k)
     p2, p1 = np.ones_like(z), 1 + recf[0] * z
     for i in range(1, len(recf), 2):
         mu, ka = recf[i], recf[i + 1]
         p2, p1 = p1, mu * z * p1 + (1 + ka) * p1 - ka * p2
-    return (1 + 2 * sigma * z + tau * z * z) * p1
+    return _NPV.polyval(z, finishing_polynomial(family, k)) * p1
 
 
 @lru_cache(maxsize=None)
-def rock2_stability_length(k: int) -> float:
-    """Real stability interval ``[-beta, 0]`` of degree index ``k`` (sampled |R| <= 1)."""
-    s = MS[k] + 2
-    z = -np.linspace(0.0, 1.5 * s * s, 15 * s * s + 1001)   # spacing < 0.1, extrema ~4 apart
-    bad = np.flatnonzero(np.abs(_R(k, z)) > 1 + 1e-12)
+def stability_length(family: int, k: int) -> float:
+    """Real stability interval ``[-beta, 0]`` (sampled ``|R| <= 1``, end bisected)."""
+    s = _degrees(family)[k] + family
+    z = -np.linspace(0.0, 1.5 * s * s, 15 * s * s + 1001)
+    bad = np.flatnonzero(np.abs(_R(family, k, z)) > 1 + 1e-12)
     if not len(bad):
         return float(-z[-1])
     lo, hi = -z[bad[0] - 1], -z[bad[0]]
     for _ in range(60):
         mid = 0.5 * (lo + hi)
-        lo, hi = (mid, hi) if abs(_R(k, np.array([-mid]))[0]) <= 1 + 1e-12 else (lo, mid)
+        lo, hi = (mid, hi) if abs(_R(family, k, np.array([-mid]))[0]) <= 1 + 1e-12 else (lo, mid)
     return float(lo)
 
 
-class ROCK2(Stepper):
-    """ROCK2, order 2; ``stages`` fixed (the smallest tabulated ``s >= stages``) or automatic."""
+class _Rock(Stepper):
+    """Shared parts: degree choice (fixed ``stages`` or from the spectral radius), recurrence."""
 
-    name, order, error_order = "rock2", 2, 1
+    family = 2
     OPTIONS = frozenset({"stages", "spectral_radius", "rho_every"})
 
     def __init__(self, system, stats=None, stages: int | None = None, spectral_radius=None,
                  rho_every: int = 25) -> None:
         super().__init__(system, stats)
+        ms = np.array(_degrees(self.family)) + self.family
+        self.fixed = None
         if stages is not None:
-            if not (isinstance(stages, (int, np.integer)) and 3 <= stages <= MS[-1] + 2):
-                raise InputError("stages", stages, f"must be an integer in 3..{MS[-1] + 2} or None")
-            self.fixed = int(np.searchsorted(np.array(MS) + 2, stages))
-        else:
-            self.fixed = None
+            if not (isinstance(stages, (int, np.integer)) and ms[0] <= stages <= ms[-1]):
+                raise InputError("stages", stages, f"must be an integer in {ms[0]}..{ms[-1]} or None")
+            self.fixed = int(np.searchsorted(ms, stages))
+        if spectral_radius is not None and not (callable(spectral_radius) or spectral_radius > 0):
+            raise InputError("spectral_radius", spectral_radius, "must be a positive number, a callable or None")
         self.rho_user, self.rho_every = spectral_radius, int(rho_every)
         self._rho, self._rho_age = None, 0
-        self.stages = MS[self.fixed] + 2 if self.fixed is not None else 3
+        self.stages = int(ms[self.fixed if self.fixed is not None else 0])
 
     def _degree(self, t, x, f0, h) -> int:
         if self.fixed is not None:
@@ -179,30 +174,67 @@ class ROCK2(Stepper):
                 self._rho = 1.2 * spectral_radius(self.f, t, x, f0)
                 self._rho_age = 0
             rho = self._rho
-        for k in range(len(MS)):
-            if rock2_stability_length(k) >= h * rho:
+        n = len(_degrees(self.family))
+        for k in range(n):   # lengths are computed lazily (cached), smallest sufficient degree
+            if stability_length(self.family, k) >= h * rho:
                 return k
-        return len(MS) - 1
+        return max(range(n), key=lambda k: stability_length(self.family, k))
 
     def accept(self, att):
         super().accept(att)
         self._rho_age += 1
 
-    def attempt(self, t, x, h):
-        f0 = self.f0(t, x)
-        k = self._degree(t, x, f0, h)
-        self.stages = MS[k] + 2
-        recf, sigma, fp2 = rock2_recurrence(k), FP1[k], FP2[k]
-        tj = t + h * recf[0]
+    def _chebyshev_stages(self, t, x, h, f0, k):
+        """The ``m`` recurrence stages; returns ``(g_m, t_m, g_{m-1}, t_{m-1})``."""
+        recf = recurrence(self.family, k)
+        self.stages = _degrees(self.family)[k] + self.family
         g2, g1 = x, x + h * recf[0] * f0
-        c2, c1 = t, tj
+        c2, c1 = t, t + h * recf[0]
         for i in range(1, len(recf), 2):
             mu, ka = recf[i], recf[i + 1]
             g2, g1 = g1, h * mu * self.f(c1, g1) + (1 + ka) * g1 - ka * g2
             c2, c1 = c1, h * mu + (1 + ka) * c1 - ka * c2
-        fa = self.f(c1, g1)
-        g_s1 = g1 + h * sigma * fa
-        fb = self.f(c1 + h * sigma, g_s1)
+        return g1, c1
+
+
+class ROCK2(_Rock):
+    """ROCK2, order 2; finishing ``g* = (two Euler steps of h sigma)``,
+    ``x1 = g* + h FP2 (F(g_{s-1}) - F(g_{s-2}))``; the last term is the error estimate."""
+
+    name, order, error_order, family = "rock2", 2, 1, 2
+
+    def attempt(self, t, x, h):
+        f0 = self.f0(t, x)
+        k = self._degree(t, x, f0, h)
+        g, c = self._chebyshev_stages(t, x, h, f0, k)
+        sigma, fp2 = D.FP1[k], D.FP2[k]
+        fa = self.f(c, g)
+        g1 = g + h * sigma * fa
+        fb = self.f(c + h * sigma, g1)
         corr = h * fp2 * (fb - fa)
-        x1 = g_s1 + h * sigma * fb + corr
-        return Attempt(t, x, h, x1, corr, f0)
+        return Attempt(t, x, h, g1 + h * sigma * fb + corr, corr, f0)
+
+
+class ROCK4(_Rock):
+    """ROCK4, order 4; 4-stage finishing RK (``FPA``, ``FPB``) with an embedded order-3
+    estimate (``FPBE``, its fifth weight on ``F(x1)``, which is reused as the next ``F0``)."""
+
+    name, order, error_order, family = "rock4", 4, 3, 4
+
+    def attempt(self, t, x, h):
+        f0 = self.f0(t, x)
+        k = self._degree(t, x, f0, h)
+        g, c = self._chebyshev_stages(t, x, h, f0, k)
+        a21, a31, a32, a41, a42, a43 = D.FPA[k]
+        b, be = D.FPB[k], D.FPBE[k]
+        k1 = self.f(c, g)
+        k2 = self.f(c + a21 * h, g + h * a21 * k1)
+        k3 = self.f(c + (a31 + a32) * h, g + h * (a31 * k1 + a32 * k2))
+        k4 = self.f(c + (a41 + a42 + a43) * h, g + h * (a41 * k1 + a42 * k2 + a43 * k3))
+        x1 = g + h * (b[0] * k1 + b[1] * k2 + b[2] * k3 + b[3] * k4)
+        err = f1 = None
+        if self.need_error:
+            f1 = self.f(t + h, x1)
+            emb = g + h * (be[0] * k1 + be[1] * k2 + be[2] * k3 + be[3] * k4 + be[4] * f1)
+            err = x1 - emb
+        return Attempt(t, x, h, x1, err, f0, f1)

@@ -39,6 +39,8 @@ CASES = [  # method, options, nominal order, step sizes
     ("rkc", {"stages": 20}, 2, [0.1, 0.05]),
     ("rock2", {"stages": 5}, 2, [0.1, 0.05]),
     ("rock2", {"stages": 50}, 2, [0.1, 0.05]),
+    ("rock4", {"stages": 5}, 4, [0.1, 0.05]),
+    ("rock4", {"stages": 30}, 4, [0.4, 0.2]),
 ]
 
 

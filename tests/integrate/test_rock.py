@@ -1,48 +1,71 @@
-"""ROCK2: regenerated recurrence vs the published table, order, stability length 0.81 s^2."""
+"""ROCK2/ROCK4: regenerated recurrences vs the published tables, orders, stability lengths."""
 import numpy as np
 import pytest
 
 from cvtfem.integrate import solve
-from cvtfem.integrate.rock import MS, rock2_recurrence, rock2_stability_length
+from cvtfem.integrate import rock_data as D
+from cvtfem.integrate.rock import _taylor, finishing_polynomial, recurrence, stability_length
 from cvtfem.integrate.study import real_stability_length
 from cvtfem.problems import heat1d
 
-# published ROCK2 `recf` entries (Abdulle's code; OrdinaryDiffEq.jl tableau)
+# published `recf` entries (Abdulle's codes, OrdinaryDiffEq.jl tableaus): (family, k) -> values
 PUBLISHED = {
-    3: [0.03957407527591189, 0.05338681630900877, 0.02247986572029358, 0.06393794866013652,
-        0.0861675960246663, 0.07433164225960258, 0.1608966052260327],          # m = 4
-    7: [0.01394572558988917, 0.01901965402711647, 0.02425291169233543, 0.02282720812165174,
-        0.09294575674653435, 0.02575013323611407, 0.1622227426315588, 0.0280770541578923,
-        0.2243919049772138, 0.03005377306193452, 0.2802435651401261, 0.03196472247412495,
-        0.3348331353768858, 0.03423680369928859, 0.398901664156519],           # m = 8
+    (2, 3): [0.03957407527591189, 0.05338681630900877, 0.02247986572029358, 0.06393794866013652,
+             0.0861675960246663, 0.07433164225960258, 0.1608966052260327],          # m = 4
+    (2, 7): [0.01394572558988917, 0.01901965402711647, 0.02425291169233543, 0.02282720812165174,
+             0.09294575674653435, 0.02575013323611407, 0.1622227426315588, 0.0280770541578923,
+             0.2243919049772138, 0.03005377306193452, 0.2802435651401261, 0.03196472247412495,
+             0.3348331353768858, 0.03423680369928859, 0.398901664156519],           # m = 8
+    (4, 2): [0.07296375286357569, 0.08749824867149327, 0.006126949805354446, 0.1026802330400501,
+             0.0302674477990085],                                                  # m = 3
+    (4, 3): [0.05345766591735225, 0.06421114488497465, 0.006297251335072349, 0.07361067001944596,
+             0.02954244012876854, 0.08450213007949955, 0.06370198138618569],        # m = 4
 }
+LAST_PAIRS = {(2, 45): (0.0001212297589117476, 0.9638702662671197),                 # m = 198
+              (4, 49): (0.0004668480955879464, 0.9136748776971255)}                 # m = 148
 
 
-@pytest.mark.parametrize("k", sorted(PUBLISHED))
-def test_regenerated_recurrence_matches_published(k):
-    assert np.max(np.abs(rock2_recurrence(k) - PUBLISHED[k])) < 1e-12
+@pytest.mark.parametrize("key", sorted(PUBLISHED))
+def test_regenerated_recurrence_matches_published(key):
+    assert np.max(np.abs(recurrence(*key) - PUBLISHED[key])) < 1e-12
 
 
-def test_highest_degree_matches_published_last_pair():
-    mu, kappa = rock2_recurrence(len(MS) - 1)[-2:]      # m = 198
-    assert abs(mu - 0.0001212297589117476) < 1e-15 and abs(kappa - 0.9638702662671197) < 1e-12
+@pytest.mark.parametrize("key", sorted(LAST_PAIRS))
+def test_highest_degree_matches_published_last_pair(key):
+    mu, kappa = recurrence(*key)[-2:]
+    assert abs(mu - LAST_PAIRS[key][0]) < 1e-15 and abs(kappa - LAST_PAIRS[key][1]) < 1e-11
 
 
-@pytest.mark.parametrize("k", [17, 25, 35, 45])
-def test_stability_length_published(k):
-    """Abdulle-Medovikov 2001 (also Hairer-Wanner II, IV.2): l_s ~ 0.81 s^2."""
-    s = MS[k] + 2
-    assert abs(rock2_stability_length(k) / (0.81 * s * s) - 1) < 0.01
+def test_rock4_all_degrees_satisfy_order_four():
+    """Only R'(0) and R''(0) are imposed; R''' and R'''' then match e^z for all 50 degrees,
+    which also checks the transcribed finishing tables FPA/FPB."""
+    for k in range(len(D.MS4)):
+        c = np.polynomial.polynomial.polymul(finishing_polynomial(4, k), _taylor(recurrence(4, k)))
+        assert np.allclose(c[:5], [1, 1, 1 / 2, 1 / 6, 1 / 24], atol=1e-11, rtol=0), D.MS4[k]
+        # embedded weights: same consistency, an order-3 pair
+        assert abs(sum(D.FPBE[k]) - sum(D.FPB[k])) < 1e-12
 
 
-def test_stability_length_by_stepping():
-    beta = real_stability_length("rock2", x_max=100, n=20001, stages=10)
-    assert abs(beta - rock2_stability_length(7)) < 1e-6 * beta
+@pytest.mark.parametrize("family,k,c", [(2, 17, 0.81), (2, 35, 0.81), (2, 45, 0.81),
+                                        (4, 21, 0.35), (4, 28, 0.35), (4, 35, 0.35)])
+def test_stability_length_published(family, k, c):
+    """l_s ~ 0.81 s^2 (ROCK2, Abdulle-Medovikov 2001), ~ 0.35 s^2 (ROCK4, Abdulle 2002; the
+    two-digit figure: s = 96 gives 0.3538 s^2, 1.1 % above it)."""
+    s = (D.MS2 if family == 2 else D.MS4)[k] + family
+    assert abs(stability_length(family, k) / (c * s * s) - 1) < 0.01
 
 
-def test_rock2_heat_automatic_stages():
+@pytest.mark.parametrize("method,stages,k", [("rock2", 10, 7), ("rock4", 12, 7)])
+def test_stability_length_by_stepping(method, stages, k):
+    fam = int(method[-1])
+    beta = real_stability_length(method, x_max=100, n=20001, stages=stages)
+    assert abs(beta - stability_length(fam, k)) < 1e-6 * beta
+
+
+@pytest.mark.parametrize("method", ["rock2", "rock4"])
+def test_heat_automatic_stages(method):
     p = heat1d(N=200, t_end=0.1)
-    res = solve(**p.solve_kwargs(), method="rock2", rtol=1e-4, atol=1e-7)
+    res = solve(**p.solve_kwargs(), method=method, rtol=1e-4, atol=1e-7)
     ref = p.reference()
     assert res.success and np.max(np.abs(res.y[:, -1] - ref)) / np.max(np.abs(ref)) < 1e-3
     assert res.stats["nfev"] * 10 < 4 * 0.1 / (2.78 / p.info["rho"])
