@@ -17,7 +17,7 @@ from cvtfem.integrate.stats import Stats
 
 __all__ = ["solve_scipy"]
 
-SCIPY_OPTIONS = {"RK23": set(), "RK45": set(), "DOP853": set(), "LSODA": {"jac", "jac_sparsity"},
+SCIPY_OPTIONS = {"RK23": set(), "RK45": set(), "DOP853": set(), "LSODA": {"jac"},
                  "Radau": {"jac", "jac_sparsity"}, "BDF": {"jac", "jac_sparsity"}}
 
 
