@@ -69,15 +69,19 @@ def plot_summary(sweep: ResponseSweep, probe: int, path: Path, point: int | None
     return Path(path)
 
 
-def plot_branch(omega: np.ndarray, amplitude: np.ndarray, stable: np.ndarray | None, path: Path,
+def plot_branch(omega: np.ndarray, amplitude: np.ndarray, stability: tuple | None, path: Path,
                 ylabel: str = "peak deflection, m", up_down: tuple | None = None) -> Path:
-    """Continuation branch (amplitude vs frequency), stable/unstable points marked, optional up/down sweeps."""
+    """Continuation branch (amplitude vs frequency), optional up/down sweeps.
+
+    ``stability = (indices, stable)`` marks the points where Floquet multipliers were computed.
+    """
     plt = _pyplot()
     fig, ax = plt.subplots(figsize=(6.5, 4.2))
     ax.plot(omega, amplitude, "-", color="0.6", lw=1, label="arclength continuation")
-    if stable is not None:
-        ax.plot(omega[stable], amplitude[stable], "o", ms=3, color="C0", label="stable (Floquet)")
-        ax.plot(omega[~stable], amplitude[~stable], "o", ms=3, color="C3", label="unstable (Floquet)")
+    if stability is not None:
+        idx, stable = stability
+        ax.plot(omega[idx[stable]], amplitude[idx[stable]], "o", ms=3, color="C0", label="stable (Floquet)")
+        ax.plot(omega[idx[~stable]], amplitude[idx[~stable]], "o", ms=3, color="C3", label="unstable (Floquet)")
     if up_down is not None:
         for (w, amp), label, marker in zip(up_down, ("sweep up", "sweep down"), ("^", "v")):
             ax.plot(w, amp, marker, ms=5, mfc="none", label=label)
