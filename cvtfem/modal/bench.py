@@ -31,8 +31,14 @@ def machine() -> str:
     """One line describing the machine and the BLAS threading."""
     load = os.getloadavg()
     threads = os.environ.get("OPENBLAS_NUM_THREADS", "default")
+    try:
+        import threadpoolctl  # noqa: F401
+
+        limit = "solves limited to 1 BLAS thread (threadpoolctl)"
+    except ImportError:
+        limit = "threadpoolctl absent: BLAS threads not limited"
     return (f"{platform.node()} {platform.machine()}, {os.cpu_count()} cores, load {load[0]:.1f}, "
-            f"python {platform.python_version()}, numpy {np.__version__}, OPENBLAS_NUM_THREADS={threads}")
+            f"python {platform.python_version()}, numpy {np.__version__}, OPENBLAS_NUM_THREADS={threads}, {limit}")
 
 
 def _median_time(fn: Callable[[], object], repeat: int) -> tuple[float, list[float]]:
