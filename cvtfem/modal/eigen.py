@@ -38,6 +38,12 @@ DENSE_LIMIT = 600
 ZERO_RTOL = 1e-6
 #: Sparse/slepc: the same, as a fraction of the largest |lambda| computed (the band of interest).
 SPARSE_ZERO = 1e-4
+#: |whirl ratio| below this is a planar mode; at zero speed its label comes from the speed
+#: PLANAR_SPEED x (highest frequency found), rad/s.
+PLANAR = 1e-6
+PLANAR_SPEED = 1e-6
+#: Blocks this small (or smaller than the Krylov space a request needs) are solved densely by every backend.
+SMALL_BLOCK = 32
 #: Default shift of the sparse backend, rad/s: a real shift below the lowest frequency of interest keeps
 #: the shift-inverted spectrum well separated (|lambda - sigma| grows with the frequency).
 SIGMA = 1.0
@@ -172,7 +178,26 @@ class ModalProblem:
             raise InputError("n_modes", n_modes, "must be >= 1")
         limit = self._blas.limit(limits=self.blas_threads, user_api="blas") if self._blas else nullcontext()
         with limit:
-            return self._solve(speed, n_modes, sigma, min_modes)
+            modes = self._solve(speed, n_modes, sigma, min_modes)
+            planar = (np.abs(modes.whirl_ratio) < PLANAR) & np.isin(modes.whirl, ("forward", "backward"))
+            if speed == 0 and np.any(planar) and self.G.nnz:
+                modes = self._label_planar(modes, planar, sigma)
+        return modes
+
+    def _label_planar(self, modes: Modes, planar: np.ndarray, sigma: float | None) -> Modes:
+        """Whirl labels of planar modes at zero speed: the limit Omega -> 0+ (anisotropic supports).
+
+        Modes that are planar at rest (e.g. x and y modes of anisotropic bearings)
+        become slightly elliptic under a tiny spin; the branch they join there
+        (matched by MAC) is their label.  Frequencies and whirl ratios stay those at rest.
+        """
+        from cvtfem.modal.whirl import mac
+
+        eps = PLANAR_SPEED * float(modes.wd.max())
+        near = self._solve(eps, len(modes.wd), sigma, 1)
+        col = np.argmax(mac(modes.shapes, near.shapes), axis=1)
+        labels = [near.whirl[col[i]] if planar[i] else modes.whirl[i] for i in range(len(modes.wd))]
+        return Modes(modes.speed, modes.eigenvalues, modes.shapes, tuple(labels), modes.whirl_ratio)
 
     def _solve(self, speed: float, n_modes: int, sigma: float | None, min_modes: int | None) -> Modes:
         lams, vecs = [], []
@@ -196,7 +221,7 @@ class ModalProblem:
                      sigma: float | None) -> tuple[np.ndarray, np.ndarray]:
         """Oscillatory eigenpairs (Im lambda > threshold) of one block."""
         m = len(self.blocks[b])
-        if self.block_methods[b] == "dense":
+        if self.block_methods[b] == "dense" or m <= max(SMALL_BLOCK, 2 * n_modes + 8):
             lam, Z = self._solve_dense(b, speed)
             thr = ZERO_RTOL * np.abs(lam).max(initial=0.0)
         elif self.block_methods[b] == "sparse":

@@ -102,3 +102,24 @@ def test_too_many_modes_is_a_numerical_error(cli):
     assert r.returncode == 3 and "oscillatory modes" in r.stderr
     r = cli("modes", "reference_cvt")
     assert r.returncode == 2 and "rotor scene" in r.stderr
+
+
+@pytest.mark.parametrize("speed", [0.0, 400.0])
+def test_sparse_backend_on_damped_model_with_rigid_and_tiny_blocks(speed):
+    """CVT shaft: damping, free torsion/axial, a 1-DOF block (the free-sliding sheave axially)."""
+    m = build_model(load_scene("cvt_sheave_shaft"))
+    dense = ModalProblem(m.M, m.K, m.C, m.G, m.dof_kind, method="dense").solve(speed, 10)
+    sparse = ModalProblem(m.M, m.K, m.C, m.G, m.dof_kind, method="sparse").solve(speed, 10)
+    np.testing.assert_allclose(sparse.eigenvalues, dense.eigenvalues, rtol=1e-9)
+    assert sparse.whirl == dense.whirl
+
+
+def test_planar_modes_at_rest_take_the_label_of_the_spinning_limit():
+    """Anisotropic (preloaded) bearings: x/y modes are planar at rest; labels = those at a small speed."""
+    m = build_model(load_scene("cvt_sheave_shaft"))
+    p = ModalProblem(m.M, m.K, m.C, m.G, m.dof_kind)
+    rest, slow = p.solve(0.0, 10), p.solve(5.0, 10)
+    lateral = np.isin(rest.whirl, ("forward", "backward"))
+    assert np.all(np.abs(rest.whirl_ratio[lateral]) < 1e-6)      # planar at rest
+    assert np.all(np.abs(slow.whirl_ratio[lateral]) > 1e-4)      # elliptic when spinning
+    assert rest.whirl == slow.whirl
