@@ -42,8 +42,6 @@ SPARSE_ZERO = 1e-4
 #: PLANAR_SPEED x (highest frequency found), rad/s.
 PLANAR = 1e-6
 PLANAR_SPEED = 1e-6
-#: Blocks this small (or smaller than the Krylov space a request needs) are solved densely by every backend.
-SMALL_BLOCK = 32
 #: Default shift of the sparse backend, rad/s: a real shift below the lowest frequency of interest keeps
 #: the shift-inverted spectrum well separated (|lambda - sigma| grows with the frequency).
 SIGMA = 1.0
@@ -217,14 +215,22 @@ class ModalProblem:
         return self._finish(speed, np.concatenate(lams), np.concatenate(vecs, axis=1), n_modes,
                             n_modes if min_modes is None else min_modes)
 
+    def backend(self, b: int, n_modes: int) -> str:
+        """Backend that solves block ``b`` for ``n_modes`` modes.
+
+        Blocks too small for a Krylov space of the requested size (``n_modes + 5``
+        DOF or fewer) are solved densely by every backend.
+        """
+        return "dense" if len(self.blocks[b]) <= n_modes + 5 else self.block_methods[b]
+
     def _solve_block(self, b: int, speed: float, n_modes: int,
                      sigma: float | None) -> tuple[np.ndarray, np.ndarray]:
         """Oscillatory eigenpairs (Im lambda > threshold) of one block."""
         m = len(self.blocks[b])
-        if self.block_methods[b] == "dense" or m <= max(SMALL_BLOCK, 2 * n_modes + 8):
+        if self.backend(b, n_modes) == "dense":
             lam, Z = self._solve_dense(b, speed)
             thr = ZERO_RTOL * np.abs(lam).max(initial=0.0)
-        elif self.block_methods[b] == "sparse":
+        elif self.backend(b, n_modes) == "sparse":
             lam, Z = self._solve_sparse(b, speed, n_modes, sigma)
             thr = SPARSE_ZERO * np.abs(lam).max(initial=0.0)
         else:
