@@ -29,7 +29,7 @@ import scipy.sparse.linalg as spla
 from scipy.sparse.csgraph import connected_components
 
 from cvtfem.errors import InputError, NumericalError
-from cvtfem.modal.whirl import circularize, classify
+from cvtfem.modal.whirl import circularize, classify, mac
 
 #: Models up to this many DOF are solved densely by ``method="auto"``.
 DENSE_LIMIT = 600
@@ -189,8 +189,6 @@ class ModalProblem:
         become slightly elliptic under a tiny spin; the branch they join there
         (matched by MAC) is their label.  Frequencies and whirl ratios stay those at rest.
         """
-        from cvtfem.modal.whirl import mac
-
         eps = PLANAR_SPEED * float(modes.wd.max())
         near = self._solve(eps, len(modes.wd), sigma, 1)
         col = np.argmax(mac(modes.shapes, near.shapes), axis=1)
