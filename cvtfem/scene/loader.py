@@ -52,7 +52,7 @@ class Scene:
 
     def replace(self, overrides: Mapping[str, Any]) -> Scene:
         """A new scene with ``overrides`` (nested dict) merged in and re-validated."""
-        return scene_from_dict(merge(thaw(self.data), overrides), source=self.source)
+        return scene_from_dict(merge(_drop_none(thaw(self.data)), overrides), source=self.source)
 
 
 def _drop_none(value: Any) -> Any:

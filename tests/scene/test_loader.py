@@ -167,3 +167,10 @@ def test_unknown_preset_and_cycles():
         scene_from_dict({"preset": "reference_cv"})
     with pytest.raises(InputError, match="exactly one machine"):
         scene_from_dict({"title": "empty"})
+
+
+def test_replace_on_every_kind():
+    rotor_scene = scene_from_dict(tomllib.loads(ROTOR))
+    assert rotor_scene.replace({"solver": {"t_end": 2.0}}).solver.t_end == 2.0
+    cvt = load_scene("reference_cvt").replace({"cvt": {"regime": {"torque": 100.0}}})
+    assert cvt.cvt.regime.torque == 100.0 and cvt.cvt.chain.n_pins == 84
