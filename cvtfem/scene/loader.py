@@ -100,7 +100,7 @@ def _parse(text: str, source: str) -> dict[str, Any]:
 def resolve_presets(data: Mapping[str, Any], seen: tuple[str, ...] = ()) -> dict[str, Any]:
     """Expand ``preset = "NAME"`` (recursively) into a plain merged document."""
     name = data.get("preset")
-    if name is None:
+    if name is None or name == "":
         return dict(data)
     if not isinstance(name, str):
         raise InputError("preset", name, "must be a string naming a built-in preset")
