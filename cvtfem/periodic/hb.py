@@ -162,7 +162,11 @@ def _linear_blocks(net: TorsionalNetwork, omega: float, n: np.ndarray):
 def prepare(net: TorsionalNetwork) -> Topology | None:
     """Check grounding and number the network (None for loops)."""
     check_grounded(net.n_nodes, net.i, net.j, net.k_in + net.k_out, net.names)
-    return through_numbering(net.n_nodes, net.i, net.j)
+    prefer = np.zeros(net.n_nodes, bool)
+    nl = net.law != 0
+    prefer[net.i[nl]] = True
+    prefer[net.j[nl][net.j[nl] >= 0]] = True
+    return through_numbering(net.n_nodes, net.i, net.j, prefer)
 
 
 def solve_linear(net: TorsionalNetwork, omega: float, N: int, stiffness: str = "contact",
@@ -274,8 +278,8 @@ def solve_periodic(net: TorsionalNetwork, omega: float, N: int, samples: int = 0
                    raise_on_failure: bool = False) -> PeriodicSolution:
     """Nonlinear periodic response by damped Newton-Kantorovich iterations (spec 8.4, 11.8).
 
-    Without ``a0`` Newton starts from the linear response with contact stiffness;
-    if that fails it continues in the load factor ``lambda`` from the largest
+    Newton starts from ``a0``, else (or when that fails) from the linear response
+    with contact stiffness; if that fails too it continues in the load factor ``lambda`` from the largest
     load whose gap-stiffness linear response stays inside the gaps (where it is
     exact) to 1, halving the load step on failure (spec 8.5, practical reading).
 
@@ -312,7 +316,11 @@ def _solve_periodic(net, omega, N, samples, tol, max_iter, a0, method, raise_on_
     start = solve_linear(net, omega, N, topo=topo).a if a0 is None else np.array(a0, complex)
     a, ok, history, used = newton(net, omega, p, start, M, topo, D, tol, max_iter, method)
     iterations = len(history) - 1
-    if not ok and a0 is None:
+    if not ok and a0 is not None:  # a given start failed: try the default one
+        a, ok, history, used = newton(net, omega, p, solve_linear(net, omega, N, topo=topo).a, M, topo, D, tol,
+                                      max_iter, method)
+        iterations += len(history) - 1
+    if not ok:
         lam = _gap_fraction(net, omega, N, topo)
         a = solve_linear(net.linearized("gap"), omega, N, topo=topo).a * lam
         step = 1.0 - lam

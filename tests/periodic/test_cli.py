@@ -98,7 +98,7 @@ def test_bad_links_are_named(tmp_path, patch, where):
 def test_cli_writes_json_and_png(cli, tmp_path):
     path = tmp_path / "pair.toml"
     path.write_text(SMALL)
-    out = cli("periodic", str(path), "--sweep", "14:18:3", "--json", str(tmp_path / "r.json"),
+    out = cli("periodic", str(path), "--sweep", "14:16:3", "--json", str(tmp_path / "r.json"),
               "--png", str(tmp_path / "r.png"))
     assert out.returncode == 0, out.stderr
     data = json.loads((tmp_path / "r.json").read_text())
