@@ -112,3 +112,23 @@ def test_ungrounded_network_is_rejected():
     net = build_network([1.0, 1.0], [0.1, 0.1], [0], [1], [1e4], orders=(1,), Q=[[1.0], [0.0]])
     with pytest.raises(InputError, match="ground"):
         hb.solve_linear(net, 10.0, 2)
+
+
+def test_diagonal_fast_path_with_one_backlash_link():
+    """One backlash link in a branched tree: the root sits at it, linear side trees stay diagonal."""
+    rng = np.random.default_rng(8)
+    parents = branched_parents()
+    net0 = random_network(rng, parents)
+    E = net0.n_links
+    law = np.zeros(E, int)
+    law[12] = 1  # a link on the first side branch
+    net = build_network(net0.m, net0.b, net0.i, net0.j, net0.k_out, d=net0.d, law=law, k_in=0.05 * net0.k_out,
+                        h=np.full(E, 1e-4), orders=net0.orders, Q=net0.Q * 10)
+    topo = hb.prepare(net)
+    assert topo.order[0] in (net.i[12], net.j[12])  # rooted at the nonlinear link
+    N, omega = 6, 150.0
+    M, D, p = hb.default_samples(N), net.incidence(), hb.load_harmonics(net, N)
+    a = hb.solve_linear(net, omega, N).a
+    d_sweep, _, _ = hb.newton_step(net, omega, a, p, M, topo, D, "sweep")
+    d_lu, _, _ = hb.newton_step(net, omega, a, p, M, topo, D, "sparse")
+    assert np.abs(d_sweep - d_lu).max() <= 1e-10 * np.abs(d_lu).max()
