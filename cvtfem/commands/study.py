@@ -8,8 +8,8 @@ import argparse
 import platform
 
 DEFAULT_STABILITY = ("euler,rk4,dopri45,dopri56,dopri78,gbs:stages=2,gbs-smooth:stages=2,"
-                     "euler-extrapolation:stages=4,sw24:d=0.5,w1-extrapolation:d=0.5:stages=4,"
-                     "trapezoidal,rkc:stages=5")
+                     "euler-extrapolation:stages=4,sw24:d=0.5,w1:d=1.0,w1-extrapolation:d=0.5:stages=4,"
+                     "trapezoidal,implicit-euler,rkc:stages=5,rock2:stages=5,rock4:stages=5")
 DEFAULT_ORDER = "euler,rk4,dopri45,dopri56,dopri78,gbs:stages=2,sw24,trapezoidal,rkc:stages=10"
 
 
