@@ -10,7 +10,6 @@ from __future__ import annotations
 import time
 import warnings
 
-import numpy as np
 from scipy.integrate import solve_ivp
 
 from cvtfem.integrate.stats import Stats
