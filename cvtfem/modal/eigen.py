@@ -144,6 +144,11 @@ class ModalProblem:
                 raise InputError(name, "non-finite entries", "must be finite")
         if self.kind.shape != (self.n,) or np.any((self.kind < 0) | (self.kind > 5)):
             raise InputError("dof_kind", self.kind.shape, f"must hold {self.n} DOF kinds in 0..5")
+        counts = np.bincount(self.kind.astype(int), minlength=6)
+        if counts[0] != counts[1] or counts[3] != counts[4]:  # whirl needs (x, y) pairs
+            raise InputError("dof_kind", f"{counts[0]} u1, {counts[1]} u2, {counts[3]} theta1, {counts[4]} theta2",
+                             "must pair every lateral DOF: as many u1 as u2 and theta1 as theta2",
+                             "planar or axial models: use kinds 2 (u3) or 5 (phi)")
         self.mdiag = self.M.diagonal()
         pattern = abs(self.M) + abs(self.K) + abs(self.C) + abs(self.G)
         n_blocks, label = connected_components(pattern, directed=False)
