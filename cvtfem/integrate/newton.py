@@ -3,7 +3,9 @@
 ``x_{k+1} = x_k + alpha_k d_k`` with ``B_k d_k = -G(x_k)``. Descent-direction variants:
 ``exact`` (fresh Jacobian each iteration), ``const`` (chord: frozen ``B``), ``broyden``
 (dense rank-1 update (2.20)), ``fake-broyden`` (the update restricted to ``B``'s sparsity
-pattern), ``trim`` (frozen ``B`` with entries below ``trim_threshold * max|B|`` dropped).
+pattern), ``hart`` (secant update of the LU factors on their patterns, no refactorisation;
+:mod:`cvtfem.integrate.luupdate`), ``trim`` (frozen ``B`` with entries below
+``trim_threshold * max|B|`` dropped).
 Line search (2.21)-(2.22) with the ratio new/old (errata #20): the first ``alpha = 2^-i``,
 ``i = 0..9``, with ratio <= 0.8, else the minimiser; all ratios >= 1 means divergence.
 Stopping (2.23): ``||G|| < eps_abs`` and ``||dx|| < eps_rel ||x|| + eps_abs`` (inf-norms).
@@ -21,10 +23,11 @@ import scipy.sparse as sp
 from cvtfem.errors import InputError
 from cvtfem.integrate.base import StepFailure
 from cvtfem.integrate.linsolve import LU
+from cvtfem.integrate.luupdate import UpdatedLU
 
 __all__ = ["NewtonOptions", "NewtonSolver", "VARIANTS"]
 
-VARIANTS = ("exact", "const", "broyden", "fake-broyden", "trim")
+VARIANTS = ("exact", "const", "broyden", "fake-broyden", "hart", "trim")
 ETA_ACCEPT = 0.8
 N_ALPHA = 10
 
@@ -69,7 +72,7 @@ class NewtonSolver:
         if self.opt.variant == "trim":
             B = _trim(B, self.opt.trim_threshold)
         self.B = B
-        self._lu = LU(st, B)
+        self._lu = UpdatedLU(st, B) if self.opt.variant == "hart" else LU(st, B)
 
     def _direction(self, g):
         if self.opt.variant == "broyden":
@@ -82,7 +85,9 @@ class NewtonSolver:
         ss = float(np.vdot(s, s).real)
         if ss == 0.0:
             return
-        if self.opt.variant == "broyden":
+        if self.opt.variant == "hart":   # update the factors, no refactorisation
+            self._lu.update(s, dg)
+        elif self.opt.variant == "broyden":
             self.B = self.B + np.outer(dg - self.B @ s, s) / ss
             self._set(self.B)
         elif sp.issparse(self.B):  # fake-broyden: the update restricted to B's pattern
@@ -131,7 +136,7 @@ class NewtonSolver:
             s = y_new - y
             converged = (np.all(np.abs(g_new) < eps) and
                          np.all(np.abs(s) <= opt.eps_rel * np.max(np.abs(y_new)) + eps))
-            if opt.variant in ("broyden", "fake-broyden") and not converged:
+            if opt.variant in ("broyden", "fake-broyden", "hart") and not converged:
                 self._update(alpha * d, g_new - g)
             y, g = y_new, g_new
             if converged:
