@@ -162,6 +162,7 @@ class ModalProblem:
         self.blas_threads = blas_threads
         self._dense: dict[int, tuple[np.ndarray, np.ndarray, np.ndarray | None]] = {}
         self._cache: dict[tuple[int, int], tuple[np.ndarray, np.ndarray]] = {}
+        self._definite: dict[int, bool] = {}
 
     def _sub(self, b: int) -> list[sp.csr_matrix]:
         dofs = self.blocks[b]
@@ -232,7 +233,9 @@ class ModalProblem:
         m = len(self.blocks[b])
         if self.backend(b, n_modes) == "dense":
             lam, Z = self._solve_dense(b, speed)
-            thr = ZERO_RTOL * np.abs(lam).max(initial=0.0)
+            # no rigid-body modes when K is symmetric positive definite: keep every Im > 0 (a relative
+            # threshold would drop genuine low modes of stiff supports, |lambda|_max ~ 1e9 rad/s)
+            thr = 0.0 if self._stiffness_definite(b) else ZERO_RTOL * np.abs(lam).max(initial=0.0)
         elif self.backend(b, n_modes) == "sparse":
             lam, Z = self._solve_sparse(b, speed, n_modes, sigma)
             thr = SPARSE_ZERO * np.abs(lam).max(initial=0.0)
@@ -248,6 +251,19 @@ class ModalProblem:
             thr = SPARSE_ZERO * np.abs(lam).max(initial=0.0)
         keep = lam.imag > thr
         return lam[keep], Z[:, keep]
+
+    def _stiffness_definite(self, b: int) -> bool:
+        """Whether block ``b``'s stiffness is symmetric positive definite (Cholesky succeeds), cached."""
+        if b not in self._definite:
+            K = self._sub(b)[1].toarray()
+            ok = np.allclose(K, K.T, rtol=0.0, atol=1e-12 * np.abs(K).max(initial=0.0))
+            if ok:
+                try:
+                    sla.cho_factor(K)
+                except np.linalg.LinAlgError:
+                    ok = False
+            self._definite[b] = ok
+        return self._definite[b]
 
     def _solve_dense(self, b: int, speed: float) -> tuple[np.ndarray, np.ndarray]:
         if b not in self._dense:  # one Cholesky of the block mass matrix, reused for every speed
