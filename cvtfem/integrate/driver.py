@@ -27,8 +27,9 @@ MESSAGES = {0: "The solver successfully reached the end of the integration inter
             1: "A termination event occurred."}
 
 
-ZENO_GAP = 1e-9     # events closer than this fraction of the span count towards Zeno
-ZENO_COUNT = 20     # that many in a row stop the run
+ZENO_GAP = 1e-9     # events closer than this fraction of the span ...
+ZENO_GAP_H = 1e-6   # ... or of the step count towards Zeno accumulation
+ZENO_COUNT = 3      # that many in a row stop the run
 
 
 class IgnoredOptionWarning(UserWarning):
@@ -74,7 +75,7 @@ def solve(fun, t_span, y0, method: str = "dopri45", h: float | None = None, rtol
           atol: float = 1e-9, events=None, jac=None, jac_sparsity=None, t_eval=None, *, n2: int = 0,
           switch=None, adaptive: bool | None = None, event_location: str = "dense",
           max_steps: int = 10_000_000, max_events: int = 100_000, raise_on_failure: bool = False,
-          **options) -> OdeResult:
+          growth_limit: float | None = None, **options) -> OdeResult:
     """Integrate ``x' = F(t, x)`` over ``t_span`` with one of the playground's methods.
 
     Parameters
@@ -96,6 +97,10 @@ def solve(fun, t_span, y0, method: str = "dopri45", h: float | None = None, rtol
     n2 : number of second-order pairs in ``y = [u, v, z]``.
     switch : ``switch(t, y, fired) -> y_new | None`` discrete-state automaton at events.
     event_location : ``"dense"`` (Brent on the interpolant) or ``"linear"`` (source's scheme).
+    growth_limit : float, optional
+        Fixed-step runs stop with an "instability" status as soon as one step amplifies the
+        state beyond ``growth_limit * (|x0| + |h F0|)`` (e.g. 1e8); default: only non-finite
+        states stop a run.
     **options : method options (``d``, ``alpha``, ``newton``, ``stages``, ``sequence`` ...);
         an option the method ignores warns with :class:`IgnoredOptionWarning`.
     """
@@ -144,8 +149,20 @@ def solve(fun, t_span, y0, method: str = "dopri45", h: float | None = None, rtol
     ctrl = SimpleController(quantum=getattr(stepper, "STEP_QUANTUM", 1.0)) if adaptive else FixedStep(h)
     if adaptive and h is None:
         h = _initial_step(stepper, t0, y0, rtol, atol, tf - t0)
+    if growth_limit is not None and not growth_limit > 1:
+        raise InputError("growth_limit", growth_limit, "must be a number > 1 or None")
     return _integrate(stepper, ctrl, system, t0, tf, y0, h, rtol, atol, t_eval, event_location,
-                      max_steps, max_events, raise_on_failure, stats, method, adaptive)
+                      max_steps, max_events, raise_on_failure, stats, method, adaptive, growth_limit)
+
+
+def _blow_up(att, x, limit):
+    """Message if a fixed step amplified the state beyond ``limit (|x0| + |h F0|)``, else None."""
+    scale = np.max(np.abs(x)) + (0.0 if att.f0 is None else np.max(np.abs(att.h * att.f0)))
+    grown = np.max(np.abs(att.x1))
+    if grown > limit * scale and grown > 0:
+        return (f"instability: |x| grew from {np.max(np.abs(x)):.3g} to {grown:.3g} in one step "
+                f"(h beyond the method's stability region? reduce h)")
+    return None
 
 
 def _initial_step(stepper, t0, y0, rtol, atol, span):
@@ -163,7 +180,7 @@ def _initial_step(stepper, t0, y0, rtol, atol, span):
 
 
 def _integrate(stepper, ctrl, system, t0, tf, y0, h, rtol, atol, t_eval, event_location,
-               max_steps, max_events, raise_on_failure, stats, method, adaptive):
+               max_steps, max_events, raise_on_failure, stats, method, adaptive, growth_limit):
     wall = time.perf_counter()
     st = stats.counts
     t, x = t0, y0.copy()
@@ -188,6 +205,8 @@ def _integrate(stepper, ctrl, system, t0, tf, y0, h, rtol, atol, t_eval, event_l
             with np.errstate(over="ignore", invalid="ignore"):   # detected below, reported
                 att = stepper.attempt(t, x, h_try)
             failure = None if np.all(np.isfinite(att.x1)) else "non-finite state"
+            if failure is None and growth_limit is not None and not adaptive:
+                failure = _blow_up(att, x, growth_limit)
         except StepFailure as err:
             att, failure = None, str(err)
         if adaptive:
@@ -208,7 +227,8 @@ def _integrate(stepper, ctrl, system, t0, tf, y0, h, rtol, atol, t_eval, event_l
         else:
             h_new = h
             if failure is not None:
-                bad = "" if att is None else f" in component {int(np.flatnonzero(~np.isfinite(att.x1))[0])}"
+                nonfin = [] if att is None else np.flatnonzero(~np.isfinite(att.x1))
+                bad = f" in component {int(nonfin[0])}" if len(nonfin) else ""
                 status, message = -1, f"{failure}{bad} at t = {t + h_try:.6g} s with fixed step h = {h:.3g} s"
                 break
         st["nsteps"] += 1
@@ -252,10 +272,11 @@ def _integrate(stepper, ctrl, system, t0, tf, y0, h, rtol, atol, t_eval, event_l
             if np.any(fired & system.event_terminal):
                 status, message = 1, MESSAGES[1]
                 break
-            zeno = zeno + 1 if t - last_event < ZENO_GAP * (tf - t0) else 0
+            gap = max(ZENO_GAP * (tf - t0), ZENO_GAP_H * h_try)
+            zeno = zeno + 1 if t - last_event < gap else 0
             last_event = t
             if zeno >= ZENO_COUNT:
-                status, message = -1, (f"{ZENO_COUNT} events closer than {ZENO_GAP:g} x the span "
+                status, message = -1, (f"{ZENO_COUNT + 1} events less than {gap:.3g} s apart "
                                        f"accumulate at t = {t:.12g} s (Zeno behaviour)")
                 break
             if st["nevents"] >= max_events:

@@ -1,8 +1,15 @@
 """Event location (spec §1.2, §11.7): sign changes, earliest crossing, simultaneous events.
 
 Two locators: ``"linear"`` interpolates indicators and state over the step (the source's
-scheme, ``theta = e0/(e0 - e1)``, ``x* = (1-theta) x0 + theta x1``); ``"dense"`` refines the
-crossing with Brent's method on the step's dense output (default).
+scheme, ``theta = e0/(e0 - e1)``, ``x* = (1-theta) x0 + theta x1``); ``"dense"`` (default)
+scans the step's dense output at ``SCAN`` interior points for the first sign change and
+refines it with Brent's method, so the earliest of several crossings in one step is found.
+
+After an event the fired indicators restart at exactly 0; their sign just after the restart
+(sampled at ``INTERIOR`` fractions of the step, as CVODE does) becomes the new reference, so a
+pass-through crossing does not re-fire and a rebound is detected when it comes back. An
+indicator that is exactly 0 at the initial state counts as coming from the other side, so
+leaving it in the firing direction is an event at ``t0``.
 """
 from __future__ import annotations
 
@@ -14,7 +21,9 @@ from cvtfem.errors import InputError
 __all__ = ["EventLocator", "crossings"]
 
 SIMULTANEOUS_RTOL = 1e-9   # crossings closer than this fraction of h count as simultaneous
-INTERIOR = (1e-6, 1e-3, 1 / 64, 1 / 8, 1 / 2)   # samples for indicators restarting at 0
+INTERIOR = (1e-10, 1e-6, 1e-3, 1 / 64, 1 / 8, 1 / 2)   # samples for indicators restarting at 0
+SCAN = 8                   # sub-intervals scanned for the earliest crossing (dense mode)
+TINY = np.finfo(float).tiny
 
 
 def crossings(g0: np.ndarray, g1: np.ndarray, direction: np.ndarray) -> np.ndarray:
@@ -40,59 +49,89 @@ class EventLocator:
         return np.asarray(self.system.events(t, x), dtype=float)
 
     def start(self, t: float, x: np.ndarray, fired: np.ndarray | None = None) -> None:
-        """Indicators at a step start; fired ones are set to exactly 0 and remember the side
-        they came from (``side``), so that they neither re-fire at once nor get missed."""
+        """Indicators at a step start; fired ones restart at exactly 0 and remember the side
+        they came from (``side``; 0 = unknown, e.g. an exact zero at the initial state)."""
         self.g0 = self.g(t, x)
         self.side = np.zeros(len(self.g0))
         if fired is not None:
             self.g0[fired] = 0.0
             self.side[fired] = np.sign(self._ga[fired])
 
-    def locate(self, t0, x0, t1, x1, dense):
-        """Earliest crossing in ``[t0, t1]``: ``(t*, x*, fired mask, g1)`` or ``None``.
-
-        ``dense(t)`` evaluates the step's interpolant. An indicator that is exactly 0 at the
-        step start (it fired there) is sampled at interior points: back on its pre-event side,
-        the sample becomes the bracket start; already across again, the crossing is bracketed
-        in ``[t0, sample]`` (a bounce-and-return inside one step is not missed).
-        """
-        g1 = self.g(t1, x1)
-        h = t1 - t0
-        ga, ta = self.g0.copy(), np.full(len(g1), t0)
-        gb, tb = g1.copy(), np.full(len(g1), t1)
+    def _brackets(self, t0, t1, g1, dense):
+        """Per-indicator bracket ``(ta, ga, tb, gb)``, resolving indicators that start at 0."""
+        m = len(g1)
+        ga, ta = self.g0.copy(), np.full(m, t0)
+        gb, tb = g1.copy(), np.full(m, t1)
         zero = ga == 0.0
+        direction = self.system.event_direction
         for frac in INTERIOR if zero.any() else ():
-            tq = t0 + frac * h
+            tq = t0 + frac * (t1 - t0)
             gq = self.g(tq, dense(tq))
             new = zero & (gq != 0.0)
-            back = new & ((self.side == 0) | (np.sign(gq) == self.side))
-            ahead = new & ~back
-            ga[back], ta[back] = gq[back], tq
-            ga[ahead] = self.side[ahead] * np.finfo(float).tiny
-            gb[ahead], tb[ahead] = gq[ahead], tq
+            virtual = -np.sign(gq) * TINY            # a fresh zero comes from the other side
+            fire_at_t0 = new & (self.side == 0) & crossings(virtual, gq, direction)
+            ga[fire_at_t0], gb[fire_at_t0], tb[fire_at_t0] = virtual[fire_at_t0], gq[fire_at_t0], tq
+            rest = new & ~fire_at_t0                 # the sign after the restart is the reference
+            ga[rest], ta[rest] = gq[rest], tq
             zero &= ~new
             if not zero.any():
                 break
-        cross = crossings(ga, gb, self.system.event_direction)
-        self._ga = ga
+        return ta, ga, tb, gb
+
+    def locate(self, t0, x0, t1, x1, dense):
+        """Earliest crossing in ``[t0, t1]``: ``(t*, x*, fired mask, g1)`` or ``None``.
+
+        ``dense(t)`` evaluates the step's interpolant.
+        """
+        g1 = self.g(t1, x1)
+        h = t1 - t0
+        ta, ga, tb, gb = self._brackets(t0, t1, g1, dense)
+        direction = self.system.event_direction
+        cross = crossings(ga, gb, direction)
         if not cross.any():
             self.g0 = g1
             return None
+        if self.mode == "dense":   # scan the interpolant for the first sign change
+            ta, ga, tb, gb = self._scan(ta, ga, tb, gb, cross, dense)
+            cross = crossings(ga, gb, direction)
         idx = np.flatnonzero(cross)
         if self.mode == "linear":
-            theta = ga[idx] / (ga[idx] - gb[idx])
-            t_k = ta[idx] + theta * (tb[idx] - ta[idx])
+            t_k = ta[idx] + ga[idx] / (ga[idx] - gb[idx]) * (tb[idx] - ta[idx])
         else:
             t_k = np.array([self._refine(k, ta[k], ga[k], tb[k], gb[k], dense) for k in idx])
         t_star = float(t_k.min())
         fired = np.zeros_like(cross)
         fired[idx[t_k <= t_star + SIMULTANEOUS_RTOL * abs(h)]] = True
+        self._ga = ga
         if self.mode == "linear":
             th = (t_star - t0) / h
             x_star = (1 - th) * x0 + th * x1
         else:
             x_star = dense(t_star)
         return t_star, x_star, fired, g1
+
+    def _scan(self, ta, ga, tb, gb, cross, dense):
+        """Narrow each bracket to its first sub-interval with a sign change (``SCAN`` samples
+        on the common part of the brackets; indicators without an end-point change are
+        checked too, which catches a double crossing inside the step)."""
+        lo, hi = float(ta.max()), float(tb.min())
+        if hi <= lo:
+            return ta, ga, tb, gb
+        direction = self.system.event_direction
+        ts = lo + (hi - lo) * np.arange(1, SCAN) / SCAN
+        gs = np.array([self.g(t, dense(t)) for t in ts])           # (SCAN-1, m)
+        ta, ga, tb, gb = ta.copy(), ga.copy(), tb.copy(), gb.copy()
+        prev_t, prev_g = ta.copy(), ga.copy()
+        done = np.zeros(len(ga), bool)
+        for t, g in zip(ts, gs):
+            hit = ~done & (t > prev_t) & crossings(prev_g, g, direction)
+            ta[hit], ga[hit], tb[hit], gb[hit] = prev_t[hit], prev_g[hit], t, g[hit]
+            done |= hit
+            upd = ~done & (t > prev_t)
+            prev_t[upd], prev_g[upd] = t, g[upd]
+        last = ~done & crossings(prev_g, gb, direction)
+        ta[last], ga[last] = prev_t[last], prev_g[last]
+        return ta, ga, tb, gb
 
     def _refine(self, k, ta, ga, tb, gb, dense):
         """Brent's method on ``e_k(t, dense(t))`` over ``[ta, tb]`` (signs differ there)."""

@@ -65,3 +65,12 @@ def test_fixed_steps_hit_the_end_exactly():
     p = oscillator(t_end=1.0)
     res = solve(**p.solve_kwargs(), method="rk4", h=0.1)
     assert res.t[-1] == 1.0 and len(res.t) == 11 and res.stats["nfev"] == 40
+
+
+def test_growth_limit_reports_instability_before_overflow():
+    """RK4 at h = 1e-3 on y' = -1e8 y: |R| = 4.2e18 per step. With ``growth_limit`` the first
+    step is reported as an instability; without it the run stops at the first non-finite state."""
+    res = solve(lambda t, y: -1e8 * y, (0.0, 0.01), [1.0], method="rk4", h=1e-3, growth_limit=1e8)
+    assert res.status == -1 and "instability" in res.message and len(res.t) == 1
+    res = solve(lambda t, y: -1e8 * y, (0.0, 0.01), [1.0], method="rk4", h=1e-3)
+    assert res.status == 0 and np.all(np.isfinite(res.y))     # 10 steps stay below overflow
