@@ -4,9 +4,10 @@ Methods are small compositions of a tableau, a step-size controller, an event lo
 for implicit ones, a Newton solver with a pluggable Jacobian provider; every costly operation
 is counted (:mod:`cvtfem.integrate.stats`).
 """
+from cvtfem.integrate.adapter import CvtfemSolver
 from cvtfem.integrate.driver import IgnoredOptionWarning, OdeResult, solve
 from cvtfem.integrate.methods import METHODS, SCIPY_METHODS
 from cvtfem.integrate.system import OdeSystem, as_system
 
 __all__ = ["solve", "OdeResult", "OdeSystem", "as_system", "METHODS", "SCIPY_METHODS",
-           "IgnoredOptionWarning"]
+           "IgnoredOptionWarning", "CvtfemSolver"]
