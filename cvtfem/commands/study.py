@@ -155,6 +155,6 @@ def _print_rows(rows) -> None:
     for r in rows:
         setting = ", ".join(f"{k}={r[k]:.3g}" for k in ("h", "rtol") if k in r)
         status = r.get("status")
-        met = "" if "met" not in r else ("  meets target" if r["met"] else "  MISSES target")
+        met = "" if r.get("met") is None else ("  meets target" if r["met"] else "  MISSES target")
         print(f"{r['label']:28s} {setting:22s} {r['error']:10.2e} {r['nfev']:10d} {r['time']:9.4f}  "
               f"{status}{met}")

@@ -181,7 +181,7 @@ def heat_benchmark(N: int = 1000, t_end: float = 0.1, target: float = 1e-4, repe
     for method in methods or plan:
         if method in UNAVAILABLE:
             rows.append({"label": method, "method": method, "error": np.nan, "nfev": -1,
-                         "time": np.nan, "status": "not available", "met": False})
+                         "time": np.nan, "status": "not available", "met": None})
             continue
         label = f"{method} (sparse)" if method == "trapezoidal" else method
         rows.append(cheapest_meeting(sparse, label, method, plan[method], target, repeats, error))
