@@ -5,8 +5,8 @@ from cvtfem.scene.schema.base import Key, Table
 
 #: Method names understood by ``cvtfem.integrate.solve`` (plus scipy's).
 METHODS = (
-    "euler", "rk4", "dopri45", "dopri56", "dopri78", "gbs", "euler-extrapolation",
-    "sw24", "w1", "theta", "trapezoidal", "dumka3", "rock2", "rock4", "rkc",
+    "euler", "rk4", "dopri45", "dopri56", "dopri78", "gbs", "gbs-smooth", "euler-extrapolation",
+    "sw24", "w1", "w1-extrapolation", "theta", "trapezoidal", "implicit-euler", "dumka3", "rock2", "rock4", "rkc",
     "RK23", "RK45", "DOP853", "Radau", "BDF", "LSODA",
 )
 
