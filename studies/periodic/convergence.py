@@ -42,7 +42,7 @@ def main() -> None:
     Ns = [4, 8, 16, 32, 64, 128]
     table = {}
     fig, ax = plt.subplots(figsize=(6.5, 4.2))
-    for omega, label in ((80.0, "below"), (107.0, "at"), (130.0, "above")):
+    for c, (omega, label) in enumerate(((80.0, "below"), (107.0, "at"), (130.0, "above"))):
         best = solve_periodic(net, omega, Ns[-1], raise_on_failure=True)
         ti = steady_state(net, omega, rtol=1e-11, atol=1e-14, tol=1e-9, max_periods=600, y0=best.state())
         ref = stats(ti.link_forces)
@@ -56,8 +56,8 @@ def main() -> None:
         print(f"omega = {omega:5.1f} rad/s ({label} resonance):")
         for N, (ep, er) in zip(Ns, errs):
             print(f"  N = {N:3d}: peak {ep:.2e}  RMS {er:.2e}")
-        ax.loglog(Ns, errs[:, 0], "o-", label=f"peak, {label} ({omega:g} rad/s)")
-        ax.loglog(Ns, errs[:, 1], "s--", label=f"RMS, {label}")
+        ax.loglog(Ns, errs[:, 0], "o-", color=f"C{c}", label=f"peak, {label} ({omega:g} rad/s)")
+        ax.loglog(Ns, errs[:, 1], "s--", color=f"C{c}", label=f"RMS, {label}")
     ax.axhline(1e-3, color="k", lw=0.8, ls=":")
     ax.set_xlabel("harmonics N")
     ax.set_ylabel("max relative error vs time integration")
