@@ -218,7 +218,11 @@ def linearize(net: TorsionalNetwork, omega: float, a: np.ndarray, p: np.ndarray,
     r, df = residual(net, omega, a, p, M, D)
     chat = np.fft.fft(df, axis=-1) / M
     L = chat[:, (n[:, None] - n[None, :]) % M]
-    L[:, np.arange(K), np.arange(K)] += (1j * n * omega)[None, :] * net.d[:, None]
+    diag = np.arange(K)
+    L[:, diag, diag] += (1j * n * omega)[None, :] * net.d[:, None]
+    lin = np.flatnonzero(net.law == 0)  # exactly diagonal (no FFT round-off): the sweep's fast path
+    L[lin] = 0
+    L[lin[:, None], diag, diag] = net.k_out[lin, None] + (1j * n * omega)[None, :] * net.d[lin, None]
     Nb = np.zeros((net.n_nodes, 1, K, K), complex)
     Nb[:, 0, np.arange(K), np.arange(K)] = _node_term(net, omega, n)
     return r, Nb, L[:, None]
