@@ -233,9 +233,11 @@ class ModalProblem:
         m = len(self.blocks[b])
         if self.backend(b, n_modes) == "dense":
             lam, Z = self._solve_dense(b, speed)
-            # no rigid-body modes when K is symmetric positive definite: keep every Im > 0 (a relative
-            # threshold would drop genuine low modes of stiff supports, |lambda|_max ~ 1e9 rad/s)
-            thr = 0.0 if self._stiffness_definite(b) else ZERO_RTOL * np.abs(lam).max(initial=0.0)
+            # no rigid-body modes when K is symmetric positive definite: the threshold is then relative to
+            # each |lambda| (drops only split real pairs); relative to |lambda|_max it would drop genuine
+            # low modes of stiff supports (|lambda|_max ~ 1e9 rad/s)
+            scale = np.abs(lam) if self._stiffness_definite(b) else np.abs(lam).max(initial=0.0)
+            thr = ZERO_RTOL * scale
         elif self.backend(b, n_modes) == "sparse":
             lam, Z = self._solve_sparse(b, speed, n_modes, sigma)
             thr = SPARSE_ZERO * np.abs(lam).max(initial=0.0)

@@ -111,3 +111,18 @@ def test_campbell_tracks_coincident_pair_and_a_crossing():
     assert np.all(camp.wd[before, col_b] > w_phi) and np.all(camp.wd[after, col_b] < w_phi)
     assert set(camp.whirl[1:, col_f]) == {"forward"} and set(camp.whirl[1:, col_b]) == {"backward"}
     assert set(camp.whirl[:, col_phi]) == {"torsional"}
+
+
+def test_critically_damped_supports_give_no_spurious_modes():
+    """Two isotropic point masses, one critically damped (double real root -w0, split by round-off
+    into a pair with Im ~ sqrt(eps) w0), one with damping ratio 0.01: only the latter's x/y pair
+    is oscillatory, at w0 sqrt(1 - zeta^2), also when the spectrum spans 1e8 (stiff second mass)."""
+    m, k1, k2, zeta = 2.0, 8e4, 8e4 * 1e16, 0.01
+    w1, w2 = math.sqrt(k1 / m), math.sqrt(k2 / m)
+    M = np.eye(6) * m
+    K = np.diag([k1, k1, k2, k2, k2, k2])
+    C = np.diag([2 * m * w1] * 2 + [2 * zeta * m * w2] * 2 + [2 * m * w2] * 2)
+    kind = np.array([0, 1, 0, 1, 0, 1])          # three nodes' (u1, u2), uncoupled
+    modes = ModalProblem(M, K, C, np.zeros((6, 6)), kind).solve(0.0, 2)
+    assert len(modes.wd) == 2
+    assert np.allclose(modes.wd, w2 * math.sqrt(1 - zeta ** 2), rtol=1e-9)
