@@ -24,7 +24,8 @@ SCIPY_STEPPERS = ("RK23", "RK45", "DOP853", "Radau", "BDF", "LSODA")
 EFFICIENCY_WINDOW = 0.05  # s, moving average of the efficiency (section 6.1)
 
 
-def make_stepper(method: str, fun, t0: float, y0, t_end: float, rtol: float, atol: float, h: float = 0.0):
+def make_stepper(method: str, fun, t0: float, y0, t_end: float, rtol: float, atol: float, h: float = 0.0,
+                 jac=None):
     """A step-by-step ODE solver with ``step()``, ``t``, ``y``, ``dense_output()`` and counters.
 
     The single place that picks the integrator: scipy's ``OdeSolver`` classes for now.
@@ -37,6 +38,8 @@ def make_stepper(method: str, fun, t0: float, y0, t_end: float, rtol: float, ato
     options: dict[str, Any] = {"rtol": rtol, "atol": atol}
     if h > 0:
         options["first_step"] = h
+    if jac is not None and method in ("Radau", "BDF", "LSODA"):
+        options["jac"] = jac
     return getattr(si, method)(fun, t0, np.asarray(y0, float), t_end, **options)
 
 
@@ -86,7 +89,7 @@ def sample_outputs(loop, t: float, x) -> dict[str, Any]:
 
 
 def run_scene(scene, until: float | None = None, results: str | Path | None = None, show_progress: bool = True,
-              overwrite: bool = False) -> RunSummary:
+              overwrite: bool = False, start: dict[str, float] | None = None) -> RunSummary:
     """Integrate a band-model CVT scene and summarise it.
 
     Parameters
@@ -97,6 +100,9 @@ def run_scene(scene, until: float | None = None, results: str | Path | None = No
         Simulated end time (default ``solver.t_end``).
     results : path, optional
         HDF5 results file written incrementally (``None``: no file).
+    start : dict, optional
+        ``ratio`` and/or ``speed_factor`` to start away from the targets
+        (:meth:`~cvtfem.control.closed_loop.ClosedLoop.initial_state`).
     """
     from cvtfem.io.progress import progress
     from cvtfem.machines import layout
@@ -109,12 +115,12 @@ def run_scene(scene, until: float | None = None, results: str | Path | None = No
         raise InputError("--until", t_end, "must be positive (simulated seconds)")
     loop = closed_loop(scene)
     specs = [o for part in layout(scene) for o in part.outputs]
-    x0 = loop.initial_state()
+    x0 = loop.initial_state(**(start or {}))
     names = {s.name for s in specs}
     missing = names - set(sample_outputs(loop, 0.0, x0))
     specs = [s for s in specs if s.name not in missing]
     sol = scene.solver
-    stepper = make_stepper(sol.method, loop.rhs, 0.0, x0, t_end, sol.rtol, sol.atol, sol.h)
+    stepper = make_stepper(sol.method, loop.rhs, 0.0, x0, t_end, sol.rtol, sol.atol, sol.h, loop.jac)
     dt = scene.output.step
     t_out = np.arange(0.0, t_end + 0.5 * dt, dt)
     t_out = t_out[t_out <= t_end * (1 + 1e-12)]

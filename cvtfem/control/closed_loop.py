@@ -98,12 +98,23 @@ class ClosedLoop:
         n = self.model.n2
         return x[:n], x[n:2 * n], x[2 * n:2 * n + self.n_ctrl], x[2 * n + self.n_ctrl:]
 
-    def initial_state(self) -> np.ndarray:
-        """Band at the span angle of the target ratio, shafts at the target speeds, no slip on pulley 1."""
+    def initial_state(self, ratio: float | None = None, speed_factor: float = 1.0) -> np.ndarray:
+        """Band at the span angle of the target ratio, driving shaft at the target speed.
+
+        Models with ``steady_state`` start in steady running (elastic coordinates and slips in balance);
+        others start without slip on pulley 1.  ``ratio`` and ``speed_factor`` start the run away from the
+        targets (geometric ratio, driving speed as a multiple of its target).
+        """
         w1, M1, i = self.regime.targets(0.0)
-        phi = self.clamping.span_angle(i)
         F = self.clamping.forces(M1, i)
-        q, v = self.model.initial_state(phi, w1, w1 / i, F)
+        if ratio is not None:  # start away from the target (tests of the loops)
+            i = ratio
+        w1 *= speed_factor
+        phi = self.clamping.span_angle(i)
+        if hasattr(self.model, "steady_state"):  # start in steady running: no start-up transient
+            q, v, _, _ = self.model.steady_state(phi, w1, F, M1)
+        else:
+            q, v = self.model.initial_state(phi, w1, w1 / i, F)
         z = self.control.initial_state(w1, w1 / i) if self.control else np.zeros(0)
         return np.concatenate([q, v, z, np.zeros(4)])
 
@@ -128,6 +139,24 @@ class ClosedLoop:
     def rhs(self, t: float, x):
         """``dx/dt``."""
         return self.evaluate(t, x)[0]
+
+    def jac(self, t: float, x):
+        """Finite-difference Jacobian ``d rhs / dx`` over the states the right-hand side depends on.
+
+        Rotation angles (sigma, phi1, phi2: indices 1..3 of q) and the work integrals never enter the
+        right-hand side, so their columns are zero and are not differenced (this also keeps scipy's
+        adaptive num_jac from inflating its increments on them).
+        """
+        n = self.model.n2
+        f0 = self.rhs(t, x)
+        cols = [0] + list(range(4, 2 * n + self.n_ctrl))
+        Jm = np.zeros((x.size, x.size))
+        for j in cols:
+            h = 1e-7 * max(1.0, abs(x[j])) if j >= n else 1e-8 * max(1e-3, abs(x[j]))
+            xp = x.copy()
+            xp[j] += h
+            Jm[:, j] = (self.rhs(t, xp) - f0) / h
+        return Jm
 
     def energy(self, x) -> float:
         """Kinetic plus elastic energy of the model, J."""

@@ -15,7 +15,8 @@ sheave pair, components along i, j).
 * Normal force ``N = c eps / (k.p)`` clipped at 0 (lift-off), friction ``R = -f N t`` with the slip
   ``v_r = J(phi) q'`` of the band edge against the sheave point; the same J gives the generalized
   friction forces, so friction only dissipates (``D = -Q^f . q' >= 0``).
-* Band damping: Rayleigh function ``beta c' int eps'^2 ds`` with ``beta = 2 nu / omega_z``.
+* Band damping: Rayleigh function ``beta c' int eps'^2 ds`` with ``beta = 2 nu / omega_z``; shaft
+  damping (6+2n+8): ``2 nu sqrt(c m)`` on each shift and tilt (effects.damping, ratio ``damping_ratio``).
 """
 from __future__ import annotations
 
@@ -148,12 +149,17 @@ class CompressibleBand:
         for k in range(2):
             self._scatter_x(Q, k, -2 * c["c_edge"] * (g["E"][k] @ (eps[k] * g["ds"][k])))
         Q[4:6] -= p.kappa * np.asarray(F)
+        dissipation = 0.0
         if self.shaft_compliance:
             for k in range(2):
                 b = 6 + 2 * n + 4 * k
                 Q[b:b + 2] -= p.c_U[k] * q[b:b + 2]
                 Q[b + 2:b + 4] -= p.c_psi[k] * q[b + 2:b + 4]
-        dissipation = 0.0
+                if p.damping:  # shaft damping at ratio nu of each spring-mass pair
+                    d = 2 * p.damping_ratio * np.array([np.sqrt(p.c_U[k] * p.m_sheave[k])] * 2
+                                                       + [np.sqrt(p.c_psi[k] * p.Theta[k])] * 2)
+                    Q[b:b + 4] -= d * v[b:b + 4]
+                    dissipation += float(np.sum(d * v[b:b + 4] ** 2))
         if c["beta"] > 0:
             deps_dt = deps * v[0] + np.stack([self._x(v, k) @ g["E"][k] for k in range(2)])
             Qd = np.zeros(n2)
@@ -294,6 +300,45 @@ class CompressibleBand:
                 K[1 + n:, 1 + n:] += np.diag([p.c_U[k]] * 2 + [p.c_psi[k]] * 2)
             self._scatter_x(q, k, np.linalg.solve(K, rhs))
         return q
+
+    def steady_state(self, phi: float, omega1: float, F, M1: float):
+        """Steady running at fixed span angle: elastic coordinates, band speed and driven speed in balance.
+
+        Unknowns: the elastic coordinates ``x_k`` (accelerations zero), the band speed ``sigma'`` and the
+        driven speed ``omega2`` (band and driving-shaft accelerations zero under the torque ``M1``, N m);
+        the driven torque is the one that holds ``omega2``.  Returns ``(q, v, M2, info)``.
+        """
+        from scipy.optimize import root
+
+        from cvtfem.errors import NumericalError
+
+        n2, el = self.n2, self._elastic_index()
+        q0, v0 = self.initial_state(phi, omega1, omega1, F)
+        r = radii(phi, self.p.length, self.p.L)[0]
+        M = np.array([M1, 0.0])
+
+        def unpack(y):
+            q, v = q0.copy(), v0.copy()
+            q[el] = y[:-2] * 1e-6 + q0[el]
+            v[1], v[3] = y[-2], y[-1]
+            return q, v
+
+        def residual(y):
+            q, v = unpack(y)
+            a, _ = self.accel(q, v, F, M)
+            return np.concatenate([a[el] * 1e-3, a[[1, 2]]])
+
+        y0 = np.concatenate([np.zeros(len(el)), [r[0] * omega1, r[0] * omega1 / r[1]]])
+        sol = root(residual, y0, method="hybr", options={"xtol": 1e-12})
+        if not sol.success:
+            raise NumericalError(f"steady state not found: {sol.message}", component=f"band-6+2n (n = {self.p.n_ritz})")
+        q, v = unpack(sol.x)
+        a, info = self.accel(q, v, F, M)
+        return q, v, -a[3] * self.p.J[1] if n2 else 0.0, info
+
+    def _elastic_index(self) -> np.ndarray:
+        n = self.p.n_ritz
+        return np.r_[4:6 + 2 * n, 6 + 2 * n:self.n2]
 
     def initial_state(self, phi0: float, omega1: float, omega2: float, F) -> tuple[np.ndarray, np.ndarray]:
         """Static elastic equilibrium at phi0, shafts at omega1, omega2 (rad/s), no slip on pulley 1."""

@@ -1,0 +1,58 @@
+"""Benchmark: wall time for 1 s of simulated time of the reference stationary regime, per dynamic band model.
+
+Prints the median of several runs for each model and integrator setting, with the machine.
+Target (issue 5, not asserted): <= 0.1 s wall per simulated second for band-4dof and band-6+2n (n = 5).
+
+    .venv/bin/python studies/lowered/bench_realtime.py [--repeat 3] [--until 1.0]
+"""
+from __future__ import annotations
+
+import argparse
+import os
+import platform
+import statistics
+import time
+
+from scipy.integrate import solve_ivp
+
+from cvtfem.machines.cvt import closed_loop
+from cvtfem.scene.loader import load_scene
+
+SETTINGS = [("Radau", 1e-6, 1e-8), ("Radau", 1e-4, 1e-6), ("BDF", 1e-4, 1e-6), ("LSODA", 1e-4, 1e-6)]
+
+
+def bench(name: str, method: str, rtol: float, atol: float, until: float, repeat: int, **over):
+    loop = closed_loop(load_scene(name), **over)
+    walls, last = [], None
+    for _ in range(repeat):
+        x0 = loop.initial_state()
+        t0 = time.perf_counter()
+        sol = solve_ivp(loop.rhs, (0, until), x0, method=method, rtol=rtol, atol=atol, jac=loop.jac)
+        walls.append(time.perf_counter() - t0)
+        last = sol
+    n = loop.model.n2
+    v = last.y[n:2 * n, -1]
+    return statistics.median(walls), last.nfev, last.njev, len(last.t) - 1, v[2] / v[3], last.status
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--until", type=float, default=1.0)
+    ap.add_argument("--models", nargs="*", default=["band-4dof", "band-6+2n", "band-6+2n+8"])
+    args = ap.parse_args()
+    load = os.getloadavg()[0] if hasattr(os, "getloadavg") else float("nan")
+    print(f"machine: {platform.processor() or platform.machine()}, {os.cpu_count()} cores, "
+          f"python {platform.python_version()}, load average {load:.1f}")
+    print(f"{'model':<13} {'method':<6} {'rtol':>7} {'wall/s_sim':>11} {'steps':>6} {'nfev':>6} {'njev':>5} "
+          f"{'ratio':>7} {'x real time':>11}")
+    for name in args.models:
+        for method, rtol, atol in SETTINGS:
+            wall, nfev, njev, steps, ratio, status = bench(name, method, rtol, atol, args.until, args.repeat)
+            per = wall / args.until
+            print(f"{name:<13} {method:<6} {rtol:>7.0e} {per:>11.3f} {steps:>6} {nfev:>6} {njev:>5} {ratio:>7.4f} "
+                  f"{1 / per:>11.2f}", flush=True)
+
+
+if __name__ == "__main__":
+    main()
