@@ -1,0 +1,56 @@
+"""`cvtfem run`: results file, summary JSON, progress-free CI runs, clear errors."""
+import json
+
+import numpy as np
+import pytest
+
+from cvtfem.analysis.run import run_scene
+from cvtfem.io.results import read_results
+from cvtfem.scene.loader import load_scene
+
+
+def test_run_writes_results_and_summary(cli, tmp_path):
+    out, js = tmp_path / "r.h5", tmp_path / "s.json"
+    proc = cli("run", "band-4dof", "--until", "0.05", "--results", str(out), "--summary-json", str(js))
+    assert proc.returncode == 0, proc.stderr
+    s = json.loads(js.read_text())
+    for key in ("simulated_time_s", "wall_time_s", "ratio", "input_speed_rpm", "output_speed_rpm", "efficiency",
+                "solver"):
+        assert key in s
+    assert s["simulated_time_s"] == pytest.approx(0.05)
+    assert s["solver"]["name"] == "Radau" and s["solver"]["nfev"] > 0
+    assert s["ratio"] == pytest.approx(2.4, rel=0.01)
+    assert s["input_speed_rpm"] == pytest.approx(3500, rel=0.01)
+    assert 0.9 < s["efficiency"] < 1.0
+    r = read_results(out)
+    assert r.attrs["status"] == "finished"
+    assert r.time[-1] == pytest.approx(0.05) and len(r.time) == 51
+    assert r.units["driving.speed"] == "rad/s"
+    # efficiency series = output over input power, and the works integrate the powers
+    P = r.series["power"]
+    assert r.series["efficiency"][:, 0] == pytest.approx(P[:, 1] / P[:, 0])
+    W = r.series["work"]
+    assert W[-1, 0] == pytest.approx(np.trapezoid(P[:, 0], r.time), rel=1e-3)
+
+
+def test_discrete_chain_model_is_refused(cli):
+    proc = cli("run", "reference_cvt", "--results", "none")
+    assert proc.returncode == 2
+    assert "cvt.model" in proc.stderr and "not available yet" in proc.stderr
+    proc = cli("run", "band-1dof", "--results", "none")
+    assert proc.returncode == 2 and "static" in proc.stderr
+
+
+def test_bad_until_is_an_input_error(cli):
+    proc = cli("run", "band-4dof", "--until", "-1", "--results", "none")
+    assert proc.returncode == 2 and "--until" in proc.stderr
+
+
+def test_compressible_run_records_normal_force(tmp_path):
+    scene = load_scene("band-6+2n", {"cvt": {"ritz_order": 2, "quadrature_nodes": 8}, "output": {"step": 5e-4}})
+    s = run_scene(scene, until=2e-3, results=tmp_path / "n.h5", show_progress=False)
+    r = read_results(tmp_path / "n.h5")
+    N = r.series["band.normal_force"]
+    assert N.shape == (5, 16)
+    assert np.all(N > 0) and np.ptp(N[-1, :8]) > 0.2 * N[-1, :8].mean()
+    assert s.n_coordinates == 10
