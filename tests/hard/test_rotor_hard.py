@@ -126,3 +126,22 @@ def test_critically_damped_supports_give_no_spurious_modes():
     modes = ModalProblem(M, K, C, np.zeros((6, 6)), kind).solve(0.0, 2)
     assert len(modes.wd) == 2
     assert np.allclose(modes.wd, w2 * math.sqrt(1 - zeta ** 2), rtol=1e-9)
+
+
+def test_campbell_of_an_overhung_disk_rotor_keeps_pairs_apart_from_zero_speed():
+    """FE rotor with a gyroscopic disk on isotropic bearings: at rest every lateral mode is a
+    double eigenvalue (x and y); from the first speed step on, the tracked backward curves fall
+    and the forward ones rise monotonically (gyroscopic softening/stiffening) and no tracked
+    curve changes its whirl label."""
+    data = {"material": [{"name": "steel", "E": E, "G": 8.12e10, "rho": RHO}],
+            "shaft": [{"length": 0.05, "outer_diameter": D, "material": "steel", "repeat": 12}],
+            "disk": [{"node": 4, "mass": 20.0, "Id": 0.1, "Ip": 0.2}],
+            "bearing": [{"node": 0, "kxx": 1e7, "kyy": 1e7}, {"node": 12, "kxx": 1e7, "kyy": 1e7}]}
+    model = build_model(scene_from_dict(data))
+    prob = ModalProblem(model.M, model.K, model.C, model.G, model.dof_kind)
+    camp = campbell(prob, np.linspace(0.0, 2000.0, 41), 6)
+    assert np.allclose(camp.wd[0, 0::2], camp.wd[0, 1::2], rtol=1e-9)          # coincident at rest
+    assert np.all(camp.whirl == camp.whirl[0]) and list(camp.whirl[0]) == ["backward", "forward"] * 3
+    step = np.diff(camp.wd, axis=0)
+    assert np.all(step[:, 0::2] < 0) and np.all(step[:, 1::2] > 0)
+    assert camp.wd[-1, 2] < 0.7 * camp.wd[0, 2] and camp.wd[-1, 3] > 1.3 * camp.wd[0, 3]
