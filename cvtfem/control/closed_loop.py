@@ -42,6 +42,7 @@ class Clamping:
     safety: float
     split: str = "equilibrium"
     _table: tuple[np.ndarray, np.ndarray] = field(init=False, repr=False)
+    _last: dict = field(init=False, repr=False, default_factory=dict)  # memo of the last (M1, ratio)
 
     def __post_init__(self) -> None:
         if self.split not in SPLITS:
@@ -67,7 +68,13 @@ class Clamping:
                          min_clamping_force(M1 * ratio, r[1], self.p.f0, g[1])])
 
     def forces(self, M1: float, ratio: float) -> np.ndarray:
-        """``F_appl = (F1, F2)``, N."""
+        """``F_appl = (F1, F2)``, N (a pure function of its arguments; the last result is memoised)."""
+        key = (float(M1), float(ratio))
+        if self._last.get("key") != key:
+            self._last.update(key=key, value=self._forces(M1, ratio))
+        return self._last["value"].copy()
+
+    def _forces(self, M1: float, ratio: float) -> np.ndarray:
         est = self.estimates(M1, ratio)
         if self.split == "per-shaft":
             return self.safety * est

@@ -74,8 +74,9 @@ class FourDofBand:
         """
         p = self.p
         phi, dphi = q[0], v[0]
-        r, dr, ddr, tg, dtg, ts, _ = arc_geometry(phi, p)
-        Ac = generalized_inertia(phi + 1e-30j, p)
+        geo = arc_geometry(phi + 1e-30j, p)  # one complex evaluation gives values and phi-derivatives
+        r, dr, ddr, tg, dtg, ts = (g.real for g in geo[:6])
+        Ac = band_inertia(phi + 1e-30j, p.length, p.L, p.mass) + np.sum(np.asarray(p.m_sheave) * (geo[3] * geo[1]) ** 2)
         A, dA = Ac.real, Ac.imag / 1e-30
         rhs_phi = p.kappa * np.sum(F * tg * dr) - 0.5 * dA * dphi ** 2
         a = np.empty(4)
