@@ -103,3 +103,42 @@ def test_event_at_the_very_last_step(method, n_steps):
     assert len(calls) == 1 and calls[0][0] == pytest.approx(t1, abs=1e-12)
     assert len(res.t_events[0]) == 1 and np.all(np.isfinite(res.y))
     assert res.y[1, -1] == pytest.approx(0.8 * math.sqrt(2 * G) - G * 1e-9, rel=1e-9)   # rebounded
+
+
+@pytest.mark.timeout(60)
+@pytest.mark.parametrize("method, kw", [("rk4", {"h": 0.1}), ("dopri45", {"rtol": 1e-8})])
+@pytest.mark.parametrize("direction", [0, 1])
+def test_pass_through_event_fires_once(method, kw, direction):
+    """y' = 1 with indicator y - 0.05 and no switch: the state passes through the surface, one
+    event at t = 0.05 s (it used to re-fire 21 times and stop as 'Zeno')."""
+    res = solve(lambda t, y: np.ones(1), (0.0, 1.0), [0.0], method=method,
+                events=(lambda t, y: np.array([y[0] - 0.05]), np.array([direction]), np.array([False])), **kw)
+    assert res.status == 0
+    assert res.t_events[0].tolist() == pytest.approx([0.05], abs=1e-12)
+    assert res.y[0, -1] == pytest.approx(1.0, abs=1e-12)
+
+
+@pytest.mark.timeout(60)
+def test_indicator_chattering_within_one_step_finds_the_earliest_crossing():
+    """cos(100 t) crosses zero at (k + 1/2) pi / 100: three crossings fall inside the first step
+    of h = 0.1 s. The first event is the earliest, pi/200 s, every reported event is a true zero
+    (to 1e-9 s), in increasing order, and the run ends normally (no false Zeno stop).
+    Two crossings inside one step with no end-point sign change are still missed: see
+    pending_events.py."""
+    res = solve(lambda t, y: 0 * y, (0.0, 0.3), [0.0], method="rk4", h=0.1, events=lambda t, y: np.cos(100 * t))
+    assert res.status == 0
+    te = res.t_events[0]
+    assert te[0] == pytest.approx(np.pi / 200, abs=1e-9)
+    zeros = (np.arange(10) + 0.5) * np.pi / 100
+    assert np.all(np.diff(te) > 0) and np.all(np.abs(te[:, None] - zeros).min(axis=1) < 1e-9)
+
+
+@pytest.mark.timeout(60)
+def test_event_exactly_at_the_initial_state_fires_at_t0():
+    """A ball on the floor (x0 = 0) moving down at 1 m/s: the impact is at t0 = 0; it rebounds
+    with 0.8 m/s and never goes below the floor (it used to fall through to x = -1.73 m)."""
+    calls: list = []
+    res = solve(**_balls(1, 0.8, calls), t_span=(0.0, 0.1), y0=[0.0, -1.0], method="dopri45", rtol=1e-8)
+    assert res.status == 0 and len(calls) >= 1 and calls[0][0] == pytest.approx(0.0, abs=1e-12)
+    assert np.all(res.y[0] >= -1e-12)
+    assert res.y[0, -1] == pytest.approx(0.8 * 0.1 - G * 0.01 / 2, rel=1e-6)

@@ -43,6 +43,20 @@ def test_fixed_step_far_above_the_stability_limit_stops_at_overflow():
     assert err.value.t == pytest.approx((n_overflow - 1) * h) and err.value.component == "rk4"
 
 
+def test_growth_limit_reports_the_unstable_fixed_step_at_once():
+    """With ``growth_limit`` (opt-in) the same run stops after the first step, before any
+    overflow, naming the amplification R(-1e5) = 4.17e18; a stable run is not affected."""
+    res = solve(lambda t, y: LAM * y, (0.0, 0.01), [1.0], method="rk4", h=1e-3, growth_limit=1e8)
+    assert res.status == -1 and list(res.t) == [0.0]
+    assert res.message == ("instability: |x| grew from 1 to 4.17e+18 in one step (h beyond the method's "
+                           "stability region? reduce h) at t = 0.001 s with fixed step h = 0.001 s")
+    ok = solve(lambda t, y: -100.0 * y, (0.0, 0.01), [1.0], method="rk4", h=1e-3, growth_limit=1e8)
+    assert ok.status == 0
+    assert ok.y[0, -1] == pytest.approx(rk4_factor(-0.1) ** 10, rel=1e-12)
+    with pytest.raises(InputError, match="`growth_limit` must be a number > 1"):
+        solve(lambda t, y: -y, (0.0, 1.0), [1.0], method="rk4", h=0.1, growth_limit=0.5)
+
+
 @pytest.mark.timeout(60)
 @pytest.mark.parametrize("newton", ["const", "exact", "broyden"])
 def test_newton_divergence_refreshes_then_fails_clearly(newton):
