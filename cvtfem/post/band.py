@@ -13,13 +13,20 @@ import numpy as np
 RPM = 30 / math.pi
 
 
-def windowed_efficiency(t, work, window: float = 0.05):
-    """Moving-window efficiency ``dW_out / dW_in`` over ``window`` seconds from cumulative works ``(n, 4)``."""
+def windowed_efficiency(t, work, window: float = 0.05, energy=None):
+    """Moving-window efficiency over ``window`` seconds from cumulative works ``(n, 4)`` (J).
+
+    Without ``energy``: ``dW_out / dW_in``.  With the model energy ``(n,)`` (J): the kinetic-energy
+    corrected form ``1 - (dW_in - dW_out - dE) / dW_in`` of spec section 6.2.
+    """
     t = np.asarray(t)
     work = np.asarray(work)
     j = np.searchsorted(t, t - window)
     d_in = work[:, 0] - work[j, 0]
     d_out = work[:, 1] - work[j, 1]
+    if energy is not None:
+        E = np.asarray(energy).reshape(-1)
+        d_out = d_out + (E - E[j])
     with np.errstate(invalid="ignore", divide="ignore"):
         return np.where(d_in > 0, d_out / np.where(d_in > 0, d_in, 1.0), np.nan)
 
@@ -48,7 +55,8 @@ def plot_regime(results, path: str | Path, title: str = "") -> Path:
     ax[1].plot(t, s["control.ratio_estimate"][:, 0], "--", label="smoothed estimate")
     ax[1].set_ylabel("ratio")
     ax[1].legend(loc="best")
-    ax[2].plot(t, windowed_efficiency(t, s["work"]), label="0.05 s window")
+    ax[2].plot(t, windowed_efficiency(t, s["work"]), label="output / input, 0.05 s window")
+    ax[2].plot(t, windowed_efficiency(t, s["work"], energy=s["energy"]), "--", label="kinetic-energy corrected")
     ax[2].set_ylabel("efficiency")
     ax[2].legend(loc="best")
     ax[3].plot(t, s["driving.clamping_force"][:, 0] / 1e3, label="F1")
