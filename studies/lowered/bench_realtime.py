@@ -18,7 +18,8 @@ from scipy.integrate import solve_ivp
 from cvtfem.machines.cvt import closed_loop
 from cvtfem.scene.loader import load_scene
 
-SETTINGS = [("Radau", 1e-6, 1e-8), ("Radau", 1e-4, 1e-6), ("BDF", 1e-4, 1e-6), ("LSODA", 1e-4, 1e-6)]
+SETTINGS = [("Radau", 1e-6, 1e-8), ("Radau", 1e-4, 1e-6), ("BDF", 1e-4, 1e-6), ("BDF", 1e-3, 1e-5),
+            ("LSODA", 1e-4, 1e-6)]
 
 
 def bench(name: str, method: str, rtol: float, atol: float, until: float, repeat: int, **over):

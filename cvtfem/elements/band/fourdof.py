@@ -22,9 +22,13 @@ from cvtfem.elements.band.params import BandParams, gauss_nodes
 def arc_geometry(phi, p: BandParams):
     """Per-pulley geometry at span angle phi: r, r', r'', tan(gamma), d tan(gamma)/dr, theta*, z0; each ``(2,)``."""
     r, dr, ddr = radii(phi, p.length, p.L)
-    tg = np.stack([p.sheaves[k].tan_gamma(r[k]) for k in range(2)])
-    dtg = np.stack([-p.sheaves[k].d2z0(r[k]) for k in range(2)])
-    z0 = np.stack([p.sheaves[k].z0(r[k]) for k in range(2)])
+    s1, s2 = p.sheaves
+    if s1 == s2:  # equal faces (the usual case): one vectorised evaluation for both pulleys
+        tg, dtg, z0 = s1.tan_gamma(r), -s1.d2z0(r), s1.z0(r)
+    else:
+        tg = np.stack([p.sheaves[k].tan_gamma(r[k]) for k in range(2)])
+        dtg = np.stack([-p.sheaves[k].d2z0(r[k]) for k in range(2)])
+        z0 = np.stack([p.sheaves[k].z0(r[k]) for k in range(2)])
     return r, dr, ddr, tg, dtg, wrap_half_angles(phi), z0
 
 

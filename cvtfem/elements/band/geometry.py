@@ -17,6 +17,9 @@ from scipy.optimize import brentq
 from cvtfem.errors import InputError
 
 
+_SIGN = np.array([1.0, -1.0])
+
+
 def radii(phi, length: float, L: float):
     """Contact radii of the two pulleys and their first two phi-derivatives.
 
@@ -43,7 +46,7 @@ def radii(phi, length: float, L: float):
     phi = np.asarray(phi)
     s, c = np.sin(phi), np.cos(phi)
     S = (length - 2 * L * (c + phi * s)) / np.pi
-    sign = np.array([1.0, -1.0]).reshape((2,) + (1,) * phi.ndim)
+    sign = _SIGN if phi.ndim == 0 else _SIGN.reshape((2,) + (1,) * phi.ndim)
     r = 0.5 * (S + sign * L * s)
     dr = L * c * (0.5 * sign - phi / np.pi)
     ddr = -L * s * (0.5 * sign - phi / np.pi) - L * c / np.pi
