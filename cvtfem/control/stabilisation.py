@@ -92,7 +92,7 @@ class Stabilisation:
         """
         p = self.p
         w1s, w2s, F11, b21 = z
-        i_t = float(ratio_estimate(w1s, w2s, p.eps, p.i_min, p.i_max))
+        i_t = 1.0 if abs(w2s) < p.eps else min(max(w1s / w2s, p.i_min), p.i_max)  # scalar form of ratio_estimate
         e = i_t - i_d
         FS = p.c_f0 * e + F11
         Fmin, Fmax = (1 / p.k_sat - 1) * F_appl[0], (p.k_sat - 1) * F_appl[0]

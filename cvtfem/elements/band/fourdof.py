@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from cvtfem.elements.band.friction import friction_vector
+from cvtfem.elements.band.friction import friction_gain
 from cvtfem.elements.band.geometry import radii, wrap_half_angles
 from cvtfem.elements.band.inertia import band_inertia
 from cvtfem.elements.band.params import BandParams, gauss_nodes
@@ -88,24 +88,26 @@ class FourDofBand:
         if p.friction:
             th = ts[:, None] * self._xi
             ds = (r * ts)[:, None] * self._wq  # (2, g)
-            vr = np.stack([np.broadcast_to((dr * dphi)[:, None], th.shape),
-                           v[1] - th * (dr * dphi)[:, None] - (r * v[2:4])[:, None],
-                           np.broadcast_to((tg * dr * dphi)[:, None], th.shape)])
-            ft = friction_vector(vr, p.f0, p.v0, p.law)
-            # generalized friction forces per unit N_k (1.51, corrected)
-            G_phi = -2 * dr * np.sum((ft[0] - th * ft[1] + tg[:, None] * ft[2]) * ds, axis=1)
-            G_sig = -2 * np.sum(ft[1] * ds, axis=1)
-            G_shaft = 2 * r * np.sum(ft[1] * ds, axis=1)
-            P = np.sum((-1.0 / np.sqrt(1 + tg[:, None] ** 2) - ft[2]) * ds, axis=1)  # int k.p ds
+            a_r = dr * dphi  # radial slip, uniform on each arc
+            a_z = tg * a_r  # axial slip
+            vt = v[1] - th * a_r[:, None] - (r * v[2:4])[:, None]
+            Gd = friction_gain(np.sqrt(vt * vt + (a_r * a_r + a_z * a_z)[:, None]), p.f0, p.v0, p.law) * ds
+            I_G, I_Gt, I_Gtt = Gd.sum(axis=1), (Gd * vt).sum(axis=1), (Gd * vt * th).sum(axis=1)
+            # generalized friction forces per unit N_k (1.51, corrected): f t = G v_r
+            G_phi = -2 * dr * (a_r * (1 + tg * tg) * I_G - I_Gtt)
+            G_sig = -2 * I_Gt
+            G_shaft = 2 * r * I_Gt
+            P = -2 * r * ts / np.sqrt(1 + tg * tg) - a_z * I_G  # int k.p ds
             msh = np.asarray(p.m_sheave)
             alpha = (0.5 * msh * (ddr * tg + dr ** 2 * dtg) * dphi ** 2 - F) / P
             beta = 0.5 * msh * dr * tg / P
-            a[0] = (rhs_phi + np.sum(alpha * G_phi)) / (A - np.sum(beta * G_phi))
+            a[0] = (rhs_phi + alpha @ G_phi) / (A - beta @ G_phi)
             N = alpha + beta * a[0]
-            a[1] = np.sum(N * G_sig) / p.mass
+            a[1] = (N @ G_sig) / p.mass
             a[2:4] = (M + N * G_shaft) / np.asarray(p.J)
-            Q = np.array([np.sum(N * G_phi), np.sum(N * G_sig), N[0] * G_shaft[0], N[1] * G_shaft[1]])
-            info.update(N=N, dissipation=-float(Q @ v), slip_max=np.sqrt(np.sum(vr ** 2, axis=0)).max(axis=1))
+            Q = np.array([N @ G_phi, N @ G_sig, N[0] * G_shaft[0], N[1] * G_shaft[1]])
+            slip_max = np.sqrt(np.max(vt * vt, axis=1) + a_r * a_r + a_z * a_z)
+            info.update(N=N, dissipation=-float(Q @ v), slip_max=slip_max)
         else:
             a[0] = rhs_phi / A
             a[1] = 0.0

@@ -24,9 +24,8 @@ def friction_coefficient(v, f0: float, v0: float, law: str = "linear-saturated")
     return np.where(x < 1.0, f0 * x, f0)
 
 
-def friction_vector(v_r, f0: float, v0: float, law: str = "linear-saturated"):
-    """``f(|v_r|) v_r / |v_r|`` for slip vectors ``v_r`` of shape ``(3, ...)`` (components first)."""
-    v = np.sqrt(np.sum(v_r * v_r, axis=0))
+def friction_gain(v, f0: float, v0: float, law: str = "linear-saturated"):
+    """``f(v) / v`` (s/m) for slip speeds ``v >= 0``, finite at ``v = 0`` (limit ``f'(0)``)."""
     x = v / v0
     if law == "tanh":
         safe = np.where(x > 1e-8, x, 1.0)
@@ -35,4 +34,9 @@ def friction_vector(v_r, f0: float, v0: float, law: str = "linear-saturated"):
         g = np.where(x < 1.0, 1.5 - 0.5 * x * x, 1.0 / np.where(x < 1.0, 1.0, x))
     else:
         g = np.where(x < 1.0, 1.0, 1.0 / np.where(x < 1.0, 1.0, x))
-    return (f0 / v0) * g * v_r
+    return (f0 / v0) * g
+
+
+def friction_vector(v_r, f0: float, v0: float, law: str = "linear-saturated"):
+    """``f(|v_r|) v_r / |v_r|`` for slip vectors ``v_r`` of shape ``(3, ...)`` (components first)."""
+    return friction_gain(np.sqrt(np.sum(v_r * v_r, axis=0)), f0, v0, law) * v_r
