@@ -2,6 +2,8 @@
 
 Prints the median of several runs for each model and integrator setting, with the machine.
 Target (issue 5, not asserted): <= 0.1 s wall per simulated second for band-4dof and band-6+2n (n = 5).
+BDF is slow on the compressible models (lightly damped elastic modes; BDF orders > 2 are not
+A-stable): pass ``--methods Radau`` for them.
 
     .venv/bin/python studies/lowered/bench_realtime.py [--repeat 3] [--until 1.0]
 """
@@ -41,6 +43,7 @@ def main() -> None:
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--until", type=float, default=1.0)
     ap.add_argument("--models", nargs="*", default=["band-4dof", "band-6+2n", "band-6+2n+8"])
+    ap.add_argument("--methods", nargs="*", default=None, help="only these methods (e.g. Radau BDF)")
     args = ap.parse_args()
     load = os.getloadavg()[0] if hasattr(os, "getloadavg") else float("nan")
     print(f"machine: {platform.processor() or platform.machine()}, {os.cpu_count()} cores, "
@@ -49,6 +52,8 @@ def main() -> None:
           f"{'ratio':>7} {'x real time':>11}")
     for name in args.models:
         for method, rtol, atol in SETTINGS:
+            if args.methods and method not in args.methods:
+                continue
             wall, nfev, njev, steps, ratio, status = bench(name, method, rtol, atol, args.until, args.repeat)
             per = wall / args.until
             print(f"{name:<13} {method:<6} {rtol:>7.0e} {per:>11.3f} {steps:>6} {nfev:>6} {njev:>5} {ratio:>7.4f} "
