@@ -80,7 +80,8 @@ class FourDofBand:
         phi, dphi = q[0], v[0]
         geo = arc_geometry(phi + 1e-30j, p)  # one complex evaluation gives values and phi-derivatives
         r, dr, ddr, tg, dtg, ts = (g.real for g in geo[:6])
-        Ac = band_inertia(phi + 1e-30j, p.length, p.L, p.mass) + np.sum(np.asarray(p.m_sheave) * (geo[3] * geo[1]) ** 2)
+        Ac = (band_inertia(phi + 1e-30j, p.length, p.L, p.mass, geo[0])
+              + np.sum(np.asarray(p.m_sheave) * (geo[3] * geo[1]) ** 2))
         A, dA = Ac.real, Ac.imag / 1e-30
         rhs_phi = p.kappa * np.sum(F * tg * dr) - 0.5 * dA * dphi ** 2
         a = np.empty(4)

@@ -56,7 +56,7 @@ def radii(phi, length: float, L: float):
 def wrap_half_angles(phi):
     """Wrap half-angles ``theta*_1 = pi/2 + phi``, ``theta*_2 = pi/2 - phi`` (rad), shape ``(2, ...)``."""
     phi = np.asarray(phi)
-    return np.stack([np.pi / 2 + phi, np.pi / 2 - phi])
+    return np.array([np.pi / 2 + phi, np.pi / 2 - phi])
 
 
 @dataclass(frozen=True)

@@ -10,7 +10,7 @@ import numpy as np
 from cvtfem.elements.band.geometry import radii
 
 
-def band_inertia(phi, length: float, L: float, mass: float):
+def band_inertia(phi, length: float, L: float, mass: float, r=None):
     """Band inertia ``A(phi)`` of eq. (1.45, corrected), kg m^2/rad^2.
 
     Parameters
@@ -20,10 +20,13 @@ def band_inertia(phi, length: float, L: float, mass: float):
         Band length and centre distance.
     mass : float, kg
         Band mass (``rho = mass / length``).
+    r : array (2, ...), optional
+        The radii ``radii(phi)[0]`` when already computed.
     """
     phi = np.asarray(phi)
     rho = mass / length
-    r, _, _ = radii(phi, length, L)
+    if r is None:
+        r, _, _ = radii(phi, length, L)
     p1, p2 = np.pi + 2 * phi, np.pi - 2 * phi
     arcs = (r[0] * (p1 + p1 ** 3 / 12) * (0.5 - phi / np.pi) ** 2
             + r[1] * (p2 + p2 ** 3 / 12) * (0.5 + phi / np.pi) ** 2)
