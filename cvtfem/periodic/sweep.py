@@ -159,9 +159,11 @@ def diagonal_blocks(N: np.ndarray, L: np.ndarray, i: np.ndarray, j: np.ndarray) 
     return N + (_scatter(ends, N.shape[0]) @ blocks).reshape(N.shape)
 
 
-def apply(N: np.ndarray, L: np.ndarray, i: np.ndarray, j: np.ndarray, a: np.ndarray) -> np.ndarray:
-    """Matrix-vector product of the block system with ``a`` (S, B, K)."""
-    out = np.einsum("sbkl,sbl->sbk", diagonal_blocks(N, L, i, j), a)
+def apply(N: np.ndarray, L: np.ndarray, i: np.ndarray, j: np.ndarray, a: np.ndarray,
+          G0: np.ndarray | None = None) -> np.ndarray:
+    """Matrix-vector product of the block system with ``a`` (S, B, K); ``G0``: precomputed diagonal blocks."""
+    G0 = diagonal_blocks(N, L, i, j) if G0 is None else G0
+    out = np.einsum("sbkl,sbl->sbk", G0, a)
     inner = j >= 0
     if not inner.any():
         return out
@@ -201,16 +203,17 @@ def _diagonal(blocks: np.ndarray) -> np.ndarray:
 
 
 def block_sweep(topo: Topology, N: np.ndarray, L: np.ndarray, i: np.ndarray, j: np.ndarray,
-                g: np.ndarray) -> np.ndarray:
+                g: np.ndarray, G0: np.ndarray | None = None) -> np.ndarray:
     """Tree block elimination (the modified vector sweep, spec 8.2).
 
     Forward: ``X_s = G_s^-1 L_s``, ``y_s = G_s^-1 g_s`` (one LU per block, via
     ``numpy.linalg.solve``), ``G_p -= L_s X_s``, ``g_p += L_s y_s``; back:
     ``a_s = y_s + X_s a_p``.  Nodes whose blocks stay diagonal (linear links
     away from the root's nonlinear ones) are eliminated with O(K) vector
-    operations instead of O(K^3).  Returns ``a`` (S, B, K).
+    operations instead of O(K^3).  ``G0``: precomputed :func:`diagonal_blocks`.
+    Returns ``a`` (S, B, K).
     """
-    G = diagonal_blocks(N, L, i, j)
+    G = diagonal_blocks(N, L, i, j) if G0 is None else G0.copy()
     g = g.astype(complex, copy=True)
     S, B, K = g.shape
     X = np.zeros((S, B, K, K), complex)
@@ -260,12 +263,13 @@ def solve_blocks(N: np.ndarray, L: np.ndarray, i: np.ndarray, j: np.ndarray, g: 
     if method == "sweep" and topo is None:
         raise InputError("method", method, "needs a tree network (this one has a loop); use 'sparse'")
     if topo is not None and method != "sparse":
+        G0 = diagonal_blocks(N, L, i, j)
         with np.errstate(all="ignore"):
             try:
-                a = block_sweep(topo, N, L, i, j, g)
+                a = block_sweep(topo, N, L, i, j, g, G0)
             except np.linalg.LinAlgError:
                 a = np.full_like(g, np.nan, dtype=complex)
-        res = np.linalg.norm(apply(N, L, i, j, a) - g) if np.all(np.isfinite(a)) else np.inf
+        res = np.linalg.norm(apply(N, L, i, j, a, G0) - g) if np.all(np.isfinite(a)) else np.inf
         if res <= RESIDUAL_LIMIT * max(np.linalg.norm(g), 1e-300) or method == "sweep":
             return a, "sweep"
     a = solve_sparse(N, L, i, j, g)
