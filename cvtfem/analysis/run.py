@@ -7,7 +7,6 @@ every accepted state for NaN/inf and returns a :class:`RunSummary`.
 """
 from __future__ import annotations
 
-import logging
 import math
 import time
 from dataclasses import asdict, dataclass, field
@@ -17,8 +16,6 @@ from typing import Any
 import numpy as np
 
 from cvtfem.errors import InputError, NumericalError
-
-log = logging.getLogger(__name__)
 
 SCIPY_STEPPERS = ("RK23", "RK45", "DOP853", "Radau", "BDF", "LSODA")
 EFFICIENCY_WINDOW = 0.05  # s, moving average of the efficiency (section 6.1)
@@ -189,8 +186,8 @@ def _summarise(scene, loop, history, t_end, wall, stats, status) -> RunSummary:
     x = X[-1]
     _, info = loop.evaluate(t[-1], x)
     w1d, _, i_d = info["targets"]
-    j = max(int(np.searchsorted(t, t[-1] - EFFICIENCY_WINDOW)) - 0, 0)
-    if j >= len(t) - 1:
+    j = int(np.searchsorted(t, t[-1] - EFFICIENCY_WINDOW))
+    if j >= len(t) - 1:  # run shorter than one output step past the window: use the whole run
         j = 0
     W0, W1 = loop.split(X[j])[3], loop.split(x)[3]
     dW = W1 - W0

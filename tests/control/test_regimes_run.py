@@ -1,5 +1,4 @@
 """Non-stationary regimes through the run driver (spec 6.2): torque ramp, ratio change, efficiency forms."""
-import numpy as np
 import pytest
 
 from cvtfem.analysis.run import run_scene
