@@ -15,7 +15,7 @@ import numpy as np
 from cvtfem.errors import InputError, NumericalError
 from cvtfem.integrate.base import StepFailure, hermite
 from cvtfem.integrate.controller import FixedStep, SimpleController, error_norm
-from cvtfem.integrate.events import EventLocator
+from cvtfem.integrate.events import EVENT_SAMPLES, EventLocator
 from cvtfem.integrate.methods import METHODS, SCIPY_METHODS, UNAVAILABLE, all_options
 from cvtfem.integrate.stats import Stats
 from cvtfem.integrate.system import as_system
@@ -30,6 +30,7 @@ MESSAGES = {0: "The solver successfully reached the end of the integration inter
 ZENO_GAP = 1e-9     # events closer than this fraction of the span ...
 ZENO_GAP_H = 1e-6   # ... or of the step count towards Zeno accumulation
 ZENO_COUNT = 3      # that many in a row stop the run
+GROWTH_LIMIT = 1e8  # default growth guard of fixed-step runs (see `solve`)
 
 
 class IgnoredOptionWarning(UserWarning):
@@ -75,7 +76,8 @@ def solve(fun, t_span, y0, method: str = "dopri45", h: float | None = None, rtol
           atol: float = 1e-9, events=None, jac=None, jac_sparsity=None, t_eval=None, *, n2: int = 0,
           switch=None, adaptive: bool | None = None, event_location: str = "dense",
           max_steps: int = 10_000_000, max_events: int = 100_000, raise_on_failure: bool = False,
-          growth_limit: float | None = None, **options) -> OdeResult:
+          growth_limit: float | None = GROWTH_LIMIT, event_samples: int = EVENT_SAMPLES,
+          **options) -> OdeResult:
     """Integrate ``x' = F(t, x)`` over ``t_span`` with one of the playground's methods.
 
     Parameters
@@ -97,10 +99,17 @@ def solve(fun, t_span, y0, method: str = "dopri45", h: float | None = None, rtol
     n2 : number of second-order pairs in ``y = [u, v, z]``.
     switch : ``switch(t, y, fired) -> y_new | None`` discrete-state automaton at events.
     event_location : ``"dense"`` (Brent on the interpolant) or ``"linear"`` (source's scheme).
-    growth_limit : float, optional
-        Fixed-step runs stop with an "instability" status as soon as one step amplifies the
-        state beyond ``growth_limit * (|x0| + |h F0|)`` (e.g. 1e8); default: only non-finite
-        states stop a run.
+    event_samples : int
+        Dense mode: indicators are also sampled at this many equally spaced interior points of
+        every step (default 4), so an even number of crossings inside one step is found;
+        0 detects sign changes between the step's end points only (the source's scheme).
+        Crossings closer together than ``h / (event_samples + 1)`` can still be missed.
+    growth_limit : float or None
+        Fixed-step runs stop with an "instability" status (-1) at the first step whose state
+        norm ``max|x1|`` exceeds ``growth_limit`` times the reference ``max(largest max|x| so
+        far, max|h F0|, max(atol))`` (default 1e8: far above any stable step's growth, far
+        below the amplification of a step far beyond the stability limit). ``None`` disables
+        the guard; then only a non-finite state stops a run.
     **options : method options (``d``, ``alpha``, ``newton``, ``stages``, ``sequence`` ...);
         an option the method ignores warns with :class:`IgnoredOptionWarning`.
     """
@@ -124,7 +133,9 @@ def solve(fun, t_span, y0, method: str = "dopri45", h: float | None = None, rtol
             raise InputError("switch", switch, f"is not supported by scipy method {method!r}",
                              "solve_ivp cannot change a discrete state; use a native method")
         for key, val, default in (("adaptive", adaptive, None),
-                                  ("event_location", event_location, "dense")):
+                                  ("event_location", event_location, "dense"),
+                                  ("event_samples", event_samples, EVENT_SAMPLES),
+                                  ("growth_limit", growth_limit, GROWTH_LIMIT)):
             if val != default:
                 warnings.warn(f"option `{key}` is ignored by scipy method {method!r}",
                               IgnoredOptionWarning, stacklevel=2)
@@ -152,16 +163,25 @@ def solve(fun, t_span, y0, method: str = "dopri45", h: float | None = None, rtol
     if growth_limit is not None and not growth_limit > 1:
         raise InputError("growth_limit", growth_limit, "must be a number > 1 or None")
     return _integrate(stepper, ctrl, system, t0, tf, y0, h, rtol, atol, t_eval, event_location,
-                      max_steps, max_events, raise_on_failure, stats, method, adaptive, growth_limit)
+                      max_steps, max_events, raise_on_failure, stats, method, adaptive, growth_limit,
+                      event_samples)
 
 
-def _blow_up(att, x, limit):
-    """Message if a fixed step amplified the state beyond ``limit (|x0| + |h F0|)``, else None."""
-    scale = np.max(np.abs(x)) + (0.0 if att.f0 is None else np.max(np.abs(att.h * att.f0)))
-    grown = np.max(np.abs(att.x1))
+def _norm(x) -> float:
+    return float(np.max(np.abs(x))) if np.size(x) else 0.0
+
+
+def _blow_up(att, x, limit, largest, floor, method):
+    """Message if a fixed step's ``max|x1|`` exceeds ``limit`` times the reference
+    ``max(largest max|x| so far, max|h F0|, floor)``, else None."""
+    scale = max(largest, floor, 0.0 if att.f0 is None else _norm(att.h * att.f0))
+    grown = _norm(att.x1)
     if grown > limit * scale and grown > 0:
-        return (f"instability: |x| grew from {np.max(np.abs(x)):.3g} to {grown:.3g} in one step "
-                f"(h beyond the method's stability region? reduce h)")
+        start = _norm(x)
+        factor = grown / start if start > 0 else grown / scale
+        return (f"instability ({method}): |x| grew by a factor {factor:.3g} in one step, from "
+                f"{start:.3g} to {grown:.3g} (more than growth_limit = {limit:.3g} times the "
+                f"largest |x| so far)")
     return None
 
 
@@ -180,13 +200,15 @@ def _initial_step(stepper, t0, y0, rtol, atol, span):
 
 
 def _integrate(stepper, ctrl, system, t0, tf, y0, h, rtol, atol, t_eval, event_location,
-               max_steps, max_events, raise_on_failure, stats, method, adaptive, growth_limit):
+               max_steps, max_events, raise_on_failure, stats, method, adaptive, growth_limit,
+               event_samples=EVENT_SAMPLES):
     wall = time.perf_counter()
     st = stats.counts
     t, x = t0, y0.copy()
     ts, ys = ([t0], [x.copy()]) if t_eval is None else ([], [])
     i_eval = 0
-    locator = EventLocator(system, stats, event_location) if system.n_events else None
+    locator = EventLocator(system, stats, event_location, event_samples) if system.n_events else None
+    largest, floor = _norm(y0), _norm(atol)     # growth guard: largest max|x| so far, its floor
     if locator is not None:
         locator.start(t, x)
     t_events = [[] for _ in range(system.n_events)]
@@ -206,7 +228,7 @@ def _integrate(stepper, ctrl, system, t0, tf, y0, h, rtol, atol, t_eval, event_l
                 att = stepper.attempt(t, x, h_try)
             failure = None if np.all(np.isfinite(att.x1)) else "non-finite state"
             if failure is None and growth_limit is not None and not adaptive:
-                failure = _blow_up(att, x, growth_limit)
+                failure = _blow_up(att, x, growth_limit, largest, floor, method)
         except StepFailure as err:
             att, failure = None, str(err)
         if adaptive:
@@ -230,6 +252,9 @@ def _integrate(stepper, ctrl, system, t0, tf, y0, h, rtol, atol, t_eval, event_l
                 nonfin = [] if att is None else np.flatnonzero(~np.isfinite(att.x1))
                 bad = f" in component {int(nonfin[0])}" if len(nonfin) else ""
                 status, message = -1, f"{failure}{bad} at t = {t + h_try:.6g} s with fixed step h = {h:.3g} s"
+                if failure.startswith("instability"):
+                    message += (": h is beyond the method's stability region; reduce h or use an "
+                                "implicit or stabilized method (growth_limit=None disables this check)")
                 break
         st["nsteps"] += 1
         t1, x1 = t + h_try, att.x1
@@ -238,7 +263,9 @@ def _integrate(stepper, ctrl, system, t0, tf, y0, h, rtol, atol, t_eval, event_l
         def dense(tq, att=att):
             nonlocal f1
             if f1 is None:
-                f1 = att.f1 if att.f1 is not None else stepper.f(att.t0 + att.h, att.x1)
+                if att.f1 is None:        # kept: accept() caches it as the next step's F0
+                    att.f1 = stepper.f(att.t0 + att.h, att.x1)
+                f1 = att.f1
             if att.f0 is None:
                 att.f0 = stepper.f(att.t0, att.x0)
             return hermite(att, f1, tq)
@@ -259,6 +286,7 @@ def _integrate(stepper, ctrl, system, t0, tf, y0, h, rtol, atol, t_eval, event_l
             ts.append(t1)
             ys.append(x1.copy())
         t, x, h = t1, x1, h_new
+        largest = max(largest, _norm(x))
         if hit is not None:
             for k in np.flatnonzero(fired):
                 t_events[k].append(t)
@@ -267,6 +295,7 @@ def _integrate(stepper, ctrl, system, t0, tf, y0, h, rtol, atol, t_eval, event_l
                 new = system.switch(t, x.copy(), fired)
                 if new is not None:
                     x = np.array(new, dtype=x.dtype)
+                    largest = max(largest, _norm(x))
             stepper.reset()
             locator.start(t, x, fired)
             if np.any(fired & system.event_terminal):

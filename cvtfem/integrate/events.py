@@ -4,6 +4,11 @@ Two locators: ``"linear"`` interpolates indicators and state over the step (the 
 scheme, ``theta = e0/(e0 - e1)``, ``x* = (1-theta) x0 + theta x1``); ``"dense"`` (default)
 scans the step's dense output at ``SCAN`` interior points for the first sign change and
 refines it with Brent's method, so the earliest of several crossings in one step is found.
+In dense mode every step also samples the indicators at ``event_samples`` (default
+``EVENT_SAMPLES`` = 4) equally spaced interior points, so an even number of crossings inside
+one step (no sign change between the step's ends) is detected as well; ``event_samples = 0``
+restores the end-point-only detection of the source. Crossings closer together than the sample
+spacing ``h / (event_samples + 1)`` can still cancel out and be missed.
 
 After an event the fired indicators restart at exactly 0; their sign just after the restart
 (sampled at ``INTERIOR`` fractions of the step, as CVODE does) becomes the new reference, so a
@@ -22,6 +27,7 @@ __all__ = ["EventLocator", "crossings"]
 
 SIMULTANEOUS_RTOL = 1e-9   # crossings closer than this fraction of h count as simultaneous
 INTERIOR = (1e-10, 1e-6, 1e-3, 1 / 64, 1 / 8, 1 / 2)   # samples for indicators restarting at 0
+EVENT_SAMPLES = 4          # interior samples per step that detect even crossings (dense mode)
 SCAN = 8                   # sub-intervals scanned for the earliest crossing (dense mode)
 TINY = np.finfo(float).tiny
 
@@ -36,10 +42,12 @@ def crossings(g0: np.ndarray, g1: np.ndarray, direction: np.ndarray) -> np.ndarr
 class EventLocator:
     """Stores indicators at the step start and finds the earliest crossing in a step."""
 
-    def __init__(self, system, stats, mode: str = "dense") -> None:
+    def __init__(self, system, stats, mode: str = "dense", samples: int = EVENT_SAMPLES) -> None:
         if mode not in ("dense", "linear"):
             raise InputError("event_location", mode, "must be 'dense' or 'linear'")
-        self.system, self.stats, self.mode = system, stats, mode
+        if isinstance(samples, bool) or not isinstance(samples, (int, np.integer)) or samples < 0:
+            raise InputError("event_samples", samples, "must be an integer >= 0")
+        self.system, self.stats, self.mode, self.samples = system, stats, mode, int(samples)
         self.g0: np.ndarray | None = None
         self.side: np.ndarray | None = None
         self._ga: np.ndarray | None = None
@@ -88,13 +96,28 @@ class EventLocator:
         ta, ga, tb, gb = self._brackets(t0, t1, g1, dense)
         direction = self.system.event_direction
         cross = crossings(ga, gb, direction)
+        extra = None
+        if self.mode == "dense" and self.samples and not cross.any():
+            # no end-point sign change: sample the interior for an even number of crossings
+            ts = t0 + h * np.arange(1, self.samples + 1) / (self.samples + 1)
+            xs = dense(ts)                                   # (n, samples), one interpolation
+            gs = np.array([self.g(t, xs[:, i]) for i, t in enumerate(ts)])
+            extra = (ts, gs)
+            if np.all(ta == t0) and np.all(tb == t1):    # common case, vectorised
+                seq = np.vstack([ga, gs, gb])
+                cross = crossings(seq[:-1], seq[1:], direction).any(axis=0)
+            else:
+                cross = crossings(*self._first(ta, ga, tb, gb, ts, gs)[1::2], direction)
         if not cross.any():
             self.g0 = g1
             return None
         if self.mode == "dense":   # scan the interpolant for the first sign change
-            ta, ga, tb, gb = self._scan(ta, ga, tb, gb, cross, dense)
+            ta, ga, tb, gb = self._scan(ta, ga, tb, gb, dense, extra)
             cross = crossings(ga, gb, direction)
         idx = np.flatnonzero(cross)
+        if not len(idx):
+            self.g0 = g1
+            return None
         if self.mode == "linear":
             t_k = ta[idx] + ga[idx] / (ga[idx] - gb[idx]) * (tb[idx] - ta[idx])
         else:
@@ -110,24 +133,35 @@ class EventLocator:
             x_star = dense(t_star)
         return t_star, x_star, fired, g1
 
-    def _scan(self, ta, ga, tb, gb, cross, dense):
+    def _scan(self, ta, ga, tb, gb, dense, extra=None):
         """Narrow each bracket to its first sub-interval with a sign change (``SCAN`` samples
-        on the common part of the brackets; indicators without an end-point change are
-        checked too, which catches a double crossing inside the step)."""
+        on the common part of the brackets, merged with the detection samples ``extra``;
+        indicators without an end-point change are checked too, which catches a double
+        crossing inside the step)."""
         lo, hi = float(ta.max()), float(tb.min())
-        if hi <= lo:
+        ts = lo + (hi - lo) * np.arange(1, SCAN) / SCAN if hi > lo else np.empty(0)
+        gs = np.array([self.g(t, dense(t)) for t in ts]).reshape(len(ts), len(ga))
+        if extra is not None:
+            ts, gs = np.concatenate([ts, extra[0]]), np.concatenate([gs, extra[1]])
+            order = np.argsort(ts, kind="stable")
+            ts, gs = ts[order], gs[order]
+        if not len(ts):
             return ta, ga, tb, gb
+        return self._first(ta, ga, tb, gb, ts, gs)
+
+    def _first(self, ta, ga, tb, gb, ts, gs):
+        """Per indicator, the first crossing along ``ta, ts (inside (ta, tb)), tb``:
+        ``(ta, ga, tb, gb)`` narrowed to it (unchanged where there is none)."""
         direction = self.system.event_direction
-        ts = lo + (hi - lo) * np.arange(1, SCAN) / SCAN
-        gs = np.array([self.g(t, dense(t)) for t in ts])           # (SCAN-1, m)
         ta, ga, tb, gb = ta.copy(), ga.copy(), tb.copy(), gb.copy()
         prev_t, prev_g = ta.copy(), ga.copy()
         done = np.zeros(len(ga), bool)
         for t, g in zip(ts, gs):
-            hit = ~done & (t > prev_t) & crossings(prev_g, g, direction)
+            inside = ~done & (t > prev_t) & (t < tb)
+            hit = inside & crossings(prev_g, g, direction)
             ta[hit], ga[hit], tb[hit], gb[hit] = prev_t[hit], prev_g[hit], t, g[hit]
             done |= hit
-            upd = ~done & (t > prev_t)
+            upd = inside & ~hit
             prev_t[upd], prev_g[upd] = t, g[upd]
         last = ~done & crossings(prev_g, gb, direction)
         ta[last], ga[last] = prev_t[last], prev_g[last]

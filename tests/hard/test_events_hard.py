@@ -122,9 +122,7 @@ def test_pass_through_event_fires_once(method, kw, direction):
 def test_indicator_chattering_within_one_step_finds_the_earliest_crossing():
     """cos(100 t) crosses zero at (k + 1/2) pi / 100: three crossings fall inside the first step
     of h = 0.1 s. The first event is the earliest, pi/200 s, every reported event is a true zero
-    (to 1e-9 s), in increasing order, and the run ends normally (no false Zeno stop).
-    Two crossings inside one step with no end-point sign change are still missed: see
-    pending_events.py."""
+    (to 1e-9 s), in increasing order, and the run ends normally (no false Zeno stop)."""
     res = solve(lambda t, y: 0 * y, (0.0, 0.3), [0.0], method="rk4", h=0.1, events=lambda t, y: np.cos(100 * t))
     assert res.status == 0
     te = res.t_events[0]
@@ -142,3 +140,73 @@ def test_event_exactly_at_the_initial_state_fires_at_t0():
     assert res.status == 0 and len(calls) >= 1 and calls[0][0] == pytest.approx(0.0, abs=1e-12)
     assert np.all(res.y[0] >= -1e-12)
     assert res.y[0, -1] == pytest.approx(0.8 * 0.1 - G * 0.01 / 2, rel=1e-6)
+
+
+@pytest.mark.timeout(60)
+def test_two_crossings_inside_one_step_are_not_missed():
+    """cos(100 t) on [0, 0.3] with h = 0.1 has ten zeros ((k + 1/2) pi / 100, k = 0..9). After the
+    event at 0.2356 s the rest step [0.2356, 0.3] holds two crossings (0.2670, 0.2985) and no
+    end-point sign change: the interior samples (default 4 per step) find them, all ten zeros
+    to 1e-9 s. With ``event_samples=0`` (the source's end-point-only detection) the two are
+    missed again: eight zeros."""
+    zeros = (np.arange(10) + 0.5) * np.pi / 100
+    res = solve(lambda t, y: 0 * y, (0.0, 0.3), [0.0], method="rk4", h=0.1, events=lambda t, y: np.cos(100 * t))
+    assert res.status == 0
+    assert np.allclose(res.t_events[0], zeros, rtol=0, atol=1e-9)
+    old = solve(lambda t, y: 0 * y, (0.0, 0.3), [0.0], method="rk4", h=0.1, events=lambda t, y: np.cos(100 * t),
+                event_samples=0)
+    assert np.allclose(old.t_events[0], zeros[:8], rtol=0, atol=1e-9)
+
+
+def _thrown(c: float, direction: int):
+    """A ball thrown up at 1 m/s from 0 (``y = t - g t^2 / 2``, exact for RK4 and the cubic
+    interpolant) with a ceiling indicator ``y - c``."""
+    ind = lambda t, x: np.array([x[0] - c])   # noqa: E731
+    return dict(fun=lambda t, x: np.array([x[1], -G]), t_span=(0.0, 0.2), y0=[0.0, 1.0], n2=1,
+                events=(ind, np.array([direction]), np.array([False])))
+
+
+def _ceiling_times(c: float) -> np.ndarray:
+    r = math.sqrt(1 - 2 * G * c)
+    return np.array([(1 - r) / G, (1 + r) / G])
+
+
+@pytest.mark.timeout(60)
+@pytest.mark.parametrize("direction, which", [(0, [0, 1]), (1, [0]), (-1, [1])])
+def test_up_and_down_crossing_inside_one_step(direction, which):
+    """One RK4 step of h = 0.2 s; the ball rises through y = 0.04 m at 0.0546 s and falls back
+    through it at 0.1493 s ((1 -+ sqrt(1 - 2 g c)) / g); y(0) = 0 and y(0.2) = 0.0038 m are both
+    below: no end-point sign change. Each crossing fires once, in its own direction, to 1e-12 s,
+    with the state on the closed form."""
+    res = solve(**_thrown(0.04, direction), method="rk4", h=0.2)
+    te = _ceiling_times(0.04)[which]
+    assert res.status == 0
+    assert res.t_events[0] == pytest.approx(te, abs=1e-12)
+    assert res.y_events[0][:, 0] == pytest.approx(np.full(len(te), 0.04), abs=1e-12)
+    assert res.y_events[0][:, 1] == pytest.approx(1 - G * te, abs=1e-12)
+    assert res.y[0, -1] == pytest.approx(0.2 - G * 0.02, abs=1e-12)
+
+
+@pytest.mark.timeout(60)
+def test_crossings_closer_than_the_sample_spacing_need_more_samples():
+    """Documented limit: at y = 0.05 m the two crossings are 0.0281 s apart (0.0879, 0.1160 s),
+    closer than the default sample spacing h / 5 = 0.04 s, and every sample (0.04, 0.08, 0.12,
+    0.16 s) lies below the ceiling: missed. Nine samples (spacing 0.02 s) find both to 1e-12 s."""
+    assert all(t - G * t * t / 2 < 0.05 for t in (0.04, 0.08, 0.12, 0.16))
+    res = solve(**_thrown(0.05, 0), method="rk4", h=0.2)
+    assert res.status == 0 and len(res.t_events[0]) == 0
+    res = solve(**_thrown(0.05, 0), method="rk4", h=0.2, event_samples=9)
+    assert res.t_events[0] == pytest.approx(_ceiling_times(0.05), abs=1e-12)
+
+
+@pytest.mark.parametrize("samples", [0, 1, 4, 7])
+def test_event_samples_are_counted(samples):
+    """An indicator that never crosses (cos(t) + 2 > 0) costs one evaluation at the start plus
+    ``1 + event_samples`` per step (end point and interior samples), all counted in nevfun; the
+    interpolant's end slope is the next step's F0, so RK4 still needs 4 RHS calls per step."""
+    res = solve(lambda t, y: -y, (0.0, 1.0), [1.0], method="rk4", h=0.1,
+                events=lambda t, y: np.cos(t) + 2, event_samples=samples)
+    assert res.stats["nsteps"] == 10 and len(res.t_events[0]) == 0
+    assert res.stats["nevfun"] == 1 + 10 * (1 + samples)
+    assert res.stats["nfev"] == 4 * 10 + (1 if samples else 0)
+    assert res.y[0, -1] == pytest.approx((1 - 0.1 + 0.01 / 2 - 0.001 / 6 + 0.0001 / 24) ** 10, rel=1e-13)

@@ -29,30 +29,76 @@ def rk4_factor(z: float) -> float:
 def test_fixed_step_far_above_the_stability_limit_stops_at_overflow():
     """RK4 at h = 1e-3 s on y' = -1e8 y (h lambda = -1e5, limit -2.785): |y| grows by R(z) = 4.2e18
     per step, exactly as the amplification factor says, and the run stops with status -1 at the
-    first non-finite state (step 17, since 17 log10 R > 308), returning only finite values."""
+    first non-finite state (step 17, since 17 log10 R > 308), returning only finite values.
+    This is the behaviour with the growth guard disabled (``growth_limit=None``); by default the
+    run stops after the first step (next test)."""
     h = 1e-3
     R = rk4_factor(LAM * h)
     n_overflow = math.ceil(math.log(np.finfo(float).max) / math.log(R))
-    res = solve(lambda t, y: LAM * y, (0.0, 1.0), [1.0], method="rk4", h=h)
+    res = solve(lambda t, y: LAM * y, (0.0, 1.0), [1.0], method="rk4", h=h, growth_limit=None)
     assert res.status == -1 and not res.success
     assert res.message == f"non-finite state in component 0 at t = {n_overflow * h:.6g} s with fixed step h = 0.001 s"
     assert len(res.t) == n_overflow and np.all(np.isfinite(res.y))
     assert np.allclose(res.y[0], R ** np.arange(n_overflow), rtol=1e-12)
     with pytest.raises(NumericalError, match="non-finite state in component 0") as err:
-        solve(lambda t, y: LAM * y, (0.0, 1.0), [1.0], method="rk4", h=h, raise_on_failure=True)
+        solve(lambda t, y: LAM * y, (0.0, 1.0), [1.0], method="rk4", h=h, growth_limit=None,
+              raise_on_failure=True)
     assert err.value.t == pytest.approx((n_overflow - 1) * h) and err.value.component == "rk4"
 
 
-def test_growth_limit_reports_the_unstable_fixed_step_at_once():
-    """With ``growth_limit`` (opt-in) the same run stops after the first step, before any
-    overflow, naming the amplification R(-1e5) = 4.17e18; a stable run is not affected."""
-    res = solve(lambda t, y: LAM * y, (0.0, 0.01), [1.0], method="rk4", h=1e-3, growth_limit=1e8)
-    assert res.status == -1 and list(res.t) == [0.0]
-    assert res.message == ("instability: |x| grew from 1 to 4.17e+18 in one step (h beyond the method's "
-                           "stability region? reduce h) at t = 0.001 s with fixed step h = 0.001 s")
-    ok = solve(lambda t, y: -100.0 * y, (0.0, 0.01), [1.0], method="rk4", h=1e-3, growth_limit=1e8)
+INSTABILITY = ("instability (rk4): |x| grew by a factor 4.17e+18 in one step, from 1 to 4.17e+18 "
+               "(more than growth_limit = 1e+08 times the largest |x| so far) at t = 0.001 s with "
+               "fixed step h = 0.001 s: h is beyond the method's stability region; reduce h or use an "
+               "implicit or stabilized method (growth_limit=None disables this check)")
+
+
+def test_fixed_step_instability_is_reported_by_default():
+    """Issue 7: 'detected and reported, not silently diverging'. RK4 at h = 1e-3 s on
+    y' = -1e8 y to t = 0.01 s (ten steps, 4e185 at the end, below overflow) used to return
+    status 0; the default growth guard (growth_limit = 1e8) stops it after the first step,
+    naming the method, t, h and the amplification R(-1e5) = 4.17e18, with the hint."""
+    R = rk4_factor(LAM * 1e-3)
+    assert R == pytest.approx(4.16650e18, rel=1e-5)
+    res = solve(lambda t, y: LAM * y, (0.0, 0.01), [1.0], method="rk4", h=1e-3)
+    assert res.status == -1 and not res.success and list(res.t) == [0.0]
+    assert res.message == INSTABILITY
+    factor = float(res.message.split("by a factor ")[1].split()[0])
+    assert factor == pytest.approx(R, rel=1e-3)
+    with pytest.raises(NumericalError, match=r"instability \(rk4\)") as err:
+        solve(lambda t, y: LAM * y, (0.0, 0.01), [1.0], method="rk4", h=1e-3, raise_on_failure=True)
+    assert err.value.t == 0.0 and err.value.component == "rk4"
+    # without the guard the ten steps reach R^10 = 1.6e186 and report success
+    off = solve(lambda t, y: LAM * y, (0.0, 0.01), [1.0], method="rk4", h=1e-3, growth_limit=None)
+    assert off.status == 0 and off.y[0, -1] == pytest.approx(R ** 10, rel=1e-12)
+
+
+def test_growth_guard_keeps_stable_and_growing_runs():
+    """The guard compares one step with the largest state so far, not with the start: a stable
+    stiff-ish step (h lambda = -0.1) and a legitimately growing solution (y' = 20 y, e^20 = 4.9e8
+    over the run, growth 1.22 per step) run to the end with the RK4 closed form R(z)^n; a start
+    from rest (y = 0) driven by a large force is not an instability either."""
+    ok = solve(lambda t, y: -100.0 * y, (0.0, 0.01), [1.0], method="rk4", h=1e-3)
     assert ok.status == 0
     assert ok.y[0, -1] == pytest.approx(rk4_factor(-0.1) ** 10, rel=1e-12)
+    grow = solve(lambda t, y: 20.0 * y, (0.0, 1.0), [1.0], method="rk4", h=1e-2)
+    assert grow.status == 0 and grow.y[0, -1] > 1e8
+    assert grow.y[0, -1] == pytest.approx(rk4_factor(0.2) ** 100, rel=1e-12)
+    # from rest, x'' = 1e6 (constant force): exact for RK4, u = 5e5 t^2, v = 1e6 t
+    rest = solve(lambda t, y: np.array([y[1], 1e6]), (0.0, 0.01), [0.0, 0.0], method="rk4", h=1e-3)
+    assert rest.status == 0
+    assert rest.y[:, -1] == pytest.approx([5e5 * 0.01 ** 2, 1e6 * 0.01], rel=1e-12)
+
+
+def test_growth_limit_reports_the_unstable_fixed_step_at_once():
+    """An explicit ``growth_limit`` works like the default; a limit so large that no finite
+    step exceeds it leaves the overflow check; invalid limits are input errors."""
+    res = solve(lambda t, y: LAM * y, (0.0, 0.01), [1.0], method="rk4", h=1e-3, growth_limit=1e8)
+    assert res.status == -1 and list(res.t) == [0.0]
+    assert res.message == INSTABILITY
+    # every step grows by R = 4.17e18 against the largest state so far (the previous one), and
+    # the reference also holds |h F0| = 1e5 |y|: a limit of 1e19 never trips, the run ends at R^10
+    res = solve(lambda t, y: LAM * y, (0.0, 0.01), [1.0], method="rk4", h=1e-3, growth_limit=1e19)
+    assert res.status == 0 and res.y[0, -1] == pytest.approx(rk4_factor(LAM * 1e-3) ** 10, rel=1e-12)
     with pytest.raises(InputError, match="`growth_limit` must be a number > 1"):
         solve(lambda t, y: -y, (0.0, 1.0), [1.0], method="rk4", h=0.1, growth_limit=0.5)
 

@@ -68,9 +68,14 @@ def test_fixed_steps_hit_the_end_exactly():
 
 
 def test_growth_limit_reports_instability_before_overflow():
-    """RK4 at h = 1e-3 on y' = -1e8 y: |R| = 4.2e18 per step. With ``growth_limit`` the first
-    step is reported as an instability; without it the run stops at the first non-finite state."""
-    res = solve(lambda t, y: -1e8 * y, (0.0, 0.01), [1.0], method="rk4", h=1e-3, growth_limit=1e8)
-    assert res.status == -1 and "instability" in res.message and len(res.t) == 1
-    res = solve(lambda t, y: -1e8 * y, (0.0, 0.01), [1.0], method="rk4", h=1e-3)
-    assert res.status == 0 and np.all(np.isfinite(res.y))     # 10 steps stay below overflow
+    """RK4 at h = 1e-3 on y' = -1e8 y: |R| = 4.2e18 per step. The default ``growth_limit`` (1e8)
+    reports the first step as an instability; with ``growth_limit=None`` the 10 steps stay below
+    overflow and the run ends normally at R^10 (no guard left)."""
+    z = -1e8 * 1e-3
+    R = 1 + z + z * z / 2 + z ** 3 / 6 + z ** 4 / 24
+    for kw in ({}, {"growth_limit": 1e8}):
+        res = solve(lambda t, y: -1e8 * y, (0.0, 0.01), [1.0], method="rk4", h=1e-3, **kw)
+        assert res.status == -1 and res.message.startswith("instability (rk4)") and len(res.t) == 1
+    res = solve(lambda t, y: -1e8 * y, (0.0, 0.01), [1.0], method="rk4", h=1e-3, growth_limit=None)
+    assert res.status == 0 and np.all(np.isfinite(res.y))
+    assert res.y[0, -1] == pytest.approx(R ** 10, rel=1e-12)

@@ -2,6 +2,7 @@
 import numpy as np
 import pytest
 
+from cvtfem.errors import InputError
 from cvtfem.integrate import solve
 from cvtfem.problems import bouncing_ball
 
@@ -73,3 +74,10 @@ def test_scipy_method_with_events_matches():
     res = solve(p.fun, p.t_span, p.y0, method="RK45", rtol=1e-10, atol=1e-12,
                 events=(ind, direction, np.array([True])))
     assert res.status == 1 and abs(res.t_events[0][0] - p.info["impacts"](1)[0]) < 1e-8
+
+
+@pytest.mark.parametrize("bad", [-1, 2.5, True, "4"])
+def test_event_samples_must_be_a_non_negative_integer(bad):
+    with pytest.raises(InputError, match="`event_samples` must be an integer >= 0"):
+        solve(lambda t, y: -y, (0.0, 1.0), [1.0], method="rk4", h=0.1, events=lambda t, y: y[0] - 0.5,
+              event_samples=bad)
