@@ -324,7 +324,9 @@ def _solve_periodic(net, omega, N, samples, tol, max_iter, a0, method, raise_on_
         a, ok, history, used = newton(net, omega, p, solve_linear(net, omega, N, topo=topo).a, M, topo, D, tol,
                                       max_iter, method)
         iterations += len(history) - 1
+    lam = 1.0
     if not ok:
+        a_full, history_full = a, history  # full-load iterate: what a failure returns
         lam = _gap_fraction(net, omega, N, topo)
         a = solve_linear(net.linearized("gap"), omega, N, topo=topo).a * lam
         step = 1.0 - lam
@@ -339,11 +341,14 @@ def _solve_periodic(net, omega, N, samples, tol, max_iter, a0, method, raise_on_
             else:
                 step /= 2
         ok = lam >= 1.0 and ok
+        if not ok:
+            a, history = a_full, history_full
     if ok:
         return PeriodicSolution(net, omega, a, True, iterations, tuple(history), used, "converged", M)
     stagnated = len(history) > 3 and history[-1] > 0.5 * history[-4]
-    msg = (f"Newton-Kantorovich did not converge at omega = {omega:.6g} rad/s ({iterations} iterations, "
-           f"load continuation included): relative residual {history[-1]:.3e} > tol {tol:.1e}"
+    msg = (f"Newton-Kantorovich did not converge at omega = {omega:.6g} rad/s ({iterations} iterations; "
+           f"load continuation reached load factor {lam:.3g} of 1): relative residual {history[-1]:.3e} > "
+           f"tol {tol:.1e} at full load"
            + ("; stagnating: the response may not be periodic with this period, or N is too small"
               if stagnated else ""))
     if raise_on_failure:
