@@ -19,17 +19,35 @@ from cvtfem.errors import InputError, NumericalError
 
 SCIPY_STEPPERS = ("RK23", "RK45", "DOP853", "Radau", "BDF", "LSODA")
 EFFICIENCY_WINDOW = 0.05  # s, moving average of the efficiency (section 6.1)
+#: Stall guard: a run fails when STALL_STEPS consecutive accepted steps each advance time by less than
+#: STALL_FRACTION * t_end (1e-10 s for a 0.1 s run; the band models' fastest time scales are ~1e-5 s).
+STALL_STEPS = 50
+STALL_FRACTION = 1e-9
 
 
 def make_stepper(method: str, fun, t0: float, y0, t_end: float, rtol: float, atol: float, h: float = 0.0,
-                 jac=None):
+                 jac=None, n2: int = 0):
     """A step-by-step ODE solver with ``step()``, ``t``, ``y``, ``dense_output()`` and counters.
 
-    The single place that picks the integrator: scipy's ``OdeSolver`` classes for now.
+    The single place that picks the integrator: the ``cvtfem.integrate`` methods through
+    :class:`~cvtfem.integrate.CvtfemSolver` (``h > 0``: fixed step, else adaptive with rtol/atol),
+    otherwise scipy's ``OdeSolver`` classes (``h > 0``: first step).  ``n2``: second-order pairs
+    ``x = [u, v, ...]`` with ``fun[:n2] = v`` (cvtfem implicit methods then solve for ``v`` only).
     """
+    from cvtfem.integrate import METHODS, CvtfemSolver
+
+    if method in METHODS:
+        try:
+            return CvtfemSolver(fun, t0, np.asarray(y0, float), t_end, cvtfem_method=method, h=h or None, rtol=rtol,
+                                atol=atol, n2=n2, jac=jac)
+        except InputError as err:  # name the scene key, not the adapter's argument
+            if err.where != "h":
+                raise
+            raise InputError("solver.h", h, f"must be a positive fixed step for {method!r} (it has no error "
+                             "estimate, so no adaptive steps)") from None
     if method not in SCIPY_STEPPERS:
-        raise InputError("solver.method", method, "must be one of " + ", ".join(SCIPY_STEPPERS) + " for `cvtfem run`",
-                         "the cvtfem.integrate methods are not wired into the run driver yet")
+        raise InputError("solver.method", method, "must be one of " + ", ".join(SCIPY_STEPPERS + tuple(sorted(METHODS)))
+                         + " for `cvtfem run`", _unavailable_hint(method))
     import scipy.integrate as si
 
     options: dict[str, Any] = {"rtol": rtol, "atol": atol}
@@ -38,6 +56,19 @@ def make_stepper(method: str, fun, t0: float, y0, t_end: float, rtol: float, ato
     if jac is not None and method in ("Radau", "BDF", "LSODA"):
         options["jac"] = jac
     return getattr(si, method)(fun, t0, np.asarray(y0, float), t_end, **options)
+
+
+def _unavailable_hint(method: str) -> str:
+    """Why ``cvtfem.integrate`` refuses a method it names (e.g. DUMKA3), else empty."""
+    from cvtfem.integrate import solve
+
+    try:
+        solve(lambda t, y: -y, (0.0, 1.0), [1.0], method=method, h=0.1)
+    except InputError as err:
+        return err.rule + (f"; {err.hint}" if err.hint else "")
+    except Exception:  # noqa: BLE001 - only a hint
+        return ""
+    return ""
 
 
 @dataclass
@@ -54,13 +85,14 @@ class RunSummary:
     input_speed_rpm: float
     output_speed_rpm: float
     target_output_speed_rpm: float
-    efficiency: float
-    efficiency_kinetic: float
+    efficiency: float | None  # None: undefined (no input work over the window), see efficiency_note
+    efficiency_kinetic: float | None
     slip_speed_m_s: list[float]
     clamping_force_N: list[float]
     status: str
     solver: dict[str, Any] = field(default_factory=dict)
     results: str = ""
+    efficiency_note: str = ""  # why efficiency is None, else empty
 
     def to_dict(self) -> dict[str, Any]:
         return asdict(self)
@@ -117,7 +149,7 @@ def run_scene(scene, until: float | None = None, results: str | Path | None = No
     missing = names - set(sample_outputs(loop, 0.0, x0))
     specs = [s for s in specs if s.name not in missing]
     sol = scene.solver
-    stepper = make_stepper(sol.method, loop.rhs, 0.0, x0, t_end, sol.rtol, sol.atol, sol.h, loop.jac)
+    stepper = make_stepper(sol.method, loop.rhs, 0.0, x0, t_end, sol.rtol, sol.atol, sol.h, loop.jac, loop.model.n2)
     dt = scene.output.step
     t_out = np.arange(0.0, t_end + 0.5 * dt, dt)
     t_out = t_out[t_out <= t_end * (1 + 1e-12)]
@@ -129,7 +161,8 @@ def run_scene(scene, until: float | None = None, results: str | Path | None = No
     wall0 = time.perf_counter()
     bar = progress(t_end, "s", f"run {scene.cvt.model}") if show_progress else None
     history: list[tuple[float, np.ndarray]] = []
-    k, steps, status, message = 0, 0, "finished", ""
+    k, steps, status, message, tiny = 0, 0, "finished", "", 0
+    h_stall = STALL_FRACTION * t_end
     try:
         while k < len(t_out) and t_out[k] <= stepper.t:  # t = 0
             _emit(writer, loop, t_out[k], stepper.y, history)
@@ -143,6 +176,10 @@ def run_scene(scene, until: float | None = None, results: str | Path | None = No
                                      component=f"band model {scene.cvt.model}")
             if steps > sol.max_steps:
                 raise NumericalError(f"step budget `solver.max_steps` = {sol.max_steps} exhausted", t=stepper.t)
+            tiny = tiny + 1 if stepper.t - t_prev < h_stall else 0
+            if tiny >= STALL_STEPS:
+                raise NumericalError(_stall_message(loop, sol.method, stepper.t, stepper.y, stepper.t - t_prev, h_stall),
+                                     t=stepper.t, component=f"band model {scene.cvt.model}")
             if k < len(t_out) and t_out[k] <= stepper.t:
                 dense = stepper.dense_output()
                 while k < len(t_out) and t_out[k] <= stepper.t:
@@ -171,6 +208,18 @@ def run_scene(scene, until: float | None = None, results: str | Path | None = No
     return summary
 
 
+def _stall_message(loop, method: str, t: float, x, h: float, h_stall: float) -> str:
+    """Why the step size collapsed, with the clamping forces and slips that usually explain it."""
+    _, info = loop.evaluate(t, x)
+    F, slip = np.asarray(info["F"]), np.asarray(info["slip"])
+    return (f"step size stalled: {STALL_STEPS} consecutive {method} steps each advanced time by less than "
+            f"{h_stall:.3g} s (STALL_FRACTION = {STALL_FRACTION:g} x t_end), last h = {h:.3g} s at t = {t:.6g} s; "
+            f"clamping forces {F[0]:.3g} / {F[1]:.3g} N, slip speeds {slip[0]:.3g} / {slip[1]:.3g} m/s. "
+            "Likely cause: a non-smooth right-hand side the solver cannot step over (anti-windup switching of the "
+            "control loops, gross slip under a vanishing clamping force at near-zero torque); raise the torque "
+            "or the clamping safety factor, or try another `solver.method`")
+
+
 def _emit(writer, loop, t: float, x, history: list) -> None:
     if not np.all(np.isfinite(x)):
         raise NumericalError("state became non-finite", t=t, component="band model")
@@ -192,13 +241,19 @@ def _summarise(scene, loop, history, t_end, wall, stats, status) -> RunSummary:
     W0, W1 = loop.split(X[j])[3], loop.split(x)[3]
     dW = W1 - W0
     dE = loop.energy(x) - loop.energy(X[j])
-    eff = dW[1] / dW[0] if dW[0] > 0 else math.nan
-    eff_kin = 1 - (dW[0] - dW[1] - dE) / dW[0] if dW[0] > 0 else math.nan
+    eff: float | None = None
+    eff_kin: float | None = None
+    note = ""
+    if dW[0] > 0:
+        eff, eff_kin = float(dW[1] / dW[0]), float(1 - (dW[0] - dW[1] - dE) / dW[0])
+    else:  # zero driving torque (or speed): output over input is 0/0
+        note = (f"undefined: input work {dW[0]:.3g} J over the last {t[-1] - t[j]:.3g} s (driving torque "
+                f"{info['M'][0]:.3g} N m); efficiency needs positive input power")
     rpm = 30 / math.pi
     w = info["w"]
     return RunSummary(scene=scene.source, model=scene.cvt.model, n_coordinates=loop.model.n2,
                       simulated_time_s=float(t[-1]), wall_time_s=wall, ratio=float(w[0] / w[1]), target_ratio=i_d,
                       input_speed_rpm=float(w[0] * rpm), output_speed_rpm=float(w[1] * rpm),
-                      target_output_speed_rpm=float(w1d / i_d * rpm), efficiency=float(eff),
-                      efficiency_kinetic=float(eff_kin), slip_speed_m_s=[float(s) for s in info["slip"]],
+                      target_output_speed_rpm=float(w1d / i_d * rpm), efficiency=eff,
+                      efficiency_kinetic=eff_kin, efficiency_note=note, slip_speed_m_s=[float(s) for s in info["slip"]],
                       clamping_force_N=[float(f) for f in info["F"]], status=status, solver=stats)

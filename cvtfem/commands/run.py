@@ -35,8 +35,9 @@ def run(args: argparse.Namespace) -> int:
           f"({s.solver['name']}, {s.solver['steps']} steps, {s.solver['nfev']} RHS calls)")
     print(f"  ratio {s.ratio:.4f} (target {s.target_ratio:g}), input {s.input_speed_rpm:.1f} rpm, "
           f"output {s.output_speed_rpm:.1f} rpm (target {s.target_output_speed_rpm:.1f})")
-    print(f"  efficiency {s.efficiency:.4f} (kinetic-energy corrected {s.efficiency_kinetic:.4f}), "
-          f"clamping {s.clamping_force_N[0] / 1e3:.2f} / {s.clamping_force_N[1] / 1e3:.2f} kN")
+    eff = (f"efficiency {s.efficiency:.4f} (kinetic-energy corrected {s.efficiency_kinetic:.4f})"
+           if s.efficiency is not None else f"efficiency {s.efficiency_note}")
+    print(f"  {eff}, clamping {s.clamping_force_N[0] / 1e3:.2f} / {s.clamping_force_N[1] / 1e3:.2f} kN")
     if s.results:
         print(f"  results: {s.results}")
     if args.summary_json:

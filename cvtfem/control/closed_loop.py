@@ -25,6 +25,11 @@ from cvtfem.elements.band.params import BandParams
 from cvtfem.errors import InputError
 
 SPLITS = ("equilibrium", "per-shaft")
+#: Smallest prescribed clamping force per pulley, N (assumed: a preload, as the spring of a real driven
+#: pulley, ~3 % of the 30-35 kN at 200 N m, i.e. the estimate (1.13) x 1.1 at ~7 N m).  Without it the
+#: forces vanish with the torque and a torque ramp towards 0 N m ends in gross slip under ~0.4 N, where
+#: the implicit solvers' steps collapse to ~1e-13 s.  It changes nothing above ~7 N m.
+MIN_CLAMPING_FORCE = 1000.0
 
 
 @dataclass(frozen=True)
@@ -36,11 +41,13 @@ class Clamping:
     target ratio (section 4.2) and scales the pair until each pulley has at least ``safety`` times
     its estimate: the band models hold a ratio only at that force ratio (friction has no steady
     phi-component), so this starts the ratio loop at its working point.
+    Neither pulley gets less than ``f_min`` (N; the equilibrium split scales the pair, keeping its ratio).
     """
 
     p: BandParams
     safety: float
     split: str = "equilibrium"
+    f_min: float = MIN_CLAMPING_FORCE
     _table: tuple[np.ndarray, np.ndarray] = field(init=False, repr=False)
     _last: dict = field(init=False, repr=False, default_factory=dict)  # memo of the last (M1, ratio)
 
@@ -77,9 +84,9 @@ class Clamping:
     def _forces(self, M1: float, ratio: float) -> np.ndarray:
         est = self.estimates(M1, ratio)
         if self.split == "per-shaft":
-            return self.safety * est
+            return np.maximum(self.safety * est, self.f_min)
         rho = forces_for_angle(self.span_angle(ratio), self.p.sheaves, self.p.length, self.p.L)
-        F2 = self.safety * max(est[1], est[0] / rho)
+        F2 = max(self.safety * max(est[1], est[0] / rho), self.f_min / min(rho, 1.0))
         return np.array([rho * F2, F2])
 
 

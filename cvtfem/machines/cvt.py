@@ -141,8 +141,31 @@ def band_model(scene: Scene, **overrides: Any):
     return model_for(model, band_params(scene, **overrides))
 
 
+def check_ratio_range(scene: Scene, p=None) -> tuple[float, float]:
+    """Admissible ratio range of the scene's sheaves; InputError for a regime ratio outside it.
+
+    Both contact radii must stay within ``cvt.geometry.r_min .. r_max`` at the target ratio (and at
+    the end value of a ratio change), otherwise the band would run below the hub or beyond the rim.
+    """
+    from cvtfem.elements.band.geometry import admissible_ratio_range
+
+    p = p or band_params(scene)
+    g, rg = scene.cvt.geometry, scene.cvt.regime
+    lo, hi = admissible_ratio_range(p.length, p.L, g.r_min, g.r_max)
+    values = [("cvt.regime.ratio", rg.ratio)]
+    if rg.kind == "ratio-change":
+        values.append(("cvt.regime.end_value", rg.end_value))
+    for where, value in values:
+        if not lo <= value <= hi:
+            what = "" if where == "cvt.regime.ratio" else "(the end ratio of the change of `cvt.regime.ratio`) "
+            raise InputError(where, value, f"{what}must lie in {lo:.4f}..{hi:.4f}: the ratios whose contact radii "
+                             f"stay within r_min = {g.r_min:g} m .. r_max = {g.r_max:g} m of the sheaves")
+    return lo, hi
+
+
 def closed_loop(scene: Scene, **overrides: Any):
     """Scene -> :class:`~cvtfem.control.closed_loop.ClosedLoop` (model, clamping schedule, regime, loops)."""
+    from cvtfem.control import closed_loop as cl
     from cvtfem.control.closed_loop import Clamping, ClosedLoop
     from cvtfem.control.regimes import Regime
     from cvtfem.control.stabilisation import Stabilisation, StabilisationParams
@@ -152,8 +175,9 @@ def closed_loop(scene: Scene, **overrides: Any):
     model = band_model(scene, **overrides)
     p = model.p
     rg = cvt.regime
+    check_ratio_range(scene, p)
     regime = Regime(rg.kind, rg.input_speed, rg.torque, rg.ratio, rg.end_value, rg.ramp_time)
-    clamping = Clamping(p, rg.clamping_safety, rg.clamping_split)
+    clamping = Clamping(p, rg.clamping_safety, rg.clamping_split, cl.MIN_CLAMPING_FORCE)
     control = None
     if cvt.effects.stabilisation:
         c = cvt.control

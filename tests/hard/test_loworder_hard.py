@@ -114,3 +114,89 @@ def test_start_up_from_near_standstill(base):
     assert s.input_speed_rpm == pytest.approx(100.0 * RPM, rel=2e-3)
     assert s.ratio == pytest.approx(2.4, rel=2e-3)
     assert s.output_speed_rpm == pytest.approx(s.target_output_speed_rpm, rel=2e-3)
+
+
+# -- formerly pending (tests/hard/pending_loworder.py), fixed ------------------------------------
+
+@pytest.mark.parametrize("ratio", [0.3, 3.0, 5.0])
+def test_ratio_outside_the_sheave_range_is_an_input_error(base, ratio):
+    """The reference geometry (r_min = 0.036 m, r_max = 0.088 m, L = 0.1746 m, band 0.756 m) admits
+    ratios 0.4164..2.4014; ratio 3.0 used to run with contact radii (0.0306, 0.0919) m, below the
+    hub and beyond the rim.  The range's ends put one radius exactly on r_min or r_max."""
+    from cvtfem.elements.band.geometry import admissible_ratio_range
+
+    p = closed_loop(base).clamping.p
+    g = base.cvt.geometry
+    lo, hi = admissible_ratio_range(p.length, p.L, g.r_min, g.r_max)
+    for i, limits in ((lo, (g.r_max, g.r_min)), (hi, (g.r_min, g.r_max))):
+        r = radii(phi_for_ratio(i, p.length, p.L), p.length, p.L)[0]
+        assert r[0] >= g.r_min * (1 - 1e-9) and r[1] >= g.r_min * (1 - 1e-9)
+        assert r.max() <= g.r_max * (1 + 1e-9)
+        assert min(abs(r[0] - limits[0]), abs(r[1] - limits[1])) < 1e-9   # one radius on its limit
+    assert lo < 0.43 and 2.4 < hi
+    with pytest.raises(InputError, match="cvt.regime.ratio") as err:
+        closed_loop(_regime(base, ratio=ratio))
+    assert f"{lo:.4f}..{hi:.4f}" in str(err.value) and f"got {ratio!r}" in str(err.value)
+
+
+def test_ratio_change_ending_outside_the_sheave_range_is_an_input_error(base):
+    with pytest.raises(InputError, match="cvt.regime.end_value") as err:
+        closed_loop(_regime(base, kind="ratio-change", ratio=2.0, end_value=3.0, ramp_time=0.1))
+    assert "cvt.regime.ratio" in str(err.value) and "got 3.0" in str(err.value)
+
+
+def test_zero_torque_summary_has_no_nan(base, cli, tmp_path):
+    """torque = 0 (allowed by the schema, ge=0): output over input work is 0/0.  The summary
+    reports efficiency None (JSON null) with the reason, never NaN; speeds and ratio are held."""
+    s = run_scene(_regime(base, torque=0.0), until=0.05, show_progress=False)
+    assert s.status == "finished"
+    assert s.efficiency is None and s.efficiency_kinetic is None
+    assert "undefined" in s.efficiency_note and "input work 0 J" in s.efficiency_note
+    floats = [v for v in s.to_dict().values() if isinstance(v, float)]
+    floats += s.slip_speed_m_s + s.clamping_force_N
+    assert all(math.isfinite(v) for v in floats)
+    assert s.ratio == pytest.approx(2.4, rel=2e-3)
+    scene, js = tmp_path / "zero.toml", tmp_path / "zero.json"
+    scene.write_text('preset = "band-4dof"\n[cvt.regime]\ntorque = 0.0\n')
+    out = cli("run", str(scene), "--until", "0.02", "--results", "none", "--summary-json", str(js))
+    assert out.returncode == 0, out.stderr
+    assert "NaN" not in js.read_text() and '"efficiency": null' in js.read_text()
+
+
+@pytest.mark.timeout(120)
+def test_torque_ramp_towards_zero_finishes_or_fails_clearly(base):
+    """Torque ramp 200 -> 1e-3 N m over 0.05 s, 0.1 s simulated.  It used to stall: clamping forces
+    (1.13) vanish with the torque (0.37 / 0.18 N), gross slip, the step collapsed to ~1e-13 s and
+    stepped in place.  With the minimum clamping force (preload) MIN_CLAMPING_FORCE = 1 kN it
+    finishes with the targets held and the floor on the pulleys (equilibrium split: F1 = f_min)."""
+    from cvtfem.control.closed_loop import MIN_CLAMPING_FORCE
+
+    scene = _regime(base, kind="torque-ramp", torque=200.0, end_value=1e-3, ramp_time=0.05)
+    s = run_scene(scene, until=0.1, show_progress=False)
+    assert s.status == "finished"
+    assert s.ratio == pytest.approx(2.4, rel=2e-3)
+    assert s.input_speed_rpm == pytest.approx(base.cvt.regime.input_speed * RPM, rel=2e-3)
+    F_appl = closed_loop(scene).clamping.forces(1e-3, 2.4)      # floor: F1 = f_min, F2 = f_min / rho
+    assert F_appl[0] == pytest.approx(MIN_CLAMPING_FORCE, rel=1e-12) and F_appl[1] > MIN_CLAMPING_FORCE
+    assert s.clamping_force_N[1] == pytest.approx(F_appl[1], rel=1e-12)   # F2 is not controlled
+    assert max(abs(v) for v in s.slip_speed_m_s) < base.cvt.friction.v0
+
+
+@pytest.mark.timeout(120)
+def test_stalled_step_size_is_a_clear_numerical_error(base, monkeypatch):
+    """The same ramp without the clamping floor reproduces the collapse; the run driver's stall guard
+    (STALL_STEPS consecutive steps each < STALL_FRACTION t_end) stops it with a NumericalError that
+    names the method, t, h and the likely cause instead of stepping in place until max_steps."""
+    import cvtfem.control.closed_loop as cl
+    from cvtfem.analysis import run as run_mod
+    from cvtfem.errors import NumericalError
+
+    monkeypatch.setattr(cl, "MIN_CLAMPING_FORCE", 0.0)
+    scene = _regime(base, kind="torque-ramp", torque=200.0, end_value=1e-3, ramp_time=0.05)
+    with pytest.raises(NumericalError) as err:
+        run_scene(scene, until=0.1, show_progress=False)
+    text = str(err.value)
+    assert "step size stalled" in text and scene.solver.method in text
+    assert f"{run_mod.STALL_STEPS} consecutive" in text and "last h = " in text and "at t = " in text
+    assert "clamping forces" in text and "Likely cause" in text
+    assert 0.05 < err.value.t < 0.1

@@ -139,6 +139,27 @@ def admissible_phi(length: float, L: float, r_min: float = 1e-4) -> tuple[float,
     return brentq(f1, -lim, 0.0), brentq(f2, 0.0, lim)
 
 
+def admissible_ratio_range(length: float, L: float, r_min: float, r_max: float) -> tuple[float, float]:
+    """Smallest and largest ratio ``r2 / r1`` with both contact radii in ``[r_min, r_max]`` (m).
+
+    ``r1`` grows and ``r2`` falls with the span angle phi (eq. (1.36)), so the largest ratio is at
+    the smallest phi with ``r1 >= r_min`` and ``r2 <= r_max``, the smallest at the largest phi with
+    ``r2 >= r_min`` and ``r1 <= r_max``.
+    """
+    lo, hi = admissible_phi(length, L)
+    r = lambda p, k: float(radii(p, length, L)[0][k])  # noqa: E731
+
+    def root(k: int, value: float, default: float) -> float:
+        f = lambda p: r(p, k) - value  # noqa: E731
+        return brentq(f, lo, hi, xtol=1e-14) if f(lo) * f(hi) < 0 else default
+
+    phi_lo = max(root(0, r_min, lo), root(1, r_max, lo))
+    phi_hi = min(root(1, r_min, hi), root(0, r_max, hi))
+    if phi_lo >= phi_hi:
+        raise InputError("cvt.geometry", (r_min, r_max), "admits no span angle for this band length and centre distance")
+    return r(phi_hi, 1) / r(phi_hi, 0), r(phi_lo, 1) / r(phi_lo, 0)
+
+
 def path_point(s_tilde, phi, length: float, L: float):
     """Position on the band path of the path coordinate ``s_tilde`` (m), spec section 4.3 path map.
 

@@ -1,0 +1,1 @@
+"""Analyses of a scene over time: the run driver (`run.py`, `cvtfem run`)."""
