@@ -108,8 +108,10 @@ _COLORS = {"shaft": "lightsteelblue", "disk": "goldenrod", "bearing": "dimgray"}
 
 def _plotter(size: tuple[int, int]):  # noqa: ANN202
     import pyvista as pv
+    from vtkmodules.vtkCommonCore import vtkLogger
 
     pv.OFF_SCREEN = True
+    vtkLogger.SetStderrVerbosity(vtkLogger.VERBOSITY_ERROR)  # no "bad X server" warning without a display
     p = pv.Plotter(off_screen=True, window_size=size)
     p.set_background("white")
     return p
