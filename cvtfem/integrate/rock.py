@@ -24,7 +24,7 @@ from scipy.optimize import fsolve
 from cvtfem.errors import InputError
 from cvtfem.integrate import rock_data as D
 from cvtfem.integrate.base import Attempt, Stepper
-from cvtfem.integrate.stabilized import spectral_radius
+from cvtfem.integrate.stabilized import SpectralRadiusTracker
 
 __all__ = ["ROCK2", "ROCK4", "recurrence", "stability_length", "finishing_polynomial"]
 
@@ -141,7 +141,7 @@ def stability_length(family: int, k: int) -> float:
     return float(lo)
 
 
-class _Rock(Stepper):
+class _Rock(SpectralRadiusTracker, Stepper):
     """Shared parts: degree choice (fixed ``stages`` or from the spectral radius), recurrence."""
 
     family = 2
@@ -158,31 +158,18 @@ class _Rock(Stepper):
             self.fixed = int(np.searchsorted(ms, stages))
         if spectral_radius is not None and not (callable(spectral_radius) or spectral_radius > 0):
             raise InputError("spectral_radius", spectral_radius, "must be a positive number, a callable or None")
-        self.rho_user, self.rho_every = spectral_radius, int(rho_every)
-        self._rho, self._rho_age = None, 0
+        self._init_rho(spectral_radius, rho_every)
         self.stages = int(ms[self.fixed if self.fixed is not None else 0])
 
     def _degree(self, t, x, f0, h) -> int:
         if self.fixed is not None:
             return self.fixed
-        if callable(self.rho_user):
-            rho = float(self.rho_user(t, x))
-        elif self.rho_user is not None:
-            rho = float(self.rho_user)
-        else:
-            if self._rho is None or self._rho_age >= self.rho_every:
-                self._rho = 1.2 * spectral_radius(self.f, t, x, f0)
-                self._rho_age = 0
-            rho = self._rho
+        rho = self._current_rho(t, x, f0)
         n = len(_degrees(self.family))
         for k in range(n):   # lengths are computed lazily (cached), smallest sufficient degree
             if stability_length(self.family, k) >= h * rho:
                 return k
         return max(range(n), key=lambda k: stability_length(self.family, k))
-
-    def accept(self, att):
-        super().accept(att)
-        self._rho_age += 1
 
     def _chebyshev_stages(self, t, x, h, f0, k):
         """The ``m`` recurrence stages; returns ``(g_m, t_m, g_{m-1}, t_{m-1})``."""

@@ -89,7 +89,33 @@ def spectral_radius(f, t, x, f0, v0=None, max_iter: int = 50, rtol: float = 0.01
     return rho
 
 
-class RKC(Stepper):
+class SpectralRadiusTracker:
+    """Spectral-radius bookkeeping shared by the stabilized explicit methods.
+
+    ``rho_user`` is a number, a callable ``rho(t, x)`` or None (power iteration,
+    refreshed every ``rho_every`` accepted steps, times :data:`RHO_SAFETY`).
+    """
+
+    def _init_rho(self, spectral_radius_option, rho_every) -> None:
+        self.rho_user, self.rho_every = spectral_radius_option, int(rho_every)
+        self._rho, self._rho_age = None, 0
+
+    def _current_rho(self, t, x, f0) -> float:
+        if callable(self.rho_user):
+            return float(self.rho_user(t, x))
+        if self.rho_user is not None:
+            return float(self.rho_user)
+        if self._rho is None or self._rho_age >= self.rho_every:
+            self._rho = RHO_SAFETY * spectral_radius(self.f, t, x, f0)
+            self._rho_age = 0
+        return self._rho
+
+    def accept(self, att):
+        super().accept(att)
+        self._rho_age += 1
+
+
+class RKC(SpectralRadiusTracker, Stepper):
     """Runge-Kutta-Chebyshev, order 2; ``stages`` fixed, or None for automatic selection."""
 
     name, order, error_order = "rkc", 2, 2
@@ -104,30 +130,17 @@ class RKC(Stepper):
             raise InputError("spectral_radius", spectral_radius, "must be a positive number, a callable or None")
         self.fixed_stages = stages
         self.stages = stages or 2
-        self.rho_user, self.rho_every = spectral_radius, int(rho_every)
-        self._rho, self._rho_age = None, 0
+        self._init_rho(spectral_radius, rho_every)
         self._coef: dict[int, tuple] = {}
 
     def _stage_count(self, t, x, f0, h) -> int:
         if self.fixed_stages:
             return self.fixed_stages
-        if callable(self.rho_user):
-            rho = float(self.rho_user(t, x))
-        elif self.rho_user is not None:
-            rho = float(self.rho_user)
-        else:
-            if self._rho is None or self._rho_age >= self.rho_every:
-                self._rho = RHO_SAFETY * spectral_radius(self.f, t, x, f0)
-                self._rho_age = 0
-            rho = self._rho
+        rho = self._current_rho(t, x, f0)
         s = max(2, int(np.sqrt(h * rho / 0.653)))
         while rkc_stability_length(s) < h * rho and s < MAX_STAGES:
             s += 1
         return s
-
-    def accept(self, att):
-        super().accept(att)
-        self._rho_age += 1
 
     def attempt(self, t, x, h):
         f0 = self.f0(t, x)
