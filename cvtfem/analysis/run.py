@@ -10,6 +10,7 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import asdict, dataclass, field
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -26,20 +27,22 @@ STALL_FRACTION = 1e-9
 
 
 def make_stepper(method: str, fun, t0: float, y0, t_end: float, rtol: float, atol: float, h: float = 0.0,
-                 jac=None, n2: int = 0):
+                 jac=None, n2: int = 0, first_step: float = 0.0):
     """A step-by-step ODE solver with ``step()``, ``t``, ``y``, ``dense_output()`` and counters.
 
     The single place that picks the integrator: the ``cvtfem.integrate`` methods through
     :class:`~cvtfem.integrate.CvtfemSolver` (``h > 0``: fixed step, else adaptive with rtol/atol),
     otherwise scipy's ``OdeSolver`` classes (``h > 0``: first step).  ``n2``: second-order pairs
     ``x = [u, v, ...]`` with ``fun[:n2] = v`` (cvtfem implicit methods then solve for ``v`` only).
+    ``first_step > 0`` (a resumed run: the step size saved at the checkpoint) overrides ``h`` as the first
+    step of adaptive methods.
     """
     from cvtfem.integrate import METHODS, CvtfemSolver
 
     if method in METHODS:
         try:
             return CvtfemSolver(fun, t0, np.asarray(y0, float), t_end, cvtfem_method=method, h=h or None, rtol=rtol,
-                                atol=atol, n2=n2, jac=jac)
+                                atol=atol, n2=n2, jac=jac, first_step=(first_step or None) if not h else None)
         except InputError as err:  # name the scene key, not the adapter's argument
             if err.where != "h":
                 raise
@@ -51,7 +54,9 @@ def make_stepper(method: str, fun, t0: float, y0, t_end: float, rtol: float, ato
     import scipy.integrate as si
 
     options: dict[str, Any] = {"rtol": rtol, "atol": atol}
-    if h > 0:
+    if first_step > 0:
+        options["first_step"] = min(first_step, t_end - t0)
+    elif h > 0:
         options["first_step"] = h
     if jac is not None and method in ("Radau", "BDF", "LSODA"):
         options["jac"] = jac
@@ -118,7 +123,8 @@ def sample_outputs(loop, t: float, x) -> dict[str, Any]:
 
 
 def run_scene(scene, until: float | None = None, results: str | Path | None = None, show_progress: bool = True,
-              overwrite: bool = False, start: dict[str, float] | None = None) -> RunSummary:
+              overwrite: bool = False, start: dict[str, float] | None = None,
+              on_checkpoint: Callable[[float, int], None] | None = None) -> RunSummary:
     """Integrate a band-model CVT scene and summarise it.
 
     Parameters
@@ -128,84 +134,205 @@ def run_scene(scene, until: float | None = None, results: str | Path | None = No
     until : float, optional, s
         Simulated end time (default ``solver.t_end``).
     results : path, optional
-        HDF5 results file written incrementally (``None``: no file).
+        HDF5 results file written incrementally (``None``: no file).  With
+        ``output.checkpoint_interval > 0`` it also receives the checkpoints (:func:`resume_run`).
     start : dict, optional
         ``ratio`` and/or ``speed_factor`` to start away from the targets
         (:meth:`~cvtfem.control.closed_loop.ClosedLoop.initial_state`).
+    on_checkpoint : callable, optional
+        ``on_checkpoint(t, seq)`` after each checkpoint is on disk.
     """
-    from cvtfem.io.progress import progress
-    from cvtfem.machines import layout
-    from cvtfem.machines.cvt import closed_loop
-
     if scene.kind != "cvt":
         raise InputError("SCENE", scene.source, f"must describe a CVT for `cvtfem run`, not a `{scene.kind}` machine")
     t_end = scene.solver.t_end if until is None else until
     if not t_end > 0:
         raise InputError("--until", t_end, "must be positive (simulated seconds)")
-    loop = closed_loop(scene)
-    specs = [o for part in layout(scene) for o in part.outputs]
-    x0 = loop.initial_state(**(start or {}))
-    names = {s.name for s in specs}
-    missing = names - set(sample_outputs(loop, 0.0, x0))
-    specs = [s for s in specs if s.name not in missing]
-    sol = scene.solver
-    stepper = make_stepper(sol.method, loop.rhs, 0.0, x0, t_end, sol.rtol, sol.atol, sol.h, loop.jac, loop.model.n2)
-    dt = scene.output.step
-    t_out = np.arange(0.0, t_end + 0.5 * dt, dt)
-    t_out = t_out[t_out <= t_end * (1 + 1e-12)]
+    run = _Run(scene, t_end)
+    x0 = run.loop.initial_state(**(start or {}))
+    run.specs = [s for s in run.specs if s.name in sample_outputs(run.loop, 0.0, x0)]
     writer = None
     if results is not None:
         from cvtfem.io.results import ResultsWriter
 
-        writer = ResultsWriter(results, scene.to_toml(), "run", specs, scene.output.flush_interval, overwrite)
-    wall0 = time.perf_counter()
-    bar = progress(t_end, "s", f"run {scene.cvt.model}") if show_progress else None
-    history: list[tuple[float, np.ndarray]] = []
-    k, steps, status, message, tiny = 0, 0, "finished", "", 0
-    h_stall = STALL_FRACTION * t_end
+        writer = ResultsWriter(results, scene.to_toml(), "run", run.specs, scene.output.flush_interval, overwrite,
+                               checkpoint=run.layout() if run.interval > 0 else None)
+    return run.drive(writer, 0.0, x0, None, show_progress, on_checkpoint)
+
+
+def resume_run(results: str | Path, show_progress: bool = True,
+               on_checkpoint: Callable[[float, int], None] | None = None) -> RunSummary:
+    """Continue a killed run from the newest checkpoint of its results file, appending to that file.
+
+    The scene (TOML stored in the file), end time and solver come from the file; rows after the
+    checkpoint are dropped and recomputed.  Fixed-step methods without step-to-step memory
+    (``euler``, ``rk4``, the explicit Runge-Kutta methods) and adaptive explicit Runge-Kutta
+    methods (whose step size is restored) give bitwise the series of an uninterrupted run;
+    methods that carry Jacobians or step history (implicit, W-, multistep) restart that memory,
+    so their results agree within the solver tolerance.  A finished run or a file without
+    checkpoint is refused with :class:`InputError`.
+    """
+    from cvtfem.io.results import ResultsWriter
+    from cvtfem.scene.loader import _parse, scene_from_dict
+
+    writer, seq, values = ResultsWriter.resume(results)
     try:
-        while k < len(t_out) and t_out[k] <= stepper.t:  # t = 0
-            _emit(writer, loop, t_out[k], stepper.y, history)
-            k += 1
-        while stepper.status == "running":
-            t_prev = stepper.t
-            msg = stepper.step()
-            steps += 1
-            if stepper.status == "failed" or not np.all(np.isfinite(stepper.y)):
-                raise NumericalError(f"{sol.method} failed: {msg or 'state became non-finite'}", t=stepper.t,
-                                     component=f"band model {scene.cvt.model}")
-            if steps > sol.max_steps:
-                raise NumericalError(f"step budget `solver.max_steps` = {sol.max_steps} exhausted", t=stepper.t)
-            tiny = tiny + 1 if stepper.t - t_prev < h_stall else 0
-            if tiny >= STALL_STEPS:
-                raise NumericalError(_stall_message(loop, sol.method, stepper.t, stepper.y, stepper.t - t_prev, h_stall),
-                                     t=stepper.t, component=f"band model {scene.cvt.model}")
-            if k < len(t_out) and t_out[k] <= stepper.t:
-                dense = stepper.dense_output()
-                while k < len(t_out) and t_out[k] <= stepper.t:
-                    _emit(writer, loop, t_out[k], dense(t_out[k]), history)
-                    k += 1
-            if bar is not None:
-                bar.update(stepper.t - t_prev)
+        scene = scene_from_dict(_parse(writer.scene_toml, str(results)), source=f"{results} (resumed)")
+        run = _Run(scene, float(values["t_end"][0]))
+        layout = run.layout()
+        if dict(writer.checkpoint_layout) != {**dict(layout.fields), "rows": 1}:
+            raise InputError("--resume", str(results), "must hold a checkpoint of this cvtfem version's run driver "
+                             f"(state layout {writer.checkpoint_layout} differs)")
+        run.specs = writer.specs
+        writer.flush_interval = scene.output.flush_interval
     except BaseException as err:
-        status, message = "failed", str(err)
-        if writer is not None:
-            writer.close("failed", message)
+        writer.close("failed", f"resume: {err}")
         raise
-    finally:
-        if bar is not None:
-            bar.close()
-    wall = time.perf_counter() - wall0
-    stats = {"name": sol.method, "steps": steps, "nfev": int(stepper.nfev), "njev": int(getattr(stepper, "njev", 0)),
-             "nlu": int(getattr(stepper, "nlu", 0)), "rtol": sol.rtol, "atol": sol.atol}
-    summary = _summarise(scene, loop, history, t_end, wall, stats, status)
-    if writer is not None:
-        writer.set_stats({**{f"solver_{k}": v for k, v in stats.items()}, "wall_time_s": wall})
-        writer.add_array("band.node_xi", loop.model.arc_nodes(0.0)[0] / (math.pi / 2), "-",
-                         "Quadrature nodes xi = theta / theta* of band.normal_force (same on both arcs).")
-        writer.close(status, message)
-        summary.results = str(results)
-    return summary
+    return run.drive(writer, float(values["t"][0]), values["x"], (seq, values), show_progress, on_checkpoint)
+
+
+class _Run:
+    """One run of a scene: loop, output grid, checkpoint payload and the stepping loop."""
+
+    def __init__(self, scene, t_end: float) -> None:
+        from cvtfem.machines import layout
+        from cvtfem.machines.cvt import closed_loop
+
+        self.scene, self.t_end = scene, t_end
+        self.loop = closed_loop(scene)
+        self.specs = [o for part in layout(scene) for o in part.outputs]
+        dt = scene.output.step
+        t_out = np.arange(0.0, t_end + 0.5 * dt, dt)
+        self.t_out = t_out[t_out <= t_end * (1 + 1e-12)]
+        # the samples a finished run emits (the stepper lands on t_end) and the start of the efficiency window
+        final = self.t_out[self.t_out <= t_end]
+        j = int(np.searchsorted(final, final[-1] - EFFICIENCY_WINDOW))
+        self.j_window = 0 if j >= len(final) - 1 else j  # run shorter than one output step past the window
+        self.interval = float(scene.output.checkpoint_interval)
+
+    def layout(self):
+        from cvtfem.integrate.stats import COUNTERS
+        from cvtfem.io.checkpoint import Layout
+
+        n = self.loop.size
+        return Layout((("t", 1), ("t_end", 1), ("x", n), ("h", 1), ("k", 1), ("steps", 1), ("tiny", 1),
+                       ("next_checkpoint", 1), ("counts", len(COUNTERS)), ("t_last", 1), ("x_last", n),
+                       ("x_window", n), ("wall", 1)))
+
+    def drive(self, writer, t0: float, x0, resumed, show_progress: bool, on_checkpoint) -> RunSummary:
+        from cvtfem.integrate import CvtfemSolver
+        from cvtfem.integrate.stats import COUNTERS
+        from cvtfem.io.progress import progress
+
+        scene, loop, sol, t_end, t_out = self.scene, self.loop, self.scene.solver, self.t_end, self.t_out
+        n = loop.size
+        k, steps, tiny, seq, wall_before = 0, 0, 0, 0, 0.0
+        last, x_window = (math.nan, np.full(n, math.nan)), np.full(n, math.nan)
+        next_ck = self.interval
+        first_step = 0.0
+        if resumed is not None:
+            seq, v = resumed
+            k, steps, tiny = int(v["k"][0]), int(v["steps"][0]), int(v["tiny"][0])
+            next_ck, wall_before, first_step = float(v["next_checkpoint"][0]), float(v["wall"][0]), float(v["h"][0])
+            last, x_window = (float(v["t_last"][0]), v["x_last"]), v["x_window"]
+        try:
+            stepper = make_stepper(sol.method, loop.rhs, t0, x0, t_end, sol.rtol, sol.atol, sol.h, loop.jac,
+                                   loop.model.n2, first_step=first_step)
+        except BaseException as err:
+            if writer is not None:
+                writer.close("failed", str(err))
+            raise
+        cvtfem_solver = isinstance(stepper, CvtfemSolver)
+        if resumed is not None:  # counters continue from the checkpoint
+            counts = resumed[1]["counts"]
+            if cvtfem_solver:
+                stepper.stats.counts.update({c: int(counts[i]) for i, c in enumerate(COUNTERS)})
+                stepper._sync()
+            else:
+                stepper.nfev, stepper.njev, stepper.nlu = (int(c) for c in counts[:3])
+
+        def emit(t: float, x) -> None:
+            nonlocal k, last, x_window
+            if not np.all(np.isfinite(x)):
+                raise NumericalError("state became non-finite", t=t, component="band model")
+            last = (float(t), np.array(x))
+            if k == self.j_window:
+                x_window = np.array(x)
+            if writer is not None:
+                writer.append(t, sample_outputs(loop, t, x))
+            k += 1
+
+        def save() -> None:
+            nonlocal seq
+            seq += 1
+            if cvtfem_solver:
+                counts = [stepper.stats.counts[c] for c in COUNTERS]
+                h = stepper.h_next
+            else:
+                counts = [stepper.nfev, getattr(stepper, "njev", 0), getattr(stepper, "nlu", 0)]
+                counts += [0] * (len(COUNTERS) - 3)
+                h = getattr(stepper, "h_abs", None) or stepper.step_size or 0.0
+            writer.checkpoint(seq, {"t": stepper.t, "t_end": t_end, "x": stepper.y, "h": h, "k": k, "steps": steps,
+                                    "tiny": tiny, "next_checkpoint": next_ck, "counts": counts, "t_last": last[0],
+                                    "x_last": last[1], "x_window": x_window,
+                                    "wall": wall_before + time.perf_counter() - wall0})
+            if on_checkpoint is not None:
+                on_checkpoint(float(stepper.t), seq)
+
+        checkpoints = writer is not None and self.interval > 0
+        wall0 = time.perf_counter()
+        bar = progress(t_end, "s", f"run {scene.cvt.model}") if show_progress else None
+        if bar is not None and t0 > 0:
+            bar.update(t0)
+        status, message = "finished", ""
+        h_stall = STALL_FRACTION * t_end
+        try:
+            while k < len(t_out) and t_out[k] <= stepper.t:  # t = 0
+                emit(t_out[k], stepper.y)
+            while stepper.status == "running":
+                t_prev = stepper.t
+                msg = stepper.step()
+                steps += 1
+                if stepper.status == "failed" or not np.all(np.isfinite(stepper.y)):
+                    raise NumericalError(f"{sol.method} failed: {msg or 'state became non-finite'}", t=stepper.t,
+                                         component=f"band model {scene.cvt.model}")
+                if steps > sol.max_steps:
+                    raise NumericalError(f"step budget `solver.max_steps` = {sol.max_steps} exhausted", t=stepper.t)
+                tiny = tiny + 1 if stepper.t - t_prev < h_stall else 0
+                if tiny >= STALL_STEPS:
+                    raise NumericalError(_stall_message(loop, sol.method, stepper.t, stepper.y, stepper.t - t_prev,
+                                                        h_stall), t=stepper.t, component=f"band model {scene.cvt.model}")
+                if k < len(t_out) and t_out[k] <= stepper.t:
+                    dense = stepper.dense_output()
+                    while k < len(t_out) and t_out[k] <= stepper.t:
+                        emit(t_out[k], dense(t_out[k]))
+                if checkpoints and stepper.status == "running" and stepper.t >= next_ck:
+                    while next_ck <= stepper.t:
+                        next_ck += self.interval
+                    save()
+                if bar is not None:
+                    bar.update(stepper.t - t_prev)
+        except BaseException as err:
+            status, message = "failed", str(err)
+            if writer is not None:
+                writer.close("failed", message)
+            raise
+        finally:
+            if bar is not None:
+                bar.close()
+        wall = wall_before + time.perf_counter() - wall0
+        stats = {"name": sol.method, "steps": steps, "nfev": int(stepper.nfev), "njev": int(getattr(stepper, "njev", 0)),
+                 "nlu": int(getattr(stepper, "nlu", 0)), "rtol": sol.rtol, "atol": sol.atol}
+        summary = _summarise(scene, loop, last, (t_out[self.j_window], x_window), t_end, wall, stats, status)
+        if writer is not None:
+            extra = {"checkpoints": seq} if checkpoints else {}
+            if resumed is not None:
+                extra["resumed_from_t"] = float(t0)
+            writer.set_stats({**{f"solver_{k}": v for k, v in stats.items()}, "wall_time_s": wall, **extra})
+            writer.add_array("band.node_xi", loop.model.arc_nodes(0.0)[0] / (math.pi / 2), "-",
+                             "Quadrature nodes xi = theta / theta* of band.normal_force (same on both arcs).")
+            writer.close(status, message)
+            summary.results = str(writer.path)
+        return summary
 
 
 def _stall_message(loop, method: str, t: float, x, h: float, h_stall: float) -> str:
@@ -220,39 +347,28 @@ def _stall_message(loop, method: str, t: float, x, h: float, h_stall: float) -> 
             "or the clamping safety factor, or try another `solver.method`")
 
 
-def _emit(writer, loop, t: float, x, history: list) -> None:
-    if not np.all(np.isfinite(x)):
-        raise NumericalError("state became non-finite", t=t, component="band model")
-    history.append((float(t), np.array(x)))
-    if writer is not None:
-        writer.append(t, sample_outputs(loop, t, x))
-
-
-def _summarise(scene, loop, history, t_end, wall, stats, status) -> RunSummary:
-    """Final ratio and speeds (raw, at t_end), efficiency over the last window from the work integrals."""
-    t = np.array([h[0] for h in history])
-    X = np.array([h[1] for h in history])
-    x = X[-1]
-    _, info = loop.evaluate(t[-1], x)
+def _summarise(scene, loop, last, window, t_end, wall, stats, status) -> RunSummary:
+    """Final ratio and speeds (raw, at the last sample ``last = (t, x)``), efficiency over the last window
+    from the work integrals (``window = (t, x)``: the sample that starts it)."""
+    t_last, x = last
+    t_j, x_j = window
+    _, info = loop.evaluate(t_last, x)
     w1d, _, i_d = info["targets"]
-    j = int(np.searchsorted(t, t[-1] - EFFICIENCY_WINDOW))
-    if j >= len(t) - 1:  # run shorter than one output step past the window: use the whole run
-        j = 0
-    W0, W1 = loop.split(X[j])[3], loop.split(x)[3]
+    W0, W1 = loop.split(x_j)[3], loop.split(x)[3]
     dW = W1 - W0
-    dE = loop.energy(x) - loop.energy(X[j])
+    dE = loop.energy(x) - loop.energy(x_j)
     eff: float | None = None
     eff_kin: float | None = None
     note = ""
     if dW[0] > 0:
         eff, eff_kin = float(dW[1] / dW[0]), float(1 - (dW[0] - dW[1] - dE) / dW[0])
     else:  # zero driving torque (or speed): output over input is 0/0
-        note = (f"undefined: input work {dW[0]:.3g} J over the last {t[-1] - t[j]:.3g} s (driving torque "
+        note = (f"undefined: input work {dW[0]:.3g} J over the last {t_last - t_j:.3g} s (driving torque "
                 f"{info['M'][0]:.3g} N m); efficiency needs positive input power")
     rpm = 30 / math.pi
     w = info["w"]
     return RunSummary(scene=scene.source, model=scene.cvt.model, n_coordinates=loop.model.n2,
-                      simulated_time_s=float(t[-1]), wall_time_s=wall, ratio=float(w[0] / w[1]), target_ratio=i_d,
+                      simulated_time_s=float(t_last), wall_time_s=wall, ratio=float(w[0] / w[1]), target_ratio=i_d,
                       input_speed_rpm=float(w[0] * rpm), output_speed_rpm=float(w[1] * rpm),
                       target_output_speed_rpm=float(w1d / i_d * rpm), efficiency=eff,
                       efficiency_kinetic=eff_kin, efficiency_note=note, slip_speed_m_s=[float(s) for s in info["slip"]],

@@ -1,4 +1,8 @@
-"""``cvtfem run SCENE [--until T] [--summary-json OUT] [--results FILE]``: a time run of a CVT scene."""
+"""``cvtfem run SCENE [--until T] [--summary-json OUT] [--results FILE]``: a time run of a CVT scene.
+
+``cvtfem run --resume RESULTS.h5`` continues a killed run from the newest checkpoint in its
+results file (scene, end time and solver from the file), appending to the same file.
+"""
 from __future__ import annotations
 
 import argparse
@@ -6,12 +10,17 @@ import argparse
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("run", help="time run of a CVT scene (band models), results to HDF5")
-    p.add_argument("scene", metavar="SCENE", help="scene file (.toml) or preset name (e.g. band-4dof)")
+    p.add_argument("scene", metavar="SCENE", nargs="?", default=None,
+                   help="scene file (.toml) or preset name (e.g. band-4dof); omitted with --resume")
     p.add_argument("--until", type=float, default=None, metavar="T", help="simulated end time, s (default solver.t_end)")
     p.add_argument("--results", default=None, metavar="FILE",
                    help="HDF5 results file (default: out/runs/<scene>.h5; 'none' for no file)")
     p.add_argument("--overwrite", action="store_true", help="replace an existing results file")
     p.add_argument("--summary-json", default=None, metavar="OUT", help="write the run summary as JSON")
+    p.add_argument("--resume", default=None, metavar="RESULTS.h5",
+                   help="continue a killed run from the newest checkpoint of its results file (scene from the file)")
+    p.add_argument("--report-checkpoints", action="store_true",
+                   help="print a line on stdout when a checkpoint is on disk")
     p.set_defaults(func=run)
 
 
@@ -19,17 +28,33 @@ def run(args: argparse.Namespace) -> int:
     import json
     from pathlib import Path
 
-    from cvtfem.analysis.run import run_scene
+    from cvtfem.analysis.run import resume_run, run_scene
+    from cvtfem.errors import InputError
     from cvtfem.scene.loader import load_scene
 
-    scene = load_scene(args.scene)
-    results = args.results
-    if results is None:
-        stem = Path(args.scene).stem if args.scene.endswith(".toml") else args.scene
-        results = Path("out") / "runs" / f"{stem}.h5"
-    elif results.lower() == "none":
-        results = None
-    summary = run_scene(scene, until=args.until, results=results, overwrite=args.overwrite)
+    def report(t: float, seq: int) -> None:
+        print(f"checkpoint {seq} at t = {t:.6g} s", flush=True)
+
+    on_checkpoint = report if args.report_checkpoints else None
+    if args.resume is not None:
+        for name, value in (("SCENE", args.scene), ("--until", args.until), ("--results", args.results),
+                            ("--overwrite", args.overwrite or None)):
+            if value is not None:
+                raise InputError(name, value, "cannot be combined with --resume (scene, end time and results file "
+                                 "are those of the resumed run)", "run `cvtfem run --resume RESULTS.h5`")
+        summary = resume_run(args.resume, on_checkpoint=on_checkpoint)
+    else:
+        if args.scene is None:
+            raise InputError("SCENE", None, "is required (a scene file or preset name), unless --resume RESULTS.h5")
+        scene = load_scene(args.scene)
+        results = args.results
+        if results is None:
+            stem = Path(args.scene).stem if args.scene.endswith(".toml") else args.scene
+            results = Path("out") / "runs" / f"{stem}.h5"
+        elif results.lower() == "none":
+            results = None
+        summary = run_scene(scene, until=args.until, results=results, overwrite=args.overwrite,
+                            on_checkpoint=on_checkpoint)
     s = summary
     print(f"{s.model}: {s.simulated_time_s:g} s simulated in {s.wall_time_s:.3g} s wall "
           f"({s.solver['name']}, {s.solver['steps']} steps, {s.solver['nfev']} RHS calls)")

@@ -7,7 +7,8 @@ Layout::
     /stats           attrs: solver statistics (counters, wall time)
     /series/time     (n,) float64, unit "s"
     /series/NAME     (n, size) float64, attrs unit, doc
-    /checkpoint/...  full state for resuming (written by the run driver)
+    /checkpoint/slots  full state for resuming (payload chosen by the run driver;
+                     layout in :mod:`cvtfem.io.checkpoint`)
 
 Rows are appended to resizable datasets and the file is flushed every
 ``flush_interval`` seconds of wall time, so a run killed half-way leaves a
@@ -18,9 +19,18 @@ keeps it consistent on disk at every moment, and readers open it with
 statistics, whole arrays and the final status are written when the run
 closes the file.  At each flush the series are extended first and ``time``
 last; a reader trusts the shortest of them.
+
+Checkpoints (``checkpoint=Layout``) are pre-created before SWMR starts and
+overwritten in place (:meth:`ResultsWriter.checkpoint`); each one records the
+number of rows written so far.  :meth:`ResultsWriter.resume` continues a killed
+run in the same file: a killed SWMR writer leaves the file flagged "open for
+writing", which HDF5 refuses to reopen for writing, so the file is rebuilt
+(rows up to the newest checkpoint, the checkpoint itself) under a temporary
+name next to it and moved over the original once it is consistent.
 """
 from __future__ import annotations
 
+import os
 import time
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
@@ -34,6 +44,7 @@ import numpy as np
 from cvtfem import __version__
 from cvtfem.elements.base import OutputSpec
 from cvtfem.errors import InputError
+from cvtfem.io import checkpoint as ckpt
 
 CHUNK_ROWS = 256
 
@@ -55,16 +66,20 @@ class ResultsWriter:
         Wall time between flushes, s.
     overwrite : bool
         Replace an existing file.
+    checkpoint : Layout, optional
+        Payload fields of the checkpoints (a ``rows`` field is added); None: no checkpoints.
     """
 
     def __init__(self, path: str | Path, scene_toml: str, kind: str, outputs: Sequence[OutputSpec],
-                 flush_interval: float = 2.0, overwrite: bool = False) -> None:
+                 flush_interval: float = 2.0, overwrite: bool = False, checkpoint: ckpt.Layout | None = None,
+                 _resume: dict[str, Any] | None = None) -> None:
         self.path = Path(path)
         if self.path.exists() and not overwrite:
             raise InputError("results file", str(self.path), "must not exist already (results are never overwritten)",
                              "choose another name or delete it")
         self.path.parent.mkdir(parents=True, exist_ok=True)
         self.flush_interval = flush_interval
+        self.scene_toml = scene_toml
         self._file = h5py.File(self.path, "w", libver="latest")
         f = self._file
         f.attrs.update(cvtfem_version=__version__, kind=kind, status="running", message="",
@@ -80,11 +95,100 @@ class ResultsWriter:
                                       chunks=(CHUNK_ROWS, spec.size), dtype="f8")
             d.attrs.update(unit=spec.unit, doc=spec.doc)
         self._rows = 0
+        self._layout = None
+        if checkpoint is not None:
+            self._layout = ckpt.Layout(tuple(checkpoint.fields) + (("rows", 1),))
+            ckpt.create(f, self._layout)
+        if _resume is not None:  # rows and checkpoint of the killed run, written before SWMR starts
+            n = _resume["time"].size
+            for name, data in [("time", _resume["time"]), *_resume["series"].items()]:
+                d = series[name]
+                d.resize((n, *d.shape[1:]))
+                d[:] = data
+            self._rows = n
+            f.attrs.update(_resume["attrs"])
+            ckpt.write(f, self._layout, _resume["seq"], _resume["values"])
         self._buffer: list[tuple[float, dict[str, np.ndarray]]] = []
         self._stats: dict[str, Any] = {}
         self._arrays: dict[str, tuple[np.ndarray, str, str]] = {}
         self._last_flush = time.monotonic()
         f.swmr_mode = True  # single-writer/multiple-reader: the file stays consistent if the writer dies
+
+    @property
+    def specs(self) -> list[OutputSpec]:
+        """The recorded series."""
+        return list(self._specs.values())
+
+    @property
+    def checkpoint_layout(self) -> tuple[tuple[str, int], ...]:
+        """Checkpoint payload fields (``rows`` included), empty without checkpoints."""
+        return self._layout.fields if self._layout is not None else ()
+
+    @property
+    def rows(self) -> int:
+        """Rows on disk (appended rows still buffered are not counted)."""
+        return self._rows
+
+    def checkpoint(self, seq: int, values: Mapping[str, Any]) -> None:
+        """Flush the rows, then store checkpoint ``seq`` (1, 2, ...) with the row count; on disk when it returns."""
+        if self._layout is None:
+            raise ValueError("this results file was created without checkpoint slots")
+        self.flush()
+        ckpt.write(self._file, self._layout, seq, {**values, "rows": self._rows})
+
+    @classmethod
+    def resume(cls, path: str | Path, flush_interval: float = 2.0,
+               where: str = "--resume") -> tuple[ResultsWriter, int, dict[str, np.ndarray]]:
+        """Reopen a killed run's file for appending from its newest checkpoint.
+
+        Returns the writer (rows up to the checkpoint, later rows dropped: the run recomputes
+        them), the checkpoint number and its payload (``rows`` included).  Refused with
+        :class:`InputError` for a finished run, a file without checkpoint or not a run.
+        """
+        path = Path(path)
+        if not path.is_file():
+            raise InputError(where, str(path), "must be an existing results file (.h5) of a killed run")
+        try:
+            f = h5py.File(path, "r", libver="latest", swmr=True, locking=False)
+        except OSError as err:
+            raise InputError(where, str(path), f"must be a readable HDF5 file ({err})") from None
+        with f:
+            attrs = dict(f.attrs)
+            if attrs.get("kind") != "run" or "series" not in f:
+                raise InputError(where, str(path), f"must be the results file of `cvtfem run` (kind is "
+                                 f"{attrs.get('kind')!r})")
+            status = str(attrs.get("status", ""))
+            group = f["series"]
+            if status == "finished":
+                t = group["time"]
+                last = f"{t[-1]:.6g} s" if t.shape[0] else "its end"
+                raise InputError(where, str(path), f"must be an unfinished run: this one finished (t = {last})",
+                                 "nothing to resume; results are never overwritten, start a new run with "
+                                 "another --results file")
+            latest = ckpt.read_latest(f)
+            if latest is None:
+                raise InputError(where, str(path), "must hold a checkpoint: this run wrote none",
+                                 "set `output.checkpoint_interval` > 0 (simulated seconds) in the scene; a run "
+                                 "without checkpoints can only be started again")
+            seq, values = latest
+            layout = ckpt.Layout.from_attrs(f[ckpt.GROUP]["slots"].attrs)
+            rows = int(values["rows"][0])
+            if min(d.shape[0] for d in group.values()) < rows:
+                raise InputError(where, str(path), f"is inconsistent: checkpoint {seq} counts {rows} rows, the "
+                                 "series hold fewer")
+            specs = [OutputSpec(name, str(d.attrs.get("unit", "")), str(d.attrs.get("doc", "")), d.shape[1])
+                     for name, d in group.items() if name != "time"]
+            resume = {"time": group["time"][:rows], "series": {s.name: group[s.name][:rows] for s in specs},
+                      "attrs": {"created": attrs.get("created", ""), "resumed": int(attrs.get("resumed", 0)) + 1},
+                      "seq": seq, "values": values}
+            scene_toml = f["scene"][()].decode()
+        fields = tuple(fd for fd in layout.fields if fd[0] != "rows")
+        tmp = path.with_name(path.name + ".resume-tmp")
+        writer = cls(tmp, scene_toml, "run", specs, flush_interval, overwrite=True, checkpoint=ckpt.Layout(fields),
+                     _resume=resume)
+        os.replace(tmp, path)  # the open file follows the rename
+        writer.path = path
+        return writer, seq, values
 
     def append(self, t: float, values: Mapping[str, Any]) -> None:
         """Record one output sample at time ``t`` (s); flushes when due."""
