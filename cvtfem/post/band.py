@@ -10,6 +10,8 @@ from pathlib import Path
 
 import numpy as np
 
+from cvtfem.post.figures import pyplot, save
+
 RPM = 30 / math.pi
 
 
@@ -40,10 +42,7 @@ def plot_regime(results, path: str | Path, title: str = "") -> Path:
         A ``cvtfem run`` results file read back.
     path : path of the PNG to write.
     """
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = pyplot()
 
     s, t = results.series, results.time
     fig, ax = plt.subplots(4, 1, figsize=(8, 9), sharex=True)
@@ -68,11 +67,7 @@ def plot_regime(results, path: str | Path, title: str = "") -> Path:
         a.grid(alpha=0.3)
     fig.suptitle(title or "regime history")
     fig.tight_layout()
-    out = Path(path)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(out, dpi=110)
-    plt.close(fig)
-    return out
+    return save(fig, path)
 
 
 def plot_normal_force(xi, curves: Mapping[str, np.ndarray], path: str | Path, title: str = "") -> Path:
@@ -83,10 +78,7 @@ def plot_normal_force(xi, curves: Mapping[str, np.ndarray], path: str | Path, ti
     xi : (g,) quadrature nodes in [-1, 1].
     curves : mapping label -> (2, g) array, N/m (arc 1 = driving, arc 2 = driven).
     """
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = pyplot()
 
     fig, ax = plt.subplots(1, 2, figsize=(10, 4), sharey=False)
     for label, N in curves.items():
@@ -101,11 +93,7 @@ def plot_normal_force(xi, curves: Mapping[str, np.ndarray], path: str | Path, ti
     ax[1].legend(loc="best", fontsize=8)
     fig.suptitle(title or "normal force along the contact arcs")
     fig.tight_layout()
-    out = Path(path)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(out, dpi=110)
-    plt.close(fig)
-    return out
+    return save(fig, path)
 
 
 def convergence_table(xi, curves: Mapping[int, np.ndarray]) -> Sequence[tuple[int, float]]:

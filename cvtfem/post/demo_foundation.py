@@ -10,13 +10,9 @@ import numpy as np
 
 def run(outdir: Path) -> list[str]:
     """Describe the reference scene and plot its randomised link pattern."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
     from cvtfem.cli import main
     from cvtfem.elements.link_pattern import link_lengths
+    from cvtfem.post.figures import pyplot, save
     from cvtfem.scene.loader import load_scene
 
     text = io.StringIO()
@@ -27,7 +23,7 @@ def run(outdir: Path) -> list[str]:
     chain = scene.cvt.chain
     lengths = link_lengths(chain.n_pins, chain.pitch_short, chain.pitch_long, chain.long_fraction,
                            np.random.default_rng(scene.seed))
-    fig, ax = plt.subplots(figsize=(9, 3))
+    fig, ax = pyplot().subplots(figsize=(9, 3))
     ax.bar(np.arange(lengths.size), lengths * 1e3, width=0.8,
            color=np.where(lengths > lengths.min(), "tab:red", "tab:blue"))
     ax.set_ylim(chain.pitch_short * 1e3 - 0.5, chain.pitch_long * 1e3 + 0.3)
@@ -36,8 +32,6 @@ def run(outdir: Path) -> list[str]:
     ax.set_title(f"reference_cvt: randomised chain, {lengths.size} links (seed {scene.seed}), "
                  f"length {lengths.sum():.4f} m")
     fig.tight_layout()
-    png = outdir / "reference_cvt_links.png"
-    fig.savefig(png, dpi=110)
-    plt.close(fig)
+    png = save(fig, outdir / "reference_cvt_links.png")
     return [f"reference_cvt_describe.txt: components, coordinates ({scene.cvt.model}) and outputs",
             f"{png.name}: long/short link pattern of the reference chain"]
