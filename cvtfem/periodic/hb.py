@@ -20,7 +20,7 @@ import numpy as np
 
 from cvtfem.elements.torsional import TorsionalNetwork, link_force
 from cvtfem.errors import InputError, NumericalError
-from cvtfem.periodic.sweep import Topology, check_grounded, solve_blocks, through_numbering
+from cvtfem.periodic.sweep import Topology, check_grounded, solve_blocks, solve_mixed, through_numbering
 
 log = logging.getLogger(__name__)
 
@@ -228,8 +228,39 @@ def linearize(net: TorsionalNetwork, omega: float, a: np.ndarray, p: np.ndarray,
     return r, Nb, L[:, None]
 
 
+def linearize_mixed(net: TorsionalNetwork, omega: float, a: np.ndarray, p: np.ndarray, M: int, D):
+    """:func:`linearize` in mixed storage: ``(r, Nd, Ld, dense, Ldense)``.
+
+    Node blocks and the blocks of linear links are diagonal in the harmonic index and kept as
+    vectors ``Nd`` (S, K), ``Ld`` (E, K); only the links with backlash (``dense``) get their
+    full Toeplitz blocks ``Ldense`` (Ed, K, K).  Same entries as :func:`linearize`.
+    """
+    N = (a.shape[1] - 1) // 2
+    n = np.arange(-N, N + 1)
+    K = len(n)
+    r, df = residual(net, omega, a, p, M, D)
+    dense = np.flatnonzero(net.law != 0)
+    chat = np.fft.fft(df[dense], axis=-1) / M
+    Ldense = chat[:, (n[:, None] - n[None, :]) % M]
+    diag = np.arange(K)
+    iw = (1j * n * omega)[None, :]
+    Ldense[:, diag, diag] += iw * net.d[dense, None]
+    Ld = net.k_out[:, None] + iw * net.d[:, None]
+    return r, _node_term(net, omega, n), Ld, dense, Ldense
+
+
 def newton_step(net, omega, a, p, M, topo, D, method="auto"):
-    """One Newton-Kantorovich correction (B:(29)): returns ``(delta, r, method_used)``."""
+    """One Newton-Kantorovich correction (B:(29)): returns ``(delta, r, method_used)``.
+
+    Trees go through the sweep in mixed storage (only backlash links' blocks full);
+    ``method="sparse"`` or loops assemble the full blocks (:func:`linearize`).
+    """
+    if topo is not None and method != "sparse":
+        r, Nd, Ld, dense, Ldense = linearize_mixed(net, omega, a, p, M, D)
+        # the operator is real: solving for the conjugate-symmetric part of r is what
+        # _symmetrize(delta) gives anyway, and the real-basis sweep needs it
+        delta, used = solve_mixed(Nd, Ld, dense, Ldense, net.i, net.j, -_symmetrize(r), topo, method)
+        return _symmetrize(delta), r, used
     r, Nb, L = linearize(net, omega, a, p, M, D)
     delta, used = solve_blocks(Nb, L, net.i, net.j, -r[:, None], topo, method)
     return _symmetrize(delta[:, 0]), r, used

@@ -277,3 +277,196 @@ def solve_blocks(N: np.ndarray, L: np.ndarray, i: np.ndarray, j: np.ndarray, g: 
         raise NumericalError("the harmonic-balance system is singular (check damping and ground links)",
                              component="periodic block solve")
     return a, "sparse"
+
+
+def _mixed_ends(i: np.ndarray, j: np.ndarray, vals: np.ndarray, S: int) -> np.ndarray:
+    """Sum ``vals`` (E, K) of links into both their end nodes (S, K) (ground ends dropped)."""
+    inner = j >= 0
+    ends = np.concatenate([i, j[inner]])
+    return (_scatter(ends, S) @ np.concatenate([vals, vals[inner]]))
+
+
+def apply_mixed(Nd, Ld, dense, Ldense, i, j, a) -> np.ndarray:
+    """:func:`apply` for mixed storage (see :func:`solve_mixed`), one batch member: ``a`` (S, K)."""
+    S = a.shape[0]
+    ja = np.where(j >= 0, j, 0)
+    aj = np.where((j >= 0)[:, None], a[ja], 0)
+    dl = a[i] - aj  # link deflection harmonics (E, K)
+    flux = Ld * dl
+    if dense.size:
+        flux[dense] = np.einsum("ekl,el->ek", Ldense, dl[dense])
+    out = Nd * a + _scatter(i, S) @ flux
+    inner = j >= 0
+    return out - _scatter(j[inner], S) @ flux[inner]
+
+
+def _to_real_vec(v: np.ndarray) -> np.ndarray:
+    """Harmonics ``n = -N..N`` (..., K) of a real signal -> real unitary cos/sin coordinates (..., K).
+
+    Order ``[z_0, c_1, s_1, ..., c_N, s_N]`` with ``z_n = (c_n - i s_n) / sqrt 2``,
+    ``z_-n = (c_n + i s_n) / sqrt 2`` (the map ``T`` is unitary).  A non-conjugate-symmetric
+    part of ``v`` (round-off) is dropped.
+    """
+    K = v.shape[-1]
+    N = (K - 1) // 2
+    pos, neg = v[..., N + 1:], v[..., N - 1::-1]
+    out = np.empty(v.shape, float)
+    out[..., 0] = v[..., N].real
+    out[..., 1::2] = ((pos + neg) / np.sqrt(2)).real
+    out[..., 2::2] = (1j * (pos - neg) / np.sqrt(2)).real
+    return out
+
+
+def _from_real_vec(w: np.ndarray) -> np.ndarray:
+    """Inverse of :func:`_to_real_vec`: ``T w`` (..., K) complex."""
+    K = w.shape[-1]
+    N = (K - 1) // 2
+    z = np.empty(w.shape, complex)
+    z[..., N] = w[..., 0]
+    c, s = w[..., 1::2], w[..., 2::2]
+    z[..., N + 1:] = (c - 1j * s) / np.sqrt(2)
+    z[..., N - 1::-1] = (c + 1j * s) / np.sqrt(2)
+    return z
+
+
+def _to_real_mat(A: np.ndarray) -> np.ndarray:
+    """``T^H A T`` (K, K), real for a block of a real operator (``A_{-n,-m} = conj A_{n,m}``)."""
+    B = _to_real_vec_cols(A)
+    return _to_real_rows(B)
+
+
+def _to_real_vec_cols(A: np.ndarray) -> np.ndarray:
+    """``A T`` (complex): columns combined as in :func:`_from_real_vec`."""
+    K = A.shape[-1]
+    N = (K - 1) // 2
+    out = np.empty(A.shape, complex)
+    pos, neg = A[:, N + 1:], A[:, N - 1::-1]
+    out[:, 0] = A[:, N]
+    out[:, 1::2] = (pos + neg) / np.sqrt(2)
+    out[:, 2::2] = (-1j * pos + 1j * neg) / np.sqrt(2)
+    return out
+
+
+def _to_real_rows(B: np.ndarray) -> np.ndarray:
+    """``T^H B`` (real part): rows combined as in :func:`_to_real_vec`."""
+    K = B.shape[0]
+    N = (K - 1) // 2
+    out = np.empty(B.shape, float)
+    pos, neg = B[N + 1:], B[N - 1::-1]
+    out[0] = B[N].real
+    out[1::2] = ((pos + neg) / np.sqrt(2)).real
+    out[2::2] = (1j * (pos - neg) / np.sqrt(2)).real
+    return out
+
+
+def _diag_to_real(d: np.ndarray) -> np.ndarray:
+    """``T^H diag(d) T`` (K, K) real (2 x 2 blocks per harmonic pair) for ``d_-n = conj d_n``."""
+    K = d.shape[-1]
+    N = (K - 1) // 2
+    out = np.zeros((K, K))
+    out[0, 0] = d[N].real
+    dp = d[N + 1:]
+    k = np.arange(1, K, 2)
+    out[k, k] = dp.real
+    out[k + 1, k + 1] = dp.real
+    out[k, k + 1] = dp.imag
+    out[k + 1, k] = -dp.imag
+    return out
+
+
+def block_sweep_mixed(topo: Topology, Nd, Ld, dense, Ldense, i, j, g) -> np.ndarray:
+    """:func:`block_sweep` for one batch member with mixed storage: diagonal blocks as vectors.
+
+    ``Nd`` (S, K) node diagonals, ``Ld`` (E, K) link diagonals, ``dense`` (Ed,) indices of
+    links with full blocks ``Ldense`` (Ed, K, K) (their ``Ld`` rows are ignored), ``g`` (S, K).
+    Dense storage only where the elimination fills in.  All blocks are those of a real
+    operator in harmonics ``n = -N..N`` (``A_{-n,-m} = conj A_{n,m}``), so the dense
+    eliminations run in the unitary real cos/sin basis (:func:`_to_real_vec`): real LU
+    and products, about 4x less work than complex.  Returns the conjugate-symmetric
+    solution ``a`` (S, K) (for a conjugate-symmetric ``g``).
+    """
+    S, K = g.shape
+    Ld = np.array(Ld, complex)
+    Ld[dense] = 0
+    Gd = Nd + _mixed_ends(i, j, Ld, S)
+    g = g.astype(complex, copy=True)
+    full: dict[int, np.ndarray] = {}  # real-basis dense blocks
+    link_full = {int(e): _to_real_mat(Ldense[k]) for k, e in enumerate(dense.tolist())}
+    for e in link_full:
+        for s in (int(i[e]), int(j[e])):
+            if s < 0:
+                continue
+            if s not in full:
+                full[s] = _diag_to_real(Gd[s])
+            full[s] += link_full[e]
+    X: dict[int, np.ndarray] = {}
+    y = np.empty((S, K), complex)
+    parent = topo.parent
+    for s in topo.order[::-1].tolist():
+        p = int(parent[s])
+        e = int(topo.parent_link[s])
+        Lfull = link_full.get(e) if e >= 0 else None
+        if s in full or Lfull is not None:
+            G = full[s] if s in full else _diag_to_real(Gd[s])
+            Lp = Lfull if Lfull is not None else (_diag_to_real(Ld[e]) if e >= 0 else np.zeros((K, K)))
+            sol = np.linalg.solve(G, np.concatenate([Lp, _to_real_vec(g[s])[:, None]], axis=1))
+            X[s], yr = sol[:, :K], sol[:, K]
+            y[s] = _from_real_vec(yr)
+            if p >= 0:
+                if p not in full:
+                    full[p] = _diag_to_real(Gd[p])
+                full[p] -= Lp @ X[s]
+                g[p] += _from_real_vec(Lp @ yr)
+        else:
+            Ls = Ld[e] if e >= 0 else np.zeros(K, complex)
+            X[s] = Ls / Gd[s]
+            y[s] = g[s] / Gd[s]
+            if p >= 0:
+                if p in full:
+                    full[p] -= _diag_to_real(Ls * Ls / Gd[s])
+                else:
+                    Gd[p] -= Ls * Ls / Gd[s]
+                g[p] += Ls * y[s]
+    a = np.empty_like(y)
+    for s in topo.order.tolist():
+        p = int(parent[s])
+        if p < 0:
+            a[s] = y[s]
+        elif X[s].ndim == 2:
+            a[s] = y[s] + _from_real_vec(X[s] @ _to_real_vec(a[p]))
+        else:
+            a[s] = y[s] + X[s] * a[p]
+    return a
+
+
+def solve_mixed(Nd, Ld, dense, Ldense, i, j, g, topo: Topology | None, method: str = "auto") -> tuple[np.ndarray, str]:
+    """:func:`solve_blocks` for one batch member with mixed storage (see :func:`block_sweep_mixed`).
+
+    Same policy: sweep checked by its residual, sparse LU (on the full blocks) as the fallback.
+    """
+    if method not in ("auto", "sweep", "sparse"):
+        raise InputError("method", method, "must be 'auto', 'sweep' or 'sparse'")
+    if method == "sweep" and topo is None:
+        raise InputError("method", method, "needs a tree network (this one has a loop); use 'sparse'")
+    if topo is not None and method != "sparse":
+        with np.errstate(all="ignore"):
+            try:
+                a = block_sweep_mixed(topo, Nd, Ld, dense, Ldense, i, j, g)
+            except np.linalg.LinAlgError:
+                a = np.full_like(g, np.nan, dtype=complex)
+            res = np.linalg.norm(apply_mixed(Nd, Ld, dense, Ldense, i, j, a) - g) if np.all(np.isfinite(a)) \
+                else np.inf
+        if res <= RESIDUAL_LIMIT * max(np.linalg.norm(g), 1e-300) or method == "sweep":
+            return a, "sweep"
+    S, K = g.shape
+    diag = np.arange(K)
+    Nb = np.zeros((S, 1, K, K), complex)
+    Nb[:, 0, diag, diag] = Nd
+    L = np.zeros((len(i), 1, K, K), complex)
+    L[:, 0, diag, diag] = Ld
+    L[dense, 0] = Ldense
+    a = solve_sparse(Nb, L, i, j, g[:, None])[:, 0]
+    if not np.all(np.isfinite(a)):
+        raise NumericalError("the harmonic-balance system is singular (check damping and ground links)",
+                             component="periodic block solve")
+    return a, "sparse"

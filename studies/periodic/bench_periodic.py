@@ -1,11 +1,12 @@
 """Benchmark: harmonic balance vs time integration on the engine gear train, and block-sweep scaling.
 
-Run:  .venv/bin/python studies/periodic/bench_periodic.py [--quick]
+Run:  .venv/bin/python studies/periodic/bench_periodic.py [--quick] [--reuse-ti] [--engine-only]
 Prints medians of several runs and the machine; writes out/studies/periodic/bench.json.
 
 1. Time integration (DOP853, rtol 1e-7, from rest, period by period until the state repeats
    within 1e-6): periods, wall and CPU time, RHS calls, probe-link peak and RMS moment.
-2. HB continued in N = 24 .. 192 (cumulative cost) and its difference from 1.
+2. HB continued in N = 24 .. 192 (cumulative cost, median of 3 runs) and its difference from 1.
+   ``--reuse-ti`` takes 1. from the previous ``bench.json``; ``--engine-only`` skips 3.
 3. Block sweep (full Toeplitz blocks, as in a Newton step) on chains and branched trees of
    10 .. 10,000 masses.
 """
@@ -46,24 +47,9 @@ def probe_stats(moment: np.ndarray) -> np.ndarray:
     return np.array([np.abs(moment).max(), np.sqrt((moment ** 2).mean())])
 
 
-def engine(quick: bool, hz: float = 12.5) -> dict:
-    """Time integration from rest to periodic steady state vs HB continued in N, same network."""
-    net = build(load_scene("engine_gear_train"))
-    probe = net.link_names.index("crank_gear-idler_gear")
-    r_probe = net.radius[net.i[probe]]
-    omega = 2 * np.pi * hz
-    rows: dict = {"frequency_hz": hz}
-    cpu = time.process_time()
-    ti = transient.steady_state(net, omega, rtol=1e-7, atol=1e-13, tol=1e-6, max_periods=400, samples=4096)
-    ti_cpu = time.process_time() - cpu
-    ti_stats = probe_stats(ti.link_forces[probe] * r_probe)
-    print(f"time integration DOP853 rtol 1e-7 from rest: {ti.periods} periods to repeat within 1e-6, "
-          f"{ti.wall:.1f} s wall, {ti_cpu:.1f} s CPU, {ti.nfev} RHS calls; probe peak {ti_stats[0]:.2f} N m, "
-          f"RMS {ti_stats[1]:.3f} N m")
-    rows["ti"] = {"periods": ti.periods, "wall": ti.wall, "cpu": ti_cpu, "nfev": ti.nfev,
-                  "peak": ti_stats[0], "rms": ti_stats[1]}
-    hb_rows = []
-    prev, wall, cpu_total = None, 0.0, 0.0
+def hb_chain(net, omega, probe, ti_stats) -> list[dict]:
+    """HB continued in N (each N starts from the previous, padded); cumulative wall and CPU per N."""
+    rows, prev, wall, cpu_total = [], None, 0.0, 0.0
     for N in (24, 48, 96, 144, 192):
         a0 = None
         if prev is not None:  # continuation in N: pad the previous harmonics
@@ -75,15 +61,54 @@ def engine(quick: bool, hz: float = 12.5) -> dict:
         wall += t
         got = probe_stats(sol.link_moments(4096)[probe])
         diff = np.abs(got - ti_stats) / ti_stats
-        print(f"HB N={N:3d}: {sol.iterations:3d} Newton iterations, cumulative {wall:6.2f} s wall, "
-              f"{cpu_total:6.2f} s CPU; probe peak {got[0]:.2f}, RMS {got[1]:.3f}; vs time integration "
-              f"{diff[0]:.1e} (peak), {diff[1]:.1e} (RMS)")
-        hb_rows.append({"N": N, "wall": wall, "cpu": cpu_total, "iterations": sol.iterations,
-                        "peak": got[0], "rms": got[1], "diff": diff.tolist()})
+        rows.append({"N": N, "wall": wall, "cpu": cpu_total, "iterations": sol.iterations,
+                     "peak": got[0], "rms": got[1], "diff": diff.tolist()})
         prev = sol
+    return rows
+
+
+def engine(quick: bool, hz: float = 12.5, reuse_ti: bool = False, repeats: int = 3) -> dict:
+    """Time integration from rest to periodic steady state vs HB continued in N, same network.
+
+    ``reuse_ti``: take the time-integration reference from an earlier ``bench.json`` (it costs
+    minutes; HB is what changes).  HB: median over ``repeats`` runs of the whole N chain.
+    """
+    net = build(load_scene("engine_gear_train"))
+    probe = net.link_names.index("crank_gear-idler_gear")
+    r_probe = net.radius[net.i[probe]]
+    omega = 2 * np.pi * hz
+    rows: dict = {"frequency_hz": hz}
+    old = OUT / "bench.json"
+    if reuse_ti and old.exists():
+        rows["ti"] = json.loads(old.read_text())["engine"]["ti"]
+        rows["ti"]["reused"] = True
+        ti = rows["ti"]
+        print(f"time integration (reused from {old}): {ti['periods']} periods, {ti['wall']:.1f} s wall, "
+              f"{ti['cpu']:.1f} s CPU; probe peak {ti['peak']:.2f} N m, RMS {ti['rms']:.3f} N m")
+    else:
+        cpu = time.process_time()
+        ti = transient.steady_state(net, omega, rtol=1e-7, atol=1e-13, tol=1e-6, max_periods=400, samples=4096)
+        ti_cpu = time.process_time() - cpu
+        stats = probe_stats(ti.link_forces[probe] * r_probe)
+        print(f"time integration DOP853 rtol 1e-7 from rest: {ti.periods} periods to repeat within 1e-6, "
+              f"{ti.wall:.1f} s wall, {ti_cpu:.1f} s CPU, {ti.nfev} RHS calls; probe peak {stats[0]:.2f} N m, "
+              f"RMS {stats[1]:.3f} N m")
+        rows["ti"] = {"periods": ti.periods, "wall": ti.wall, "cpu": ti_cpu, "nfev": ti.nfev,
+                      "peak": stats[0], "rms": stats[1]}
+    ti_stats = np.array([rows["ti"]["peak"], rows["ti"]["rms"]])
+    runs = [hb_chain(net, omega, probe, ti_stats) for _ in range(1 if quick else repeats)]
+    hb_rows = []
+    for k, row in enumerate(runs[0]):
+        row = dict(row)
+        for key in ("wall", "cpu"):
+            row[key] = float(np.median([run[k][key] for run in runs]))
+            row[key + "_runs"] = [run[k][key] for run in runs]
+        hb_rows.append(row)
+        print(f"HB N={row['N']:3d}: {row['iterations']:3d} Newton iterations, cumulative {row['wall']:6.2f} s wall, "
+              f"{row['cpu']:6.2f} s CPU (median of {len(runs)}); probe peak {row['peak']:.2f}, RMS {row['rms']:.3f}; "
+              f"vs time integration {row['diff'][0]:.1e} (peak), {row['diff'][1]:.1e} (RMS); speed-up "
+              f"{rows['ti']['cpu'] / row['cpu']:.0f}x CPU, {rows['ti']['wall'] / row['wall']:.0f}x wall")
     rows["hb"] = hb_rows
-    print(f"==> speed-up of HB (N = 192, cumulative) over time integration: {rows['ti']['wall'] / wall:.0f}x wall, "
-          f"{ti_cpu / cpu_total:.0f}x CPU")
     return rows
 
 
@@ -118,7 +143,9 @@ def scaling(quick: bool) -> dict:
 def main() -> None:
     quick = "--quick" in sys.argv
     print(f"machine: {machine()}")
-    results = {"machine": machine(), "engine": engine(quick), "scaling": scaling(quick)}
+    results = {"machine": machine(), "engine": engine(quick, reuse_ti="--reuse-ti" in sys.argv)}
+    if "--engine-only" not in sys.argv:
+        results["scaling"] = scaling(quick)
     OUT.mkdir(parents=True, exist_ok=True)
     (OUT / "bench.json").write_text(json.dumps(results, indent=1))
     print(f"wrote {OUT / 'bench.json'}")

@@ -132,3 +132,28 @@ def test_diagonal_fast_path_with_one_backlash_link():
     d_sweep, _, _ = hb.newton_step(net, omega, a, p, M, topo, D, "sweep")
     d_lu, _, _ = hb.newton_step(net, omega, a, p, M, topo, D, "sparse")
     assert np.abs(d_sweep - d_lu).max() <= 1e-10 * np.abs(d_lu).max()
+
+
+def test_mixed_real_basis_sweep_equals_full_complex_sweep():
+    """Mixed storage + real cos/sin basis (Newton steps) == the full complex block sweep, also when the
+    root is away from the backlash links (dense fill-in through linear links, diagonal children of dense nodes)."""
+    rng = np.random.default_rng(11)
+    parents = branched_parents()
+    net0 = random_network(rng, parents)
+    E = net0.n_links
+    law = np.zeros(E, int)
+    law[[3, 12, 15]] = 1
+    net = build_network(net0.m, net0.b, net0.i, net0.j, net0.k_out, d=net0.d, law=law, k_in=0.05 * net0.k_out,
+                        h=np.full(E, 1e-4), orders=net0.orders, Q=net0.Q * 10)
+    N, omega = 7, 140.0
+    M, D, p = hb.default_samples(N), net.incidence(), hb.load_harmonics(net, N)
+    a = hb.solve_linear(net, omega, N).a
+    r, Nb, L = hb.linearize(net, omega, a, p, M, D)
+    _, Nd, Ld, dense, Ldense = hb.linearize_mixed(net, omega, a, p, M, D)
+    g = -hb._symmetrize(r)
+    for topo in (hb.prepare(net), sweep.through_numbering(net.n_nodes, net.i, net.j)):
+        ref = sweep.block_sweep(topo, Nb, L, net.i, net.j, g[:, None])[:, 0]
+        got = sweep.block_sweep_mixed(topo, Nd, Ld, dense, Ldense, net.i, net.j, g)
+        assert np.abs(got - ref).max() <= 1e-10 * np.abs(ref).max()
+        res = sweep.apply_mixed(Nd, Ld, dense, Ldense, net.i, net.j, got) - g
+        assert np.linalg.norm(res) <= 1e-10 * np.linalg.norm(g)
