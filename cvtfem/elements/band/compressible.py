@@ -49,7 +49,13 @@ class CompressibleBand:
         c_edge = p.c / 2 if p.source_literal else p.c
         omega_z = np.sqrt(2 * c_edge * np.pi * r0 / min(p.m_sheave))
         nx = 1 + n + (4 if self.shaft_compliance else 0)
-        self._c.update(xi=xi, wq=wq, F=F, dF=dF, nx=nx, c_edge=c_edge,
+        # x_k = q[xidx[k]] (disjoint index rows, so scatter-adds can use fancy indexing)
+        xidx = np.array([np.r_[4 + k, 6 + k * n:6 + (k + 1) * n]
+                         if not self.shaft_compliance else
+                         np.r_[4 + k, 6 + k * n:6 + (k + 1) * n, 6 + 2 * n + 4 * k:10 + 2 * n + 4 * k]
+                         for k in range(2)])
+        self._c.update(xi=xi, wq=wq, F=F, dF=dF, nx=nx, c_edge=c_edge, xidx=xidx, bidx=np.r_[0, 1, 6:6 + 2 * n],
+                       ones=np.ones((2, 1, len(xi))), mdF=-dF[None],
                        beta=2 * p.damping_ratio / omega_z if p.damping else 0.0, alpha=ritz_alpha(n))
 
     @property
@@ -74,11 +80,7 @@ class CompressibleBand:
     # --- index helpers -------------------------------------------------------------------------
     def _x(self, q, k: int):
         """Elastic coordinates ``x_k = [z_k, h_k, U_k, psi_k]`` of arc k."""
-        n = self.p.n_ritz
-        parts = [q[4 + k:5 + k], q[6 + k * n:6 + (k + 1) * n]]
-        if self.shaft_compliance:
-            parts.append(q[6 + 2 * n + 4 * k:10 + 2 * n + 4 * k])
-        return np.concatenate(parts)
+        return q[self._c["xidx"][k]]
 
     def _scatter_x(self, out, k: int, values) -> None:
         n = self.p.n_ritz
@@ -88,21 +90,20 @@ class CompressibleBand:
             out[6 + 2 * n + 4 * k:10 + 2 * n + 4 * k] += values[1 + n:]
 
     def _band_index(self) -> np.ndarray:
-        n = self.p.n_ritz
-        return np.r_[0, 1, 6:6 + 2 * n]
+        return self._c["bidx"]
 
     # --- kernels -------------------------------------------------------------------------------
     def arcs(self, phi):
         """Per-arc geometry at ``phi`` (complex allowed): dict of ``(2,)`` and ``(2, g)`` arrays."""
         p, c = self.p, self._c
         r, dr, _ = radii(phi, p.length, p.L)
-        ts = np.stack([np.pi / 2 + phi, np.pi / 2 - phi])
-        tg = np.stack([p.sheaves[k].tan_gamma(r[k]) for k in range(2)])
-        z0 = np.stack([p.sheaves[k].z0(r[k]) for k in range(2)])
+        ts = np.array([np.pi / 2 + phi, np.pi / 2 - phi])
+        tg = np.array([p.sheaves[0].tan_gamma(r[0]), p.sheaves[1].tan_gamma(r[1])])
+        z0 = np.array([p.sheaves[0].z0(r[0]), p.sheaves[1].z0(r[1])])
         th = ts[:, None] * c["xi"]
-        fr = -c["dF"][None] / ts[:, None, None]  # (2, n, g)
+        fr = c["mdF"] / ts[:, None, None]  # (2, n, g)
         geo = dict(r=r, dr=dr, ts=ts, tg=tg, z0=z0, th=th, fr=fr, ds=(r * ts)[:, None] * c["wq"])
-        rows = [np.ones_like(th)[:, None], tg[:, None, None] * fr]
+        rows = [c["ones"], tg[:, None, None] * fr]
         if self.shaft_compliance:
             a = np.stack([p.sheaves[k].lever(r[k]) for k in range(2)])
             tabs = th + np.array([0.0, np.pi])[:, None]
@@ -119,7 +120,7 @@ class CompressibleBand:
         g = self.arcs(phi) if geo is None else geo
         n, rho = p.n_ritz, p.rho
         M = np.zeros((2 + 2 * n, 2 + 2 * n), dtype=np.result_type(phi, float))
-        M[0, 0] = band_inertia(phi, p.length, p.L, p.mass)
+        M[0, 0] = band_inertia(phi, p.length, p.L, p.mass, r=g["r"])
         M[1, 1] = p.mass
         for k in range(2):
             sl = slice(2 + k * n, 2 + (k + 1) * n)
@@ -131,7 +132,8 @@ class CompressibleBand:
 
     def strain(self, q, geo):
         """Band-edge strain ``eps`` at the nodes, ``(2, g)`` (1.55) / (1.63)."""
-        return np.stack([-geo["z0"][k] + self._x(q, k) @ geo["E"][k] for k in range(2)])
+        X = q[self._c["xidx"]]  # (2, nx)
+        return np.einsum("kx,kxg->kg", X, geo["E"]) - geo["z0"][:, None]
 
     def accel(self, q, v, F, M):
         """Accelerations and diagnostics (``N`` (2, g) N/m, ``dissipation``, ``clamp_power`` W, slips)."""
@@ -139,15 +141,15 @@ class CompressibleBand:
         n, n2 = p.n_ritz, self.n2
         phi = q[0]
         gc = self.arcs(phi + 1j * H)
-        g = {k: (val.real if np.iscomplexobj(val) else val) for k, val in gc.items()}
+        g = {k: (val.real if val.dtype.kind == "c" else val) for k, val in gc.items()}
         eps_c = self.strain(q, gc)
         eps, deps = eps_c.real, eps_c.imag / H
         Q = np.zeros(n2)
         # elastic band energy and its generalized forces
         Pi_c = c["c_edge"] * np.sum(eps_c ** 2 * gc["ds"])
         Q[0] -= Pi_c.imag / H
-        for k in range(2):
-            self._scatter_x(Q, k, -2 * c["c_edge"] * (g["E"][k] @ (eps[k] * g["ds"][k])))
+        xidx = c["xidx"]
+        Q[xidx] -= 2 * c["c_edge"] * np.einsum("kxg,kg->kx", g["E"], eps * g["ds"])
         Q[4:6] -= p.kappa * np.asarray(F)
         dissipation = 0.0
         if self.shaft_compliance:
@@ -161,11 +163,10 @@ class CompressibleBand:
                     Q[b:b + 4] -= d * v[b:b + 4]
                     dissipation += float(np.sum(d * v[b:b + 4] ** 2))
         if c["beta"] > 0:
-            deps_dt = deps * v[0] + np.stack([self._x(v, k) @ g["E"][k] for k in range(2)])
+            deps_dt = deps * v[0] + np.einsum("kx,kxg->kg", v[xidx], g["E"])
             Qd = np.zeros(n2)
             Qd[0] = -2 * c["beta"] * c["c_edge"] * np.sum(deps_dt * deps * g["ds"])
-            for k in range(2):
-                self._scatter_x(Qd, k, -2 * c["beta"] * c["c_edge"] * (g["E"][k] @ (deps_dt[k] * g["ds"][k])))
+            Qd[xidx] = -2 * c["beta"] * c["c_edge"] * np.einsum("kxg,kg->kx", g["E"], deps_dt * g["ds"])
             dissipation -= float(Qd @ v)
             Q += Qd
         info = {"N": np.zeros_like(eps), "eps": eps}
@@ -178,7 +179,7 @@ class CompressibleBand:
             vt = v[1] - g["r"] * v[2:4]
             info.update(slip=vt, slip_max=np.abs(vt))
         Q[2:4] += M
-        a = self._solve(q, v, Q, phi)
+        a = self._solve(q, v, Q, phi, gc)
         info.update(dissipation=dissipation, clamp_power=float(-p.kappa * np.dot(F, v[4:6])))
         return a, info
 
@@ -218,11 +219,11 @@ class CompressibleBand:
                 Q[b + 4 * k:b + 4 * k + 4] = [QU1[k], QU2[k], Qp1[k], Qp2[k]]
         return Q, N, vr
 
-    def _solve(self, q, v, Q, phi):
+    def _solve(self, q, v, Q, phi, gc=None):
         p, n = self.p, self.p.n_ritz
         a = np.empty(self.n2)
         bi = self._band_index()
-        Mc = self.band_mass(phi + 1j * H)
+        Mc = self.band_mass(phi + 1j * H, gc)  # gc: the geometry accel already built at phi + iH
         Mb, dMb = Mc.real, Mc.imag / H
         vb = v[bi]
         rhs = Q[bi] - v[0] * (dMb @ vb)
