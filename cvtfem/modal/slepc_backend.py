@@ -70,15 +70,7 @@ def solve_pep(M: sp.spmatrix, K: sp.spmatrix, D: sp.spmatrix, n_eig: int, sigma:
     pep.setScale(SLEPc.PEP.Scale.SCALAR)      # K and M differ by many orders of magnitude
     pep.setTarget(sigma)
     pep.setWhichEigenpairs(SLEPc.PEP.Which.TARGET_MAGNITUDE)
-    st = pep.getST()
-    st.setType(SLEPc.ST.Type.SINVERT)
-    st.getKSP().setType("preonly")
-    st.getKSP().getPC().setType("lu")
-    pep.setTolerances(tol=tol, max_it=1000)
-    pep.solve()
-    nconv = pep.getConverged()
-    if nconv == 0:
-        raise NumericalError("SLEPc PEP found no eigenpairs", component="modal.slepc")
+    nconv = _solve_shift_invert(pep, tol, "PEP")
     xr, xi = pep.getOperators()[0].createVecs()
     lam = np.empty(nconv, dtype=complex)
     X = np.empty((M.shape[0], nconv), dtype=complex)
@@ -87,6 +79,22 @@ def solve_pep(M: sp.spmatrix, K: sp.spmatrix, D: sp.spmatrix, n_eig: int, sigma:
         X[:, i] = xr.getArray() + 1j * xi.getArray() if np.isrealobj(xr.getArray()) else xr.getArray()
     pep.destroy()
     return lam, X
+
+
+def _solve_shift_invert(solver, tol: float, kind: str) -> int:
+    """Shift-invert with a direct LU, solve, and return the number of converged pairs (SLEPc PEP or EPS)."""
+    from slepc4py import SLEPc
+
+    st = solver.getST()
+    st.setType(SLEPc.ST.Type.SINVERT)
+    st.getKSP().setType("preonly")
+    st.getKSP().getPC().setType("lu")
+    solver.setTolerances(tol=tol, max_it=1000)
+    solver.solve()
+    nconv = solver.getConverged()
+    if nconv == 0:
+        raise NumericalError(f"SLEPc {kind} found no eigenpairs", component="modal.slepc")
+    return nconv
 
 
 def solve_gep(M: sp.spmatrix, K: sp.spmatrix, n_eig: int, sigma: float,
@@ -111,15 +119,7 @@ def solve_gep(M: sp.spmatrix, K: sp.spmatrix, n_eig: int, sigma: float,
     eps.setDimensions(nev=nev, ncv=min(n, max(2 * nev, nev + 15)))
     eps.setTarget(-sigma * sigma)
     eps.setWhichEigenpairs(SLEPc.EPS.Which.TARGET_MAGNITUDE)
-    st = eps.getST()
-    st.setType(SLEPc.ST.Type.SINVERT)
-    st.getKSP().setType("preonly")
-    st.getKSP().getPC().setType("lu")
-    eps.setTolerances(tol=tol, max_it=1000)
-    eps.solve()
-    nconv = eps.getConverged()
-    if nconv == 0:
-        raise NumericalError("SLEPc EPS found no eigenpairs", component="modal.slepc")
+    nconv = _solve_shift_invert(eps, tol, "EPS")
     xr, xi = eps.getOperators()[0].createVecs()
     w2 = np.empty(nconv)
     X = np.empty((M.shape[0], nconv), dtype=complex)
