@@ -132,22 +132,27 @@ class ClosedLoop:
         z = self.control.initial_state(w1, w1 / i) if self.control else np.zeros(0)
         return np.concatenate([q, v, z, np.zeros(4)])
 
-    def evaluate(self, t: float, x):
-        """Right-hand side and everything an output needs: ``(dx, loads, info)``."""
-        q, v, z, _ = self.split(x)
+    def _controls(self, t: float, w, z):
+        """Clamping forces, shaft torques and controller derivative at shaft speeds ``w`` (rad/s), state z."""
         w1d, M1, i_d = self.regime.targets(t)
         w2d = w1d / i_d
         F_appl = self.clamping.forces(M1, i_d)
-        k1, k2 = self.model.speed_indices()
-        w = np.array([v[k1], v[k2]])
         if self.control is not None:
             F, M2, dz, diag = self.control.outputs(w, z, i_d, w2d, M1, F_appl)
         else:
             b20 = M1 * i_d / w2d
             F, M2, dz, diag = F_appl, -b20 * w[1], np.zeros(0), {"ratio_estimate": w[0] / w[1], "resistance": b20}
-        a, info = self.model.accel(q, v, F, np.array([M1, M2]))
-        dW = np.array([M1 * w[0], -M2 * w[1], info["dissipation"], info["clamp_power"]])
-        info.update(diag, F=F, M=np.array([M1, M2]), w=w, targets=(w1d, M1, i_d))
+        return F, np.array([M1, M2]), dz, diag, (w1d, M1, i_d)
+
+    def evaluate(self, t: float, x):
+        """Right-hand side and everything an output needs: ``(dx, loads, info)``."""
+        q, v, z, _ = self.split(x)
+        k1, k2 = self.model.speed_indices()
+        w = np.array([v[k1], v[k2]])
+        F, M, dz, diag, targets = self._controls(t, w, z)
+        a, info = self.model.accel(q, v, F, M)
+        dW = np.array([M[0] * w[0], -M[1] * w[1], info["dissipation"], info["clamp_power"]])
+        info.update(diag, F=F, M=M, w=w, targets=targets)
         return np.concatenate([v, a, dz, dW]), info
 
     def rhs(self, t: float, x):
@@ -155,6 +160,53 @@ class ClosedLoop:
         return self.evaluate(t, x)[0]
 
     def jac(self, t: float, x):
+        """Jacobian ``d rhs / dx``: chain rule through the model's own Jacobian when it has one
+        (``model.jacobian(q, v, F, M)``, rows ``[a, dissipation, clamp_power]``, columns ``[q, v, F, M]``)
+        and a difference quotient of the loops' outputs in the shaft speeds and the controller state;
+        otherwise :meth:`jac_fd`.
+        """
+        if not hasattr(self.model, "jacobian"):
+            return self.jac_fd(t, x)
+        n, nc = self.model.n2, self.n_ctrl
+        q, v, z, _ = self.split(x)
+        k1, k2 = self.model.speed_indices()
+        w = np.array([v[k1], v[k2]])
+        F, M, dz, _, _ = self._controls(t, w, z)
+        # d(F1, F2, M1, M2, dz) / d(w1, w2, z) by forward differences (the loops are cheap and piecewise smooth)
+        u0 = np.concatenate([F, M, dz])
+        G = np.zeros((4 + nc, 2 + nc))
+        for j in range(2 + nc):
+            wp, zp = w.copy(), z.copy()
+            if j < 2:
+                h = 1e-7 * max(1.0, abs(w[j]))
+                wp[j] += h
+            else:
+                h = 1e-7 * max(1.0, abs(z[j - 2]))
+                zp[j - 2] += h
+            Fp, Mp, dzp, _, _ = self._controls(t, wp, zp)
+            G[:, j] = (np.concatenate([Fp, Mp, dzp]) - u0) / h
+        Ja = self.model.jacobian(q, v, F, M)  # (n + 2, 2 n + 4)
+        AU = Ja[:, 2 * n:] @ G[:4]  # model rows through the loops' outputs, (n + 2, 2 + nc)
+        Jm = np.zeros((x.size, x.size))
+        Jm[:n, n:2 * n] = np.eye(n)
+        rows = slice(n, 2 * n)
+        Jm[rows, :2 * n] = Ja[:n, :2 * n]
+        Jm[rows, [n + k1, n + k2]] += AU[:n, :2]
+        Jm[rows, 2 * n:2 * n + nc] = AU[:n, 2:]
+        Jm[2 * n:2 * n + nc, [n + k1, n + k2]] = G[4:, :2]
+        Jm[2 * n:2 * n + nc, 2 * n:2 * n + nc] = G[4:, 2:]
+        iw = 2 * n + nc  # work integrals: [M1 w1, -M2 w2, dissipation, clamping power]
+        dM = G[2:4]  # d(M1, M2) / d(w, z)
+        Jm[iw, [n + k1, n + k2]] = M[0] * np.array([1.0, 0.0]) + w[0] * dM[0, :2]
+        Jm[iw, 2 * n:iw] = w[0] * dM[0, 2:]
+        Jm[iw + 1, [n + k1, n + k2]] = -M[1] * np.array([0.0, 1.0]) - w[1] * dM[1, :2]
+        Jm[iw + 1, 2 * n:iw] = -w[1] * dM[1, 2:]
+        Jm[iw + 2:iw + 4, :2 * n] = Ja[n:, :2 * n]
+        Jm[iw + 2:iw + 4, [n + k1, n + k2]] += AU[n:, :2]
+        Jm[iw + 2:iw + 4, 2 * n:iw] = AU[n:, 2:]
+        return Jm
+
+    def jac_fd(self, t: float, x):
         """Finite-difference Jacobian ``d rhs / dx`` over the states the right-hand side depends on.
 
         Rotation angles (sigma, phi1, phi2: indices 1..3 of q) and the work integrals never enter the

@@ -3,13 +3,16 @@
 Prints the median of several runs for each model and integrator setting, with the machine.
 Target (issue 5, not asserted): <= 0.1 s wall per simulated second for band-4dof and band-6+2n (n = 5).
 BDF is slow on the compressible models (lightly damped elastic modes; BDF orders > 2 are not
-A-stable): pass ``--methods Radau`` for them.
+A-stable): pass ``--methods Radau`` for them.  ``--settings Radau:1e-3:1e-5`` replaces the list of
+settings, ``--nodes 8`` overrides the Gauss nodes per arc, ``--numpy`` runs the numpy twin of the
+compiled right-hand side, ``--fd-jac`` the finite-difference Jacobian of the whole loop.
 
     .venv/bin/python studies/lowered/bench_realtime.py [--repeat 3] [--until 1.0]
 """
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import os
 import platform
 import statistics
@@ -24,13 +27,17 @@ SETTINGS = [("Radau", 1e-6, 1e-8), ("Radau", 1e-4, 1e-6), ("BDF", 1e-4, 1e-6), (
             ("LSODA", 1e-4, 1e-6)]
 
 
-def bench(name: str, method: str, rtol: float, atol: float, until: float, repeat: int, **over):
+def bench(name: str, method: str, rtol: float, atol: float, until: float, repeat: int, numpy: bool = False,
+          fd_jac: bool = False, **over):
     loop = closed_loop(load_scene(name), **over)
+    if numpy and hasattr(loop.model, "use_numba"):
+        loop = dataclasses.replace(loop, model=dataclasses.replace(loop.model, use_numba=False))
     walls, last = [], None
     for _ in range(repeat):
         x0 = loop.initial_state()
         t0 = time.perf_counter()
-        sol = solve_ivp(loop.rhs, (0, until), x0, method=method, rtol=rtol, atol=atol, jac=loop.jac)
+        sol = solve_ivp(loop.rhs, (0, until), x0, method=method, rtol=rtol, atol=atol,
+                        jac=loop.jac_fd if fd_jac else loop.jac)
         walls.append(time.perf_counter() - t0)
         last = sol
     n = loop.model.n2
@@ -44,17 +51,25 @@ def main() -> None:
     ap.add_argument("--until", type=float, default=1.0)
     ap.add_argument("--models", nargs="*", default=["band-4dof", "band-6+2n", "band-6+2n+8"])
     ap.add_argument("--methods", nargs="*", default=None, help="only these methods (e.g. Radau BDF)")
+    ap.add_argument("--settings", nargs="*", default=None, help="METHOD:RTOL:ATOL entries replacing the defaults")
+    ap.add_argument("--nodes", type=int, default=0, help="Gauss nodes per arc (compressible models; 0: preset)")
+    ap.add_argument("--numpy", action="store_true", help="numpy twin instead of the compiled right-hand side")
+    ap.add_argument("--fd-jac", action="store_true", help="finite-difference Jacobian of the whole loop")
     args = ap.parse_args()
+    settings = SETTINGS if args.settings is None else [
+        (m, float(r), float(a)) for m, r, a in (e.split(":") for e in args.settings)]
     load = os.getloadavg()[0] if hasattr(os, "getloadavg") else float("nan")
     print(f"machine: {platform.processor() or platform.machine()}, {os.cpu_count()} cores, "
           f"python {platform.python_version()}, load average {load:.1f}")
     print(f"{'model':<13} {'method':<6} {'rtol':>7} {'wall/s_sim':>11} {'steps':>6} {'nfev':>6} {'njev':>5} "
           f"{'ratio':>7} {'x real time':>11}")
     for name in args.models:
-        for method, rtol, atol in SETTINGS:
+        over = {"n_gauss": args.nodes} if args.nodes and name != "band-4dof" else {}
+        for method, rtol, atol in settings:
             if args.methods and method not in args.methods:
                 continue
-            wall, nfev, njev, steps, ratio, status = bench(name, method, rtol, atol, args.until, args.repeat)
+            wall, nfev, njev, steps, ratio, status = bench(name, method, rtol, atol, args.until, args.repeat,
+                                                           args.numpy, args.fd_jac, **over)
             per = wall / args.until
             print(f"{name:<13} {method:<6} {rtol:>7.0e} {per:>11.3f} {steps:>6} {nfev:>6} {njev:>5} {ratio:>7.4f} "
                   f"{1 / per:>11.2f}", flush=True)

@@ -1,0 +1,353 @@
+"""Compiled right-hand side of the 6+2n / 6+2n+8 band models (numba), with a finite-difference Jacobian.
+
+The numpy methods of :class:`~cvtfem.elements.band.compressible.CompressibleBand` are the reference
+twin: ``accel_kernel`` computes the same accelerations, normal forces and powers statement by
+statement (same complex-step derivatives in phi, same quadrature), only without numpy's per-call
+overhead on 16-node arrays (``tests/band/test_compressible_kernel.py`` checks them against each other).
+Without numba (``HAVE_NUMBA`` false) the model uses its numpy methods.
+
+Parameters are packed by :func:`pack`: ``s`` (scalars, index constants ``S_*``), ``sh`` (2, 5) sheave
+faces ``[profile (0 conical, 1 toroidal), gamma, R, y, w]``, ``sf`` (2, 5) shafts
+``[J, m_sheave, Theta, c_U, c_psi]``, ``xidx`` (2, nx) elastic-coordinate indices, and the Ritz shapes.
+Complex powers are written as products: numba's complex ``z ** k`` goes through exp/log, whose
+rounding (~1e-16 |z|^k in the imaginary part) swamps a 1e-30 complex step.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+try:
+    from numba import njit
+    HAVE_NUMBA = True
+except ImportError:  # pragma: no cover - exercised only without numba
+    HAVE_NUMBA = False
+
+    def njit(*args, **kwargs):  # noqa: D103 - identity decorator, the kernels then run as (slow) Python
+        return (lambda f: f) if not args or not callable(args[0]) else args[0]
+
+H = 1e-30  # complex step, as in compressible.py
+LAW_CODES = {"tanh": 0, "smoothed": 1, "linear-saturated": 2}
+# scalar slots of ``s``
+(S_LENGTH, S_L, S_MASS, S_RHO, S_CEDGE, S_C, S_KAPPA, S_BETA, S_F0, S_V0, S_LAW, S_FRICTION, S_SHAFT,
+ S_DAMPING, S_GYRO, S_NU) = range(16)
+
+
+def pack(model) -> tuple:
+    """Kernel arguments of a :class:`CompressibleBand` (arrays only, built once per model)."""
+    p, c = model.p, model._c
+    s = np.array([p.length, p.L, p.mass, p.rho, c["c_edge"], p.c, p.kappa, c["beta"], p.f0, p.v0,
+                  LAW_CODES[p.law], p.friction, model.shaft_compliance, p.damping, p.gyroscopic, p.damping_ratio],
+                 dtype=float)
+    sh = np.array([[0.0 if f.profile == "conical" else 1.0, f.gamma, f.R, f.y, f.w] for f in p.sheaves])
+    sf = np.array([[p.J[k], p.m_sheave[k], p.Theta[k], p.c_U[k], p.c_psi[k]] for k in range(2)])
+    return s, sh, sf, np.ascontiguousarray(c["xidx"]), c["xi"], c["wq"], c["F"], c["dF"]
+
+
+@njit(cache=True)
+def _face(shk, r):
+    """``(tan gamma, z0, lever)`` of sheave face ``shk`` at contact radius r (complex), as Sheave does."""
+    if shk[0] == 0.0:
+        tg = np.tan(shk[1]) + 0.0 * r
+        z0 = shk[4] - r * np.tan(shk[1])
+    else:
+        u = (r + shk[3]) / shk[2]
+        tg = u / np.sqrt(1.0 - u * u)
+        z0 = shk[4] + np.sqrt(shk[2] * shk[2] - (r + shk[3]) * (r + shk[3]))
+    return tg, z0, shk[4] - z0
+
+
+@njit(cache=True)
+def _geometry(phi, s, sh, xi, wq, dF, nx, shaft):
+    """Arc geometry at complex phi: r, dr, tg, z0, lever (2,), th, ds (2, g), fr (2, n, g), E (2, nx, g)."""
+    length, L = s[S_LENGTH], s[S_L]
+    sn, cs = np.sin(phi), np.cos(phi)
+    S = (length - 2 * L * (cs + phi * sn)) / np.pi
+    n, g = dF.shape
+    r = np.empty(2, np.complex128)
+    dr = np.empty(2, np.complex128)
+    ts = np.empty(2, np.complex128)
+    tg = np.empty(2, np.complex128)
+    z0 = np.empty(2, np.complex128)
+    lev = np.empty(2, np.complex128)
+    th = np.empty((2, g), np.complex128)
+    ds = np.empty((2, g), np.complex128)
+    fr = np.empty((2, n, g), np.complex128)
+    E = np.zeros((2, nx, g), np.complex128)
+    cth = np.zeros((2, g))
+    sth = np.zeros((2, g))
+    for k in range(2):
+        sg = 1.0 - 2.0 * k
+        r[k] = 0.5 * (S + sg * L * sn)
+        dr[k] = L * cs * (0.5 * sg - phi / np.pi)
+        ts[k] = np.pi / 2 + sg * phi
+        tg[k], z0[k], lev[k] = _face(sh[k], r[k])
+        for j in range(g):
+            th[k, j] = ts[k] * xi[j]
+            ds[k, j] = r[k] * ts[k] * wq[j]
+            E[k, 0, j] = 1.0
+            for i in range(n):
+                fr[k, i, j] = -dF[i, j] / ts[k]
+                E[k, 1 + i, j] = tg[k] * fr[k, i, j]
+            if shaft:
+                ta = th[k, j] + np.pi * k
+                ca, sa = np.cos(ta), np.sin(ta)
+                cth[k, j], sth[k, j] = ca.real, sa.real
+                lv = r[k] + tg[k] * lev[k]
+                E[k, n + 1, j] = -tg[k] * ca
+                E[k, n + 2, j] = -tg[k] * sa
+                E[k, n + 3, j] = lv * sa
+                E[k, n + 4, j] = -lv * ca
+    return r, dr, tg, z0, lev, th, ds, fr, E, cth, sth
+
+
+@njit(cache=True)
+def _band_inertia(phi, r, s):
+    """A(phi) of eq. (1.45, corrected), as ``inertia.band_inertia``."""
+    L = s[S_L]
+    p1, p2 = np.pi + 2 * phi, np.pi - 2 * phi
+    b1, b2 = 0.5 - phi / np.pi, 0.5 + phi / np.pi
+    f2 = phi * phi
+    cphi = np.cos(phi)
+    arcs = r[0] * (p1 + p1 * p1 * p1 / 12) * b1 * b1 + r[1] * (p2 + p2 * p2 * p2 / 12) * b2 * b2
+    spans = L * cphi * (1 / 6 + np.pi ** 2 / 8 - (1 - 2 / np.pi ** 2) * f2 + 2 * f2 * f2 / np.pi ** 2)
+    return s[S_RHO] * L * L * cphi * cphi * (arcs + spans)
+
+
+@njit(cache=True)
+def _band_mass(phi, s, r, dr, th, ds, fr, Fs):
+    """Band block of the mass matrix over ``[phi, sigma, h1, h2]`` (complex), as ``band_mass``."""
+    n, g = Fs.shape
+    rho = s[S_RHO]
+    M = np.zeros((2 + 2 * n, 2 + 2 * n), np.complex128)
+    M[0, 0] = _band_inertia(phi, r, s)
+    M[1, 1] = s[S_MASS]
+    for k in range(2):
+        o = 2 + k * n
+        for i in range(n):
+            a1 = 0.0j
+            a0 = 0.0j
+            for j in range(g):
+                a1 += Fs[i, j] * ds[k, j]
+                a0 += (fr[k, i, j] - th[k, j] * Fs[i, j]) * ds[k, j]
+            M[1, o + i] = M[o + i, 1] = rho * a1
+            M[0, o + i] = M[o + i, 0] = rho * dr[k] * a0
+            for m in range(i, n):
+                acc = 0.0j
+                for j in range(g):
+                    acc += (fr[k, i, j] * fr[k, m, j] + Fs[i, j] * Fs[m, j]) * ds[k, j]
+                M[o + i, o + m] = M[o + m, o + i] = rho * acc
+    return M
+
+
+@njit(cache=True)
+def _gain(x, law):
+    """``f(v) / v`` in units of ``f0 / v0`` at ``x = v / v0``, as ``friction.friction_gain``."""
+    if law == 0:
+        return np.tanh(x) / x if x > 1e-8 else 1.0 - x * x / 3
+    if law == 1:
+        return 1.5 - 0.5 * x * x if x < 1.0 else 1.0 / x
+    return 1.0 if x < 1.0 else 1.0 / x
+
+
+@njit(cache=True)
+def accel_kernel(q, v, F, Mt, s, sh, sf, xidx, xi, wq, Fs, dF):
+    """Accelerations ``a`` (n2,), normal force ``N`` (2, g) N/m, strain ``eps`` (2, g), circumferential slip
+    at the arc middles and largest slip per arc (2,) m/s, dissipation and clamping power (W); the numpy
+    ``CompressibleBand.accel`` statement by statement."""
+    n, g = Fs.shape
+    n2 = q.size
+    nx = xidx.shape[1]
+    shaft = s[S_SHAFT] != 0.0
+    ce = s[S_CEDGE]
+    rc, drc, tgc, z0c, levc, thc, dsc, frc, Ec, cs, sn = _geometry(q[0] + 1j * H, s, sh, xi, wq, dF, nx, shaft)
+    r, dr, tg, th, ds, fr, E, lev = rc.real, drc.real, tgc.real, thc.real, dsc.real, frc.real, Ec.real, levc.real
+    Q = np.zeros(n2)
+    eps = np.empty((2, g))
+    deps = np.empty((2, g))
+    Pi_im = 0.0
+    for k in range(2):
+        for j in range(g):
+            e = -z0c[k]
+            for x in range(nx):
+                e += q[xidx[k, x]] * Ec[k, x, j]
+            eps[k, j], deps[k, j] = e.real, e.imag / H
+            Pi_im += (ce * e * e * dsc[k, j]).imag
+        for x in range(nx):
+            acc = 0.0
+            for j in range(g):
+                acc += E[k, x, j] * eps[k, j] * ds[k, j]
+            Q[xidx[k, x]] -= 2 * ce * acc
+    Q[0] -= Pi_im / H
+    Q[4] -= s[S_KAPPA] * F[0]
+    Q[5] -= s[S_KAPPA] * F[1]
+    dissipation = 0.0
+    b = 6 + 2 * n
+    if shaft:
+        for k in range(2):
+            o = b + 4 * k
+            for i in range(4):
+                stiff = sf[k, 3] if i < 2 else sf[k, 4]
+                Q[o + i] -= stiff * q[o + i]
+                if s[S_DAMPING] != 0.0:
+                    d = 2 * s[S_NU] * np.sqrt(stiff * (sf[k, 1] if i < 2 else sf[k, 2]))
+                    Q[o + i] -= d * v[o + i]
+                    dissipation += d * v[o + i] ** 2
+    beta = s[S_BETA]
+    if beta > 0:
+        Qd = np.zeros(n2)
+        for k in range(2):
+            dd = np.empty(g)
+            for j in range(g):
+                acc = deps[k, j] * v[0]
+                for x in range(nx):
+                    acc += v[xidx[k, x]] * E[k, x, j]
+                dd[j] = acc
+                Qd[0] -= 2 * beta * ce * acc * deps[k, j] * ds[k, j]
+            for x in range(nx):
+                acc = 0.0
+                for j in range(g):
+                    acc += E[k, x, j] * dd[j] * ds[k, j]
+                Qd[xidx[k, x]] = -2 * beta * ce * acc
+        for i in range(n2):
+            dissipation -= Qd[i] * v[i]
+            Q[i] += Qd[i]
+    N = np.zeros((2, g))
+    vr = np.zeros((3, 2, g))
+    if s[S_FRICTION] != 0.0:
+        f0, v0, law = s[S_F0], s[S_V0], int(s[S_LAW])
+        Qf = np.zeros(n2)
+        for k in range(2):
+            cosg = 1.0 / np.sqrt(1.0 + tg[k] ** 2)
+            for j in range(g):
+                vr_r = dr[k] * v[0]
+                vr_t = v[1] - th[k, j] * dr[k] * v[0] - r[k] * v[2 + k]
+                for i in range(n):
+                    hd = v[6 + k * n + i]
+                    vr_r += fr[k, i, j] * hd
+                    vr_t += hd * Fs[i, j]
+                if shaft:
+                    o = b + 4 * k
+                    U0, U1, P0, P1 = v[o], v[o + 1], v[o + 2], v[o + 3]
+                    a = lev[k]
+                    vr_r = vr_r - (U0 * cs[k, j] + U1 * sn[k, j]) - a * (-P0 * sn[k, j] + P1 * cs[k, j])
+                    vr_t = vr_t - (-U0 * sn[k, j] + U1 * cs[k, j]) + a * (P0 * cs[k, j] + P1 * sn[k, j])
+                vr_z = tg[k] * vr_r
+                vr[0, k, j], vr[1, k, j], vr[2, k, j] = vr_r, vr_t, vr_z
+                gn = (f0 / v0) * _gain(np.sqrt(vr_r ** 2 + vr_t ** 2 + vr_z ** 2) / v0, law)
+                Nk = max(0.0, -s[S_C] * eps[k, j] / (cosg + gn * vr_z))
+                N[k, j] = Nk
+                T0, T1, T2 = gn * vr_r * Nk * ds[k, j], gn * vr_t * Nk * ds[k, j], gn * vr_z * Nk * ds[k, j]
+                Tn = T0 + tg[k] * T2
+                Qf[0] -= 2 * dr[k] * (Tn - th[k, j] * T1)
+                Qf[1] -= 2 * T1
+                Qf[2 + k] += 2 * r[k] * T1
+                for i in range(n):
+                    Qf[6 + k * n + i] -= 2 * (fr[k, i, j] * Tn + T1 * Fs[i, j])
+                if shaft:
+                    o = b + 4 * k
+                    a = lev[k]
+                    Qf[o] += 2 * (cs[k, j] * Tn - sn[k, j] * T1)
+                    Qf[o + 1] += 2 * (sn[k, j] * Tn + cs[k, j] * T1)
+                    Qf[o + 2] -= 2 * a * (sn[k, j] * Tn + cs[k, j] * T1)
+                    Qf[o + 3] += 2 * a * (cs[k, j] * Tn - sn[k, j] * T1)
+        for i in range(n2):
+            dissipation -= Qf[i] * v[i]
+            Q[i] += Qf[i]
+    else:
+        for k in range(2):
+            vr[1, k, :] = v[1] - r[k] * v[2 + k]
+    Q[2] += Mt[0]
+    Q[3] += Mt[1]
+    a = _solve(q, v, Q, s, sf, rc, drc, thc, dsc, frc, Fs, q[0] + 1j * H, shaft)
+    clamp_power = -s[S_KAPPA] * (F[0] * v[4] + F[1] * v[5])
+    slip = np.empty(2)
+    slip_max = np.zeros(2)
+    for k in range(2):
+        slip[k] = vr[1, k, g // 2]
+        for j in range(g):
+            slip_max[k] = max(slip_max[k], np.sqrt(vr[0, k, j] ** 2 + vr[1, k, j] ** 2 + vr[2, k, j] ** 2))
+    return a, N, eps, slip, slip_max, dissipation, clamp_power
+
+
+@njit(cache=True)
+def _solve(q, v, Q, s, sf, rc, drc, thc, dsc, frc, Fs, phic, shaft):
+    n = Fs.shape[0]
+    nb = 2 + 2 * n
+    Mc = _band_mass(phic, s, rc, drc, thc, dsc, frc, Fs)
+    Mb = np.ascontiguousarray(Mc.real)
+    dMb = Mc.imag / H
+    bi = np.empty(nb, np.int64)
+    bi[0], bi[1] = 0, 1
+    for i in range(2 * n):
+        bi[2 + i] = 6 + i
+    vb = np.empty(nb)
+    for i in range(nb):
+        vb[i] = v[bi[i]]
+    dv = dMb @ vb
+    rhs = np.empty(nb)
+    for i in range(nb):
+        rhs[i] = Q[bi[i]] - v[0] * dv[i]
+    rhs[0] += 0.5 * np.dot(vb, dv)
+    ab = np.linalg.solve(Mb, rhs)
+    a = np.empty(q.size)
+    for i in range(nb):
+        a[bi[i]] = ab[i]
+    a[4] = Q[4] / sf[0, 1]
+    a[5] = Q[5] / sf[1, 1]
+    if not shaft:
+        a[2] = Q[2] / sf[0, 0]
+        a[3] = Q[3] / sf[1, 0]
+        return a
+    b = 6 + 2 * n
+    for k in range(2):
+        j = b + 4 * k
+        a[j] = Q[j] / sf[k, 1]
+        a[j + 1] = Q[j + 1] / sf[k, 1]
+        J, Th = sf[k, 0], sf[k, 2]
+        p1, p2, d1, d2 = q[j + 2], q[j + 3], v[j + 2], v[j + 3]
+        if s[S_GYRO] != 0.0:
+            w_ax = v[2 + k] + 0.5 * (d1 * p2 - d2 * p1)
+            wdot = Q[2 + k] / J
+            a[j + 2] = (Q[j + 2] - 0.5 * J * wdot * p2 - J * w_ax * d2) / Th
+            a[j + 3] = (Q[j + 3] + 0.5 * J * wdot * p1 + J * w_ax * d1) / Th
+            a[2 + k] = wdot - 0.5 * (a[j + 2] * p2 - a[j + 3] * p1)
+        else:
+            a[j + 2] = Q[j + 2] / Th
+            a[j + 3] = Q[j + 3] / Th
+            a[2 + k] = Q[2 + k] / J
+    return a
+
+
+@njit(cache=True)
+def jacobian_kernel(q, v, F, Mt, s, sh, sf, xidx, xi, wq, Fs, dF):
+    """Forward-difference Jacobian of ``y = [a, dissipation, clamp_power]`` (n2 + 2) with respect to
+    ``[q, v, F, M]`` (2 n2 + 4 columns); the rotation angles q[1:4] never enter, their columns are 0.
+
+    Increments as ``ClosedLoop.jac``: ``1e-8 max(1e-3, |q_j|)`` for coordinates, ``1e-7 max(1, |v_j|)``
+    for velocities; ``y`` is affine in F and M, so their columns are exact to rounding.
+    """
+    n2 = q.size
+    a0, _, _, _, _, d0, c0 = accel_kernel(q, v, F, Mt, s, sh, sf, xidx, xi, wq, Fs, dF)
+    Jm = np.zeros((n2 + 2, 2 * n2 + 4))
+    for col in range(2 * n2 + 4):
+        if 1 <= col <= 3:
+            continue
+        qp, vp, Fp, Mp = q.copy(), v.copy(), F.copy(), Mt.copy()
+        if col < n2:
+            h = 1e-8 * max(1e-3, abs(q[col]))
+            qp[col] += h
+        elif col < 2 * n2:
+            h = 1e-7 * max(1.0, abs(v[col - n2]))
+            vp[col - n2] += h
+        elif col < 2 * n2 + 2:
+            h = 1e-6 * max(1.0, abs(F[col - 2 * n2]))
+            Fp[col - 2 * n2] += h
+        else:
+            h = 1e-6 * max(1.0, abs(Mt[col - 2 * n2 - 2]))
+            Mp[col - 2 * n2 - 2] += h
+        a1, _, _, _, _, d1, c1 = accel_kernel(qp, vp, Fp, Mp, s, sh, sf, xidx, xi, wq, Fs, dF)
+        for i in range(n2):
+            Jm[i, col] = (a1[i] - a0[i]) / h
+        Jm[n2, col] = (d1 - d0) / h
+        Jm[n2 + 1, col] = (c1 - c0) / h
+    return Jm
