@@ -28,7 +28,8 @@ SPLITS = ("equilibrium", "per-shaft")
 #: Smallest prescribed clamping force per pulley, N (assumed: a preload, as the spring of a real driven
 #: pulley, ~3 % of the 30-35 kN at 200 N m, i.e. the estimate (1.13) x 1.1 at ~7 N m).  Without it the
 #: forces vanish with the torque and a torque ramp towards 0 N m ends in gross slip under ~0.4 N, where
-#: the implicit solvers' steps collapse to ~1e-13 s.  It changes nothing above ~7 N m.
+#: the implicit solvers' steps collapse to ~1e-13 s.  It changes nothing above ~7 N m.  Scenes set it
+#: with ``cvt.regime.min_clamping_force`` (same default); this is the default of :class:`Clamping`.
 MIN_CLAMPING_FORCE = 1000.0
 
 

@@ -165,7 +165,6 @@ def check_ratio_range(scene: Scene, p=None) -> tuple[float, float]:
 
 def closed_loop(scene: Scene, **overrides: Any):
     """Scene -> :class:`~cvtfem.control.closed_loop.ClosedLoop` (model, clamping schedule, regime, loops)."""
-    from cvtfem.control import closed_loop as cl
     from cvtfem.control.closed_loop import Clamping, ClosedLoop
     from cvtfem.control.regimes import Regime
     from cvtfem.control.stabilisation import Stabilisation, StabilisationParams
@@ -177,7 +176,7 @@ def closed_loop(scene: Scene, **overrides: Any):
     rg = cvt.regime
     check_ratio_range(scene, p)
     regime = Regime(rg.kind, rg.input_speed, rg.torque, rg.ratio, rg.end_value, rg.ramp_time)
-    clamping = Clamping(p, rg.clamping_safety, rg.clamping_split, cl.MIN_CLAMPING_FORCE)
+    clamping = Clamping(p, rg.clamping_safety, rg.clamping_split, rg.min_clamping_force)
     control = None
     if cvt.effects.stabilisation:
         c = cvt.control
