@@ -17,6 +17,12 @@ SOLVER = Table("solver", "Time integration settings (used by `cvtfem run`).", (
     Key("rtol", "float", "Relative tolerance of adaptive methods.", "-", 1e-6, gt=0.0, lt=1.0),
     Key("atol", "float", "Absolute tolerance of adaptive methods.", "-", 1e-9, gt=0.0),
     Key("max_steps", "int", "Step budget; the run fails with a clear message past it.", "-", 10_000_000, ge=1),
+    Key("error_check", "int", "Fixed steps: estimate the local error every this many steps and warn when it exceeds "
+        "rtol/atol (0: off).", "-", 20, ge=0),
+    Key("on_failure", "str", "On a numerical failure: 'stop' (keep the partial results, exit 3) or 'retry' (from the "
+        "last checkpoint with half the step, then with `solver.fallback`).", "", "stop", choices=("stop", "retry")),
+    Key("max_retries", "int", "Retries of `on_failure = 'retry'` before the run fails.", "-", 3, ge=1),
+    Key("fallback", "str", "Method of the last retry (robust, implicit).", "", "Radau", choices=METHODS),
 ))
 
 OUTPUT = Table("output", "What a run writes and how often.", (
