@@ -20,7 +20,7 @@ from cvtfem.control.regimes import Regime
 from cvtfem.control.stabilisation import Stabilisation
 from cvtfem.elements.band.estimates import min_clamping_force
 from cvtfem.elements.band.equilibrium import forces_for_angle
-from cvtfem.elements.band.geometry import phi_for_ratio, radii
+from cvtfem.elements.band.geometry import phi_for_ratio, phi_for_ratios, radii
 from cvtfem.elements.band.params import BandParams
 from cvtfem.errors import InputError
 
@@ -56,7 +56,7 @@ class Clamping:
         if self.split not in SPLITS:
             raise InputError("regime.clamping_split", self.split, "must be one of " + ", ".join(SPLITS))
         ratios = np.geomspace(0.3, 3.5, 400)
-        phis = np.array([phi_for_ratio(i, self.p.length, self.p.L) for i in ratios])
+        phis = phi_for_ratios(ratios, self.p.length, self.p.L)
         object.__setattr__(self, "_table", (np.log(ratios), phis))
 
     def span_angle(self, ratio: float) -> float:

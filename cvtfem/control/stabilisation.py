@@ -91,7 +91,9 @@ class Stabilisation:
         F : (2,) N; M2 : float, N m; dz : (4,); diag : dict (ratio estimate, b2, saturation flags)
         """
         p = self.p
-        w1s, w2s, F11, b21 = z
+        w1s, w2s, F11, b21 = np.asarray(z, float).tolist()  # Python floats: this runs at every right-hand-side call
+        w0, w1 = np.asarray(w, float).tolist()
+        F_appl = np.asarray(F_appl, float).tolist()
         i_t = 1.0 if abs(w2s) < p.eps else min(max(w1s / w2s, p.i_min), p.i_max)  # scalar form of ratio_estimate
         e = i_t - i_d
         FS = p.c_f0 * e + F11
@@ -108,6 +110,6 @@ class Stabilisation:
         sat2 = (bS < lo and g1 < 0) or (bS > hi and g1 > 0)
         b2 = b20 + min(max(bS, lo), hi)
         M2 = -b2 * w2s
-        dz = np.array([(w[0] - w1s) / p.tau_omega, (w[1] - w2s) / p.tau_omega,
+        dz = np.array([(w0 - w1s) / p.tau_omega, (w1 - w2s) / p.tau_omega,
                        0.0 if sat1 else f1, 0.0 if sat2 else g1])
         return F, M2, dz, {"ratio_estimate": i_t, "resistance": b2, "sat1": sat1, "sat2": sat2}

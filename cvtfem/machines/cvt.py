@@ -7,6 +7,7 @@ chain models (chain-models-2.md section 0: 2/3/5/10/21 per pin), shafts
 """
 from __future__ import annotations
 
+import importlib.util
 from typing import Any
 
 from cvtfem.elements.base import Layout, OutputSpec
@@ -33,8 +34,9 @@ def _band(model: str, ritz_order: int, nodes: int) -> Layout:
     outputs += [OutputSpec("band.normal_force", "N/m",
                            f"Normal force per sheave at the {nodes} Gauss nodes of each arc (arc 1, then arc 2).",
                            2 * nodes)]
+    kernel = "numba" if importlib.util.find_spec("numba") else "numpy (numba not installed)"
     return Layout("band", model, 2 + 2 * ritz_order, outputs=tuple(outputs),
-                  note=f"phi, sigma and {ritz_order} Ritz coefficients per arc")
+                  note=f"phi, sigma and {ritz_order} Ritz coefficients per arc; right-hand side: {kernel}")
 
 
 def _shaft(name: str, scene: Scene, model: str) -> Layout:

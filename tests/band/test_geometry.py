@@ -2,7 +2,7 @@
 import numpy as np
 import pytest
 
-from cvtfem.elements.band.geometry import Sheave, admissible_phi, path_point, phi_for_ratio, radii
+from cvtfem.elements.band.geometry import Sheave, admissible_phi, path_point, phi_for_ratio, phi_for_ratios, radii
 from cvtfem.elements.band.inertia import band_inertia, complex_step
 from cvtfem.elements.band.ritz import ritz_alpha, ritz_functions, ritz_shapes
 from cvtfem.errors import InputError
@@ -97,3 +97,13 @@ def test_ritz_alpha_table_and_inextensibility():
     assert fr == pytest.approx(-num, abs=1e-7)
     x, w = np.polynomial.legendre.leggauss(40)
     assert np.abs(ritz_functions(x, ts, 8)[1] @ w).max() < 1e-12
+
+
+def test_vectorised_ratio_inversion_equals_the_scalar_one():
+    ratios = np.geomspace(0.3, 3.5, 50)
+    phis = phi_for_ratios(ratios, LENGTH, L)
+    assert np.abs(phis - [phi_for_ratio(i, LENGTH, L) for i in ratios]).max() < 1e-13
+    r = radii(phis, LENGTH, L)[0]
+    assert np.abs(r[1] / r[0] / ratios - 1).max() < 1e-13
+    with pytest.raises(InputError, match="ratio"):
+        phi_for_ratios([2.0, 1e4], LENGTH, L)

@@ -131,6 +131,27 @@ def phi_for_ratio(ratio: float, length: float, L: float) -> float:
     return brentq(g, lo, hi, xtol=1e-14)
 
 
+def phi_for_ratios(ratios, length: float, L: float) -> np.ndarray:
+    """Vectorised :func:`phi_for_ratio` for an array of ratios ``r2 / r1`` (rad), by bisection to rounding.
+
+    ``log(r2/r1)`` falls monotonically in phi on the admissible interval, so 64 halvings of that
+    interval give each root to the last bit, as brentq at ``xtol = 1e-14`` does.
+    """
+    ratios = np.asarray(ratios, dtype=float)
+    lo, hi = admissible_phi(length, L)
+    target = np.log(ratios)
+    g = lambda p: np.log(radii(p, length, L)[0][1] / radii(p, length, L)[0][0]) - target  # noqa: E731
+    bad = (g(np.full_like(target, lo)) < 0) | (g(np.full_like(target, hi)) > 0) | ~(ratios > 0)
+    if bad.any():
+        phi_for_ratio(float(ratios[bad][0]), length, L)  # raises the InputError that names the ratio
+    a, b = np.full_like(target, lo), np.full_like(target, hi)
+    for _ in range(64):
+        m = 0.5 * (a + b)
+        right = g(m) > 0  # root right of m
+        a, b = np.where(right, m, a), np.where(right, b, m)
+    return 0.5 * (a + b)
+
+
 def admissible_phi(length: float, L: float, r_min: float = 1e-4) -> tuple[float, float]:
     """Span-angle interval on which both radii exceed ``r_min`` (m), rad."""
     f1 = lambda p: float(radii(p, length, L)[0][0]) - r_min  # noqa: E731
