@@ -7,6 +7,7 @@ every accepted state for NaN/inf and returns a :class:`RunSummary`.
 """
 from __future__ import annotations
 
+import logging
 import math
 import time
 from dataclasses import asdict, dataclass, field
@@ -24,10 +25,11 @@ EFFICIENCY_WINDOW = 0.05  # s, moving average of the efficiency (section 6.1)
 #: STALL_FRACTION * t_end (1e-10 s for a 0.1 s run; the band models' fastest time scales are ~1e-5 s).
 STALL_STEPS = 50
 STALL_FRACTION = 1e-9
+log = logging.getLogger(__name__)
 
 
 def make_stepper(method: str, fun, t0: float, y0, t_end: float, rtol: float, atol: float, h: float = 0.0,
-                 jac=None, n2: int = 0, first_step: float = 0.0):
+                 jac=None, n2: int = 0, first_step: float = 0.0, error_check: int = 0):
     """A step-by-step ODE solver with ``step()``, ``t``, ``y``, ``dense_output()`` and counters.
 
     The single place that picks the integrator: the ``cvtfem.integrate`` methods through
@@ -35,14 +37,16 @@ def make_stepper(method: str, fun, t0: float, y0, t_end: float, rtol: float, ato
     otherwise scipy's ``OdeSolver`` classes (``h > 0``: first step).  ``n2``: second-order pairs
     ``x = [u, v, ...]`` with ``fun[:n2] = v`` (cvtfem implicit methods then solve for ``v`` only).
     ``first_step > 0`` (a resumed run: the step size saved at the checkpoint) overrides ``h`` as the first
-    step of adaptive methods.
+    step of adaptive methods.  ``error_check``: local-error check of fixed-step cvtfem methods every that many
+    steps (``CvtfemSolver.monitor``; 0: off).
     """
     from cvtfem.integrate import METHODS, CvtfemSolver
 
     if method in METHODS:
         try:
             return CvtfemSolver(fun, t0, np.asarray(y0, float), t_end, cvtfem_method=method, h=h or None, rtol=rtol,
-                                atol=atol, n2=n2, jac=jac, first_step=(first_step or None) if not h else None)
+                                atol=atol, n2=n2, jac=jac, first_step=(first_step or None) if not h else None,
+                                error_check=error_check)
         except InputError as err:  # name the scene key, not the adapter's argument
             if err.where != "h":
                 raise
@@ -148,7 +152,7 @@ def run_scene(scene, until: float | None = None, results: str | Path | None = No
     if not t_end > 0:
         raise InputError("--until", t_end, "must be positive (simulated seconds)")
     run = _Run(scene, t_end)
-    x0 = run.loop.initial_state(**(start or {}))
+    x0 = run.x_start = run.loop.initial_state(**(start or {}))
     run.specs = [s for s in run.specs if s.name in sample_outputs(run.loop, 0.0, x0)]
     writer = None
     if results is not None:
@@ -156,7 +160,7 @@ def run_scene(scene, until: float | None = None, results: str | Path | None = No
 
         writer = ResultsWriter(results, scene.to_toml(), "run", run.specs, scene.output.flush_interval, overwrite,
                                checkpoint=run.layout() if run.interval > 0 else None)
-    return run.drive(writer, 0.0, x0, None, show_progress, on_checkpoint)
+    return run.drive_with_policy(writer, 0.0, x0, None, show_progress, on_checkpoint)
 
 
 def resume_run(results: str | Path, show_progress: bool = True,
@@ -164,12 +168,12 @@ def resume_run(results: str | Path, show_progress: bool = True,
     """Continue a killed run from the newest checkpoint of its results file, appending to that file.
 
     The scene (TOML stored in the file), end time and solver come from the file; rows after the
-    checkpoint are dropped and recomputed.  Fixed-step methods without step-to-step memory
-    (``euler``, ``rk4``, the explicit Runge-Kutta methods) and adaptive explicit Runge-Kutta
-    methods (whose step size is restored) give bitwise the series of an uninterrupted run;
-    methods that carry Jacobians or step history (implicit, W-, multistep) restart that memory,
-    so their results agree within the solver tolerance.  A finished run or a file without
-    checkpoint is refused with :class:`InputError`.
+    checkpoint are dropped and recomputed.  Methods without step-to-step memory (explicit Runge-Kutta,
+    fixed or adaptive: the step size is restored) and those whose memory the checkpoint holds
+    (:mod:`cvtfem.io.solver_state`: trapezoidal/theta, scipy Radau and BDF, with dense Jacobians) give
+    bitwise the series of an uninterrupted run; others (W-methods, LSODA) restart their memory, so their
+    results agree within the solver tolerance.  A finished run or a file without checkpoint is refused
+    with :class:`InputError`.
     """
     from cvtfem.io.results import ResultsWriter
     from cvtfem.scene.loader import _parse, scene_from_dict
@@ -187,7 +191,9 @@ def resume_run(results: str | Path, show_progress: bool = True,
     except BaseException as err:
         writer.close("failed", f"resume: {err}")
         raise
-    return run.drive(writer, float(values["t"][0]), values["x"], (seq, values), show_progress, on_checkpoint)
+    run.retry, run.x_start = int(values["retry"][0]), run.loop.initial_state()
+    return run.drive_with_policy(writer, float(values["t"][0]), values["x"], (seq, values), show_progress,
+                                 on_checkpoint)
 
 
 class _Run:
@@ -208,6 +214,27 @@ class _Run:
         j = int(np.searchsorted(final, final[-1] - EFFICIENCY_WINDOW))
         self.j_window = 0 if j >= len(final) - 1 else j  # run shorter than one output step past the window
         self.interval = float(scene.output.checkpoint_interval)
+        self.retry = 0          # retries of `solver.on_failure = "retry"` so far
+        self.retry_log: list[str] = []
+
+    def settings(self) -> tuple[str, float, float, float]:
+        """``(method, h, rtol, atol)`` of the current attempt: the scene's, then per retry half the fixed step
+        (adaptive: half the tolerances), the last retry with ``solver.fallback`` (adaptive)."""
+        sol, r = self.scene.solver, self.retry
+        if r == 0:
+            return sol.method, sol.h, sol.rtol, sol.atol
+        if r >= sol.max_retries:
+            return sol.fallback, 0.0, sol.rtol, sol.atol
+        if sol.h > 0 and sol.method not in SCIPY_STEPPERS:
+            return sol.method, sol.h / 2 ** r, sol.rtol, sol.atol
+        return sol.method, sol.h, sol.rtol / 2 ** r, sol.atol / 2 ** r
+
+    def state_size(self) -> int:
+        from cvtfem.io.solver_state import state_size
+
+        sol, n, n2 = self.scene.solver, self.loop.size, self.loop.model.n2
+        methods = [sol.method] + ([sol.fallback] if sol.on_failure == "retry" else [])
+        return max(state_size(m, n, n2) for m in methods)
 
     def layout(self):
         from cvtfem.integrate.stats import COUNTERS
@@ -216,15 +243,68 @@ class _Run:
         n = self.loop.size
         return Layout((("t", 1), ("t_end", 1), ("x", n), ("h", 1), ("k", 1), ("steps", 1), ("tiny", 1),
                        ("next_checkpoint", 1), ("counts", len(COUNTERS)), ("t_last", 1), ("x_last", n),
-                       ("x_window", n), ("wall", 1)))
+                       ("x_window", n), ("wall", 1), ("largest", 1), ("monitor", 5), ("retry", 1),
+                       ("solver_state", self.state_size())))
 
-    def drive(self, writer, t0: float, x0, resumed, show_progress: bool, on_checkpoint) -> RunSummary:
+    def drive_with_policy(self, writer, t0: float, x0, resumed, show_progress: bool, on_checkpoint) -> RunSummary:
+        """:meth:`drive`, and on a :class:`NumericalError` the scene's ``solver.on_failure`` policy: "stop"
+        re-raises (the results file is closed "failed" with the message, its rows stay readable); "retry"
+        restarts from the newest checkpoint (or from the start without one) with :meth:`settings` of the next
+        retry, at most ``solver.max_retries`` times, each logged in the results file (``/stats`` retries and
+        retry_log) and by the logger."""
+        from cvtfem.io.results import ResultsWriter
+
+        sol = self.scene.solver
+        start = (t0, np.array(x0), resumed)
+        while True:
+            try:
+                return self.drive(writer, *start, show_progress, on_checkpoint, fresh_solver=bool(self.retry_log))
+            except NumericalError as err:
+                if sol.on_failure != "retry" or self.retry >= sol.max_retries:
+                    raise
+                failed = self.settings()
+                self.retry += 1
+                method, h, rtol, _ = self.settings()
+                what = f"h = {h:g} s" if h > 0 and method not in SCIPY_STEPPERS else f"rtol = {rtol:g}"
+                note = (f"retry {self.retry} of {sol.max_retries} with {method}, {what} after: {err} "
+                        f"({failed[0]})")
+                if writer is not None and writer.checkpoint_layout:
+                    try:
+                        writer, seq, values = ResultsWriter.resume(writer.path)
+                    except InputError:  # no checkpoint on disk yet: start again
+                        writer = self._restart_file(writer)
+                        start = (0.0, self.x_start, None)
+                    else:
+                        start = (float(values["t"][0]), values["x"], (seq, values))
+                        note += f", from the checkpoint at t = {start[0]:.6g} s"
+                else:
+                    writer = None if writer is None else self._restart_file(writer)
+                    start = (0.0, self.x_start, None)
+                self.retry_log.append(note)
+                log.warning("%s", note)
+
+    def _restart_file(self, writer):
+        """A fresh results file in place of ``writer``'s (a retry from the start)."""
+        from cvtfem.io.results import ResultsWriter
+
+        writer.close("failed", "retried from the start")
+        return ResultsWriter(writer.path, writer.scene_toml, "run", writer.specs, self.scene.output.flush_interval,
+                             True, checkpoint=self.layout() if self.interval > 0 else None)
+
+    def drive(self, writer, t0: float, x0, resumed, show_progress: bool, on_checkpoint,
+              fresh_solver: bool = False) -> RunSummary:
+        """Step from ``(t0, x0)`` to ``t_end``; ``resumed = (seq, checkpoint payload)`` continues a run, with the
+        integrator memory restored unless ``fresh_solver`` (a retry with other settings)."""
         from cvtfem.integrate import CvtfemSolver
+        from cvtfem.integrate.driver import GROWTH_LIMIT
+        from cvtfem.integrate.guards import GrowthGuard
         from cvtfem.integrate.stats import COUNTERS
         from cvtfem.io.progress import progress
+        from cvtfem.io.solver_state import export_state, import_state
 
         scene, loop, sol, t_end, t_out = self.scene, self.loop, self.scene.solver, self.t_end, self.t_out
-        n = loop.size
+        method, h_fixed, rtol, atol = self.settings()
+        n, n2 = loop.size, loop.model.n2
         k, steps, tiny, seq, wall_before = 0, 0, 0, 0, 0.0
         last, x_window = (math.nan, np.full(n, math.nan)), np.full(n, math.nan)
         next_ck = self.interval
@@ -235,15 +315,23 @@ class _Run:
             next_ck, wall_before, first_step = float(v["next_checkpoint"][0]), float(v["wall"][0]), float(v["h"][0])
             last, x_window = (float(v["t_last"][0]), v["x_last"]), v["x_window"]
         try:
-            stepper = make_stepper(sol.method, loop.rhs, t0, x0, t_end, sol.rtol, sol.atol, sol.h, loop.jac,
-                                   loop.model.n2, first_step=first_step)
+            stepper = make_stepper(method, loop.rhs, t0, x0, t_end, rtol, atol, h_fixed, loop.jac, n2,
+                                   first_step=0.0 if fresh_solver else first_step, error_check=sol.error_check)
         except BaseException as err:
             if writer is not None:
                 writer.close("failed", str(err))
             raise
         cvtfem_solver = isinstance(stepper, CvtfemSolver)
-        if resumed is not None:  # counters continue from the checkpoint
-            counts = resumed[1]["counts"]
+        guard = stepper.guard if cvtfem_solver else GrowthGuard(GROWTH_LIMIT, x0, atol, method, adaptive=True)
+        monitor = stepper.monitor if cvtfem_solver else None
+        if resumed is not None:  # memory and counters continue from the checkpoint
+            v = resumed[1]
+            guard.largest = max(guard.largest, float(v["largest"][0]))
+            if monitor is not None:
+                monitor.restore(v["monitor"])
+            if not fresh_solver:
+                import_state(method, stepper, v["solver_state"], n, n2)
+            counts = v["counts"]
             if cvtfem_solver:
                 stepper.stats.counts.update({c: int(counts[i]) for i, c in enumerate(COUNTERS)})
                 stepper._sync()
@@ -271,10 +359,15 @@ class _Run:
                 counts = [stepper.nfev, getattr(stepper, "njev", 0), getattr(stepper, "nlu", 0)]
                 counts += [0] * (len(COUNTERS) - 3)
                 h = getattr(stepper, "h_abs", None) or stepper.step_size or 0.0
+            state = np.full(self.state_size(), np.nan)
+            mem = export_state(method, stepper, n, n2)
+            state[:mem.size] = mem
             writer.checkpoint(seq, {"t": stepper.t, "t_end": t_end, "x": stepper.y, "h": h, "k": k, "steps": steps,
                                     "tiny": tiny, "next_checkpoint": next_ck, "counts": counts, "t_last": last[0],
                                     "x_last": last[1], "x_window": x_window,
-                                    "wall": wall_before + time.perf_counter() - wall0})
+                                    "wall": wall_before + time.perf_counter() - wall0, "largest": guard.largest,
+                                    "monitor": monitor.snapshot() if monitor is not None else np.zeros(5),
+                                    "retry": self.retry, "solver_state": state})
             if on_checkpoint is not None:
                 on_checkpoint(float(stepper.t), seq)
 
@@ -285,22 +378,31 @@ class _Run:
             bar.update(t0)
         status, message = "finished", ""
         h_stall = STALL_FRACTION * t_end
+        component = f"band model {scene.cvt.model}"
+        retry_stats = {"retries": self.retry, "retry_log": "\n".join(self.retry_log)} if self.retry_log else {}
         try:
             while k < len(t_out) and t_out[k] <= stepper.t:  # t = 0
                 emit(t_out[k], stepper.y)
             while stepper.status == "running":
-                t_prev = stepper.t
+                t_prev, y_prev, f_prev = stepper.t, stepper.y, getattr(stepper, "f", None)
                 msg = stepper.step()
                 steps += 1
                 if stepper.status == "failed" or not np.all(np.isfinite(stepper.y)):
-                    raise NumericalError(f"{sol.method} failed: {msg or 'state became non-finite'}", t=stepper.t,
-                                         component=f"band model {scene.cvt.model}")
+                    raise NumericalError(f"{method} failed: {msg or 'state became non-finite'}", t=stepper.t,
+                                         component=component)
+                if not cvtfem_solver:  # scipy steppers: the growth guard of cvtfem's adaptive runs
+                    why = guard.check(y_prev, stepper.y, stepper.t - t_prev, f_prev)
+                    if why is not None:
+                        raise NumericalError(f"{method} failed: {why} at t = {stepper.t:.6g} s with adaptive step "
+                                             f"h = {stepper.t - t_prev:.3g} s{guard.hint()}", t=stepper.t,
+                                             component=component)
+                    guard.update(stepper.y)
                 if steps > sol.max_steps:
                     raise NumericalError(f"step budget `solver.max_steps` = {sol.max_steps} exhausted", t=stepper.t)
                 tiny = tiny + 1 if stepper.t - t_prev < h_stall else 0
                 if tiny >= STALL_STEPS:
-                    raise NumericalError(_stall_message(loop, sol.method, stepper.t, stepper.y, stepper.t - t_prev,
-                                                        h_stall), t=stepper.t, component=f"band model {scene.cvt.model}")
+                    raise NumericalError(_stall_message(loop, method, stepper.t, stepper.y, stepper.t - t_prev,
+                                                        h_stall), t=stepper.t, component=component)
                 if k < len(t_out) and t_out[k] <= stepper.t:
                     dense = stepper.dense_output()
                     while k < len(t_out) and t_out[k] <= stepper.t:
@@ -314,20 +416,28 @@ class _Run:
         except BaseException as err:
             status, message = "failed", str(err)
             if writer is not None:
+                writer.set_stats(retry_stats)
                 writer.close("failed", message)
             raise
         finally:
             if bar is not None:
                 bar.close()
         wall = wall_before + time.perf_counter() - wall0
-        stats = {"name": sol.method, "steps": steps, "nfev": int(stepper.nfev), "njev": int(getattr(stepper, "njev", 0)),
-                 "nlu": int(getattr(stepper, "nlu", 0)), "rtol": sol.rtol, "atol": sol.atol}
+        stats = {"name": method, "steps": steps, "nfev": int(stepper.nfev), "njev": int(getattr(stepper, "njev", 0)),
+                 "nlu": int(getattr(stepper, "nlu", 0)), "rtol": rtol, "atol": atol}
+        if monitor is not None and monitor.active:
+            stats.update(monitor.stats())
+            warning = monitor.warning()
+            if warning is not None:
+                stats["warning"] = warning
+                log.warning("%s", warning)
         summary = _summarise(scene, loop, last, (t_out[self.j_window], x_window), t_end, wall, stats, status)
         if writer is not None:
             extra = {"checkpoints": seq} if checkpoints else {}
             if resumed is not None:
-                extra["resumed_from_t"] = float(t0)
-            writer.set_stats({**{f"solver_{k}": v for k, v in stats.items()}, "wall_time_s": wall, **extra})
+                extra["resumed_from_t"] = float(resumed[1]["t"][0])
+            writer.set_stats({**{f"solver_{k}": v for k, v in stats.items()}, "wall_time_s": wall, **extra,
+                              **retry_stats})
             writer.add_array("band.node_xi", loop.model.arc_nodes(0.0)[0] / (math.pi / 2), "-",
                              "Quadrature nodes xi = theta / theta* of band.normal_force (same on both arcs).")
             writer.close(status, message)

@@ -13,7 +13,8 @@ from scipy.integrate import DenseOutput, OdeSolver
 from cvtfem.errors import InputError
 from cvtfem.integrate.base import StepFailure, hermite
 from cvtfem.integrate.controller import SimpleController, error_norm
-from cvtfem.integrate.driver import _initial_step
+from cvtfem.integrate.driver import GROWTH_LIMIT, _initial_step
+from cvtfem.integrate.guards import ErrorMonitor, GrowthGuard
 from cvtfem.integrate.methods import METHODS
 from cvtfem.integrate.stats import Stats
 from cvtfem.integrate.system import as_system
@@ -33,13 +34,16 @@ class _Hermite(DenseOutput):
 class CvtfemSolver(OdeSolver):
     """``OdeSolver`` running ``cvtfem_method`` with a fixed ``h`` or adaptive steps (``h=None``).
 
-    Extra keywords: ``n2``, ``jac``, ``jac_sparsity`` and the method's own options.
-    ``stats`` holds the full cvtfem counters.
+    Extra keywords: ``n2``, ``jac``, ``jac_sparsity``, ``growth_limit`` and ``error_check``
+    (as in :func:`~cvtfem.integrate.solve`; a blow-up is a failed step whose message names
+    method, component, t and h) and the method's own options.
+    ``stats`` holds the full cvtfem counters; ``monitor`` the local-error monitor of fixed steps.
     """
 
     def __init__(self, fun, t0, y0, t_bound, vectorized=False, cvtfem_method: str = "dopri45",
                  h: float | None = None, rtol: float = 1e-6, atol: float = 1e-9, n2: int = 0,
-                 jac=None, jac_sparsity=None, first_step=None, **options):
+                 jac=None, jac_sparsity=None, first_step=None, growth_limit: float | None = GROWTH_LIMIT,
+                 error_check: int = 0, **options):
         if cvtfem_method not in METHODS:
             raise InputError("cvtfem_method", cvtfem_method, f"must be one of {sorted(METHODS)}")
         super().__init__(fun, t0, y0, t_bound, vectorized, support_complex=True)
@@ -63,6 +67,10 @@ class CvtfemSolver(OdeSolver):
         span = abs(t_bound - t0)
         self.h_next = (first_step or _initial_step(self.stepper, t0, self.y, rtol, atol, span)
                        if self.adaptive else float(h))
+        if growth_limit is not None and not growth_limit > 1:
+            raise InputError("growth_limit", growth_limit, "must be a number > 1 or None")
+        self.guard = GrowthGuard(growth_limit, self.y, atol, cvtfem_method, self.adaptive)
+        self.monitor = ErrorMonitor(self.stepper, rtol, atol, 0 if self.adaptive else error_check)
         self._att = None
         self._sync()
 
@@ -78,6 +86,7 @@ class CvtfemSolver(OdeSolver):
             h = min(self.h_next, self.t_bound - t)
             if self.t_bound - (t + h) < 1e-9 * h:    # absorb round-off: land on t_bound
                 h = self.t_bound - t
+            self.monitor.before()
             try:
                 with np.errstate(over="ignore", invalid="ignore"):
                     att = self.stepper.attempt(t, x, h)
@@ -86,19 +95,27 @@ class CvtfemSolver(OdeSolver):
             except StepFailure as err:
                 att, ok, why = None, False, str(err)
             if not self.adaptive:
-                if not ok:
+                blow_up = self.guard.check(x, att.x1, h, att.f0) if ok else None
+                if not ok or blow_up is not None:
                     self._sync()
-                    return False, f"{why} at t = {t + h:.6g} s with fixed step h = {h:.3g} s"
+                    where = f" at t = {t + h:.6g} s with fixed step h = {h:.3g} s"
+                    return False, (why + where if blow_up is None else blow_up + where + self.guard.hint())
                 break
             accept, h_new = (self.ctrl.propose(h, error_norm(att.err, x, att.x1, self.rtol, self.atol),
                                                self.stepper.error_order) if ok else (False, 0.25 * h))
             self.h_next = h_new
             if accept:
+                blow_up = self.guard.check(x, att.x1, h, att.f0)
+                if blow_up is not None:
+                    self._sync()
+                    return False, f"{blow_up} at t = {t + h:.6g} s with adaptive step h = {h:.3g} s{self.guard.hint()}"
                 break
             self.stats.counts["nreject"] += 1
             if h_new < h_min:
                 return False, f"step size underflow at t = {t:.6g} s" + (f": {why}" if not ok else "")
         self.stepper.accept(att)
+        self.monitor.after(att)
+        self.guard.update(att.x1)
         self.stats.counts["nsteps"] += 1
         self._att = att
         self.t_old, self.t, self.y = t, t + h, att.x1

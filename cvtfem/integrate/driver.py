@@ -16,6 +16,7 @@ from cvtfem.errors import InputError, NumericalError
 from cvtfem.integrate.base import StepFailure, hermite
 from cvtfem.integrate.controller import FixedStep, SimpleController, error_norm
 from cvtfem.integrate.events import EVENT_SAMPLES, EventLocator
+from cvtfem.integrate.guards import ErrorMonitor, GrowthGuard
 from cvtfem.integrate.methods import METHODS, SCIPY_METHODS, UNAVAILABLE, all_options
 from cvtfem.integrate.stats import Stats
 from cvtfem.integrate.system import as_system
@@ -30,7 +31,7 @@ MESSAGES = {0: "The solver successfully reached the end of the integration inter
 ZENO_GAP = 1e-9     # events closer than this fraction of the span ...
 ZENO_GAP_H = 1e-6   # ... or of the step count towards Zeno accumulation
 ZENO_COUNT = 3      # that many in a row stop the run
-GROWTH_LIMIT = 1e8  # default growth guard of fixed-step runs (see `solve`)
+GROWTH_LIMIT = 1e8  # default growth guard (see `solve` and :mod:`cvtfem.integrate.guards`)
 
 
 class IgnoredOptionWarning(UserWarning):
@@ -77,7 +78,7 @@ def solve(fun, t_span, y0, method: str = "dopri45", h: float | None = None, rtol
           switch=None, adaptive: bool | None = None, event_location: str = "dense",
           max_steps: int = 10_000_000, max_events: int = 100_000, raise_on_failure: bool = False,
           growth_limit: float | None = GROWTH_LIMIT, event_samples: int = EVENT_SAMPLES,
-          **options) -> OdeResult:
+          error_check: int = 0, **options) -> OdeResult:
     """Integrate ``x' = F(t, x)`` over ``t_span`` with one of the playground's methods.
 
     Parameters
@@ -105,11 +106,17 @@ def solve(fun, t_span, y0, method: str = "dopri45", h: float | None = None, rtol
         0 detects sign changes between the step's end points only (the source's scheme).
         Crossings closer together than ``h / (event_samples + 1)`` can still be missed.
     growth_limit : float or None
-        Fixed-step runs stop with an "instability" status (-1) at the first step whose state
+        A run stops with an "instability" status (-1) at the first (accepted) step whose state
         norm ``max|x1|`` exceeds ``growth_limit`` times the reference ``max(largest max|x| so
-        far, max|h F0|, max(atol))`` (default 1e8: far above any stable step's growth, far
-        below the amplification of a step far beyond the stability limit). ``None`` disables
-        the guard; then only a non-finite state stops a run.
+        far, max|h F0|, max(atol))`` (default 1e8: far above any stable or accurate step's
+        growth, far below the amplification of a step far beyond the stability limit; adaptive
+        runs too, as a backstop for a fooled error estimate). ``None`` disables the guard;
+        then only a non-finite state stops a run.
+    error_check : int
+        Fixed-step runs: estimate the local error every ``error_check`` steps (embedded
+        estimate, or step doubling for explicit RK methods without one; 0: off) and warn in
+        ``message`` when it exceeded rtol/atol; counters ``nerr_checks``, ``nfev_err_check``,
+        ``err_check_max`` in ``stats``.
     **options : method options (``d``, ``alpha``, ``newton``, ``stages``, ``sequence`` ...);
         an option the method ignores warns with :class:`IgnoredOptionWarning`.
     """
@@ -135,7 +142,8 @@ def solve(fun, t_span, y0, method: str = "dopri45", h: float | None = None, rtol
         for key, val, default in (("adaptive", adaptive, None),
                                   ("event_location", event_location, "dense"),
                                   ("event_samples", event_samples, EVENT_SAMPLES),
-                                  ("growth_limit", growth_limit, GROWTH_LIMIT)):
+                                  ("growth_limit", growth_limit, GROWTH_LIMIT),
+                                  ("error_check", error_check, 0)):
             if val != default:
                 warnings.warn(f"option `{key}` is ignored by scipy method {method!r}",
                               IgnoredOptionWarning, stacklevel=2)
@@ -162,27 +170,13 @@ def solve(fun, t_span, y0, method: str = "dopri45", h: float | None = None, rtol
         h = _initial_step(stepper, t0, y0, rtol, atol, tf - t0)
     if growth_limit is not None and not growth_limit > 1:
         raise InputError("growth_limit", growth_limit, "must be a number > 1 or None")
+    if not (isinstance(error_check, (int, np.integer)) and error_check >= 0):
+        raise InputError("error_check", error_check, "must be a whole number of steps >= 0 (0: off)")
+    guard = GrowthGuard(growth_limit, y0, atol, method, adaptive)
+    monitor = ErrorMonitor(stepper, rtol, atol, 0 if adaptive else error_check)
     return _integrate(stepper, ctrl, system, t0, tf, y0, h, rtol, atol, t_eval, event_location,
-                      max_steps, max_events, raise_on_failure, stats, method, adaptive, growth_limit,
-                      event_samples)
-
-
-def _norm(x) -> float:
-    return float(np.max(np.abs(x))) if np.size(x) else 0.0
-
-
-def _blow_up(att, x, limit, largest, floor, method):
-    """Message if a fixed step's ``max|x1|`` exceeds ``limit`` times the reference
-    ``max(largest max|x| so far, max|h F0|, floor)``, else None."""
-    scale = max(largest, floor, 0.0 if att.f0 is None else _norm(att.h * att.f0))
-    grown = _norm(att.x1)
-    if grown > limit * scale and grown > 0:
-        start = _norm(x)
-        factor = grown / start if start > 0 else grown / scale
-        return (f"instability ({method}): |x| grew by a factor {factor:.3g} in one step, from "
-                f"{start:.3g} to {grown:.3g} (more than growth_limit = {limit:.3g} times the "
-                f"largest |x| so far)")
-    return None
+                      max_steps, max_events, raise_on_failure, stats, method, adaptive, guard,
+                      event_samples, monitor)
 
 
 def _initial_step(stepper, t0, y0, rtol, atol, span):
@@ -200,15 +194,14 @@ def _initial_step(stepper, t0, y0, rtol, atol, span):
 
 
 def _integrate(stepper, ctrl, system, t0, tf, y0, h, rtol, atol, t_eval, event_location,
-               max_steps, max_events, raise_on_failure, stats, method, adaptive, growth_limit,
-               event_samples=EVENT_SAMPLES):
+               max_steps, max_events, raise_on_failure, stats, method, adaptive, guard,
+               event_samples=EVENT_SAMPLES, monitor=None):
     wall = time.perf_counter()
     st = stats.counts
     t, x = t0, y0.copy()
     ts, ys = ([t0], [x.copy()]) if t_eval is None else ([], [])
     i_eval = 0
     locator = EventLocator(system, stats, event_location, event_samples) if system.n_events else None
-    largest, floor = _norm(y0), _norm(atol)     # growth guard: largest max|x| so far, its floor
     if locator is not None:
         locator.start(t, x)
     t_events = [[] for _ in range(system.n_events)]
@@ -223,12 +216,14 @@ def _integrate(stepper, ctrl, system, t0, tf, y0, h, rtol, atol, t_eval, event_l
         h_try = min(h, tf - t)
         if tf - (t + h_try) < 1e-9 * h_try:
             h_try = tf - t
+        if monitor is not None:
+            monitor.before()
         try:
             with np.errstate(over="ignore", invalid="ignore"):   # detected below, reported
                 att = stepper.attempt(t, x, h_try)
             failure = None if np.all(np.isfinite(att.x1)) else "non-finite state"
-            if failure is None and growth_limit is not None and not adaptive:
-                failure = _blow_up(att, x, growth_limit, largest, floor, method)
+            if failure is None and not adaptive:
+                failure = guard.check(x, att.x1, h_try, att.f0)
         except StepFailure as err:
             att, failure = None, str(err)
         if adaptive:
@@ -237,6 +232,11 @@ def _integrate(stepper, ctrl, system, t0, tf, y0, h, rtol, atol, t_eval, event_l
             else:
                 en = error_norm(att.err, x, att.x1, rtol, atol)
                 accept, h_new = ctrl.propose(h_try, en, stepper.error_order)
+                blow_up = guard.check(x, att.x1, h_try, att.f0) if accept else None
+                if blow_up is not None:
+                    status = -1
+                    message = f"{blow_up} at t = {t + h_try:.6g} s with adaptive step h = {h_try:.3g} s{guard.hint()}"
+                    break
             if not accept:
                 st["nreject"] += 1
                 h = h_new
@@ -253,8 +253,7 @@ def _integrate(stepper, ctrl, system, t0, tf, y0, h, rtol, atol, t_eval, event_l
                 bad = f" in component {int(nonfin[0])}" if len(nonfin) else ""
                 status, message = -1, f"{failure}{bad} at t = {t + h_try:.6g} s with fixed step h = {h:.3g} s"
                 if failure.startswith("instability"):
-                    message += (": h is beyond the method's stability region; reduce h or use an "
-                                "implicit or stabilized method (growth_limit=None disables this check)")
+                    message += guard.hint()
                 break
         st["nsteps"] += 1
         t1, x1 = t + h_try, att.x1
@@ -276,6 +275,8 @@ def _integrate(stepper, ctrl, system, t0, tf, y0, h, rtol, atol, t_eval, event_l
             st["nevents"] += 1
             st["ntruncated"] += 1
         stepper.accept(att)
+        if monitor is not None:
+            monitor.after(att)
         if t_eval is not None:
             j = i_eval + np.searchsorted(t_eval[i_eval:], t1, side="right")
             if j > i_eval:
@@ -286,7 +287,7 @@ def _integrate(stepper, ctrl, system, t0, tf, y0, h, rtol, atol, t_eval, event_l
             ts.append(t1)
             ys.append(x1.copy())
         t, x, h = t1, x1, h_new
-        largest = max(largest, _norm(x))
+        guard.update(x)
         if hit is not None:
             for k in np.flatnonzero(fired):
                 t_events[k].append(t)
@@ -295,8 +296,10 @@ def _integrate(stepper, ctrl, system, t0, tf, y0, h, rtol, atol, t_eval, event_l
                 new = system.switch(t, x.copy(), fired)
                 if new is not None:
                     x = np.array(new, dtype=x.dtype)
-                    largest = max(largest, _norm(x))
+                    guard.update(x)
             stepper.reset()
+            if monitor is not None:
+                monitor.reset()
             locator.start(t, x, fired)
             if np.any(fired & system.event_terminal):
                 status, message = 1, MESSAGES[1]
@@ -312,10 +315,17 @@ def _integrate(stepper, ctrl, system, t0, tf, y0, h, rtol, atol, t_eval, event_l
                 status, message = -1, f"`max_events` = {max_events} reached at t = {t:.6g} s (Zeno?)"
                 break
     stats.times["t_total"] = time.perf_counter() - wall
+    extra = {}
+    if monitor is not None and monitor.active:
+        extra = monitor.stats()
+        warn = monitor.warning()
+        if warn is not None and status >= 0:
+            message += f" Warning: {warn}."
+            log.warning("%s: %s", method, warn)
     if status < 0:
         log.warning("%s: %s", method, message)
         if raise_on_failure:
             raise NumericalError(message, t=t, component=method)
     y = np.array(ys).T if ys else np.empty((len(y0), 0))
-    return OdeResult(np.array(ts), y, stats.as_dict(), status, message,
+    return OdeResult(np.array(ts), y, {**stats.as_dict(), **extra}, status, message,
                      [np.array(v) for v in t_events], [np.array(v) for v in y_events], method)

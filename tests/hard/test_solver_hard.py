@@ -46,7 +46,7 @@ def test_fixed_step_far_above_the_stability_limit_stops_at_overflow():
     assert err.value.t == pytest.approx((n_overflow - 1) * h) and err.value.component == "rk4"
 
 
-INSTABILITY = ("instability (rk4): |x| grew by a factor 4.17e+18 in one step, from 1 to 4.17e+18 "
+INSTABILITY = ("instability (rk4): |x| grew by a factor 4.17e+18 in one step (component 0), from 1 to 4.17e+18 "
                "(more than growth_limit = 1e+08 times the largest |x| so far) at t = 0.001 s with "
                "fixed step h = 0.001 s: h is beyond the method's stability region; reduce h or use an "
                "implicit or stabilized method (growth_limit=None disables this check)")
