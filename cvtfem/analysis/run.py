@@ -262,12 +262,10 @@ class _Run:
             except NumericalError as err:
                 if sol.on_failure != "retry" or self.retry >= sol.max_retries:
                     raise
-                failed = self.settings()
                 self.retry += 1
                 method, h, rtol, _ = self.settings()
                 what = f"h = {h:g} s" if h > 0 and method not in SCIPY_STEPPERS else f"rtol = {rtol:g}"
-                note = (f"retry {self.retry} of {sol.max_retries} with {method}, {what} after: {err} "
-                        f"({failed[0]})")
+                note = f"retry {self.retry} of {sol.max_retries} with {method}, {what} after: {err}"
                 if writer is not None and writer.checkpoint_layout:
                     try:
                         writer, seq, values = ResultsWriter.resume(writer.path)
