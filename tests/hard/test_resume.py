@@ -39,7 +39,21 @@ def _series_equal(a, b) -> bool:
         np.array_equal(a.series[n], b.series[n], equal_nan=True) for n in a.series)
 
 
-IMPLICIT_UNTIL, IMPLICIT_INTERVAL = 0.1, 0.02   # s simulated: ~3 s wall, checkpoints ~0.5 s apart
+#: implicit runs: a ratio change 2.4 -> 1.0 over the whole run at rtol 1e-7 keeps every method busy
+#: (0.2 s simulated: 1.3 s wall BDF .. 3.3 s trapezoidal), so the kill (<= 0.3 s after checkpoint 2 of 10) comes first
+IMPLICIT_UNTIL, IMPLICIT_INTERVAL = 0.2, 0.02
+IMPLICIT_SCENE = """preset = "band-4dof"
+[solver]
+method = "{method}"
+rtol = 1e-7
+atol = 1e-9
+[cvt.regime]
+kind = "ratio-change"
+end_value = 1.0
+ramp_time = 0.2
+[output]
+checkpoint_interval = {interval}
+"""
 
 
 def _kill_and_resume(tmp_path, cli, text: str, until: float, interval: float, rows: int):
@@ -98,8 +112,7 @@ def test_killed_run_resumes_bitwise(tmp_path, cli):
 def test_killed_implicit_run_resumes_bitwise(tmp_path, cli, method):
     """SIGKILL at a random moment: the resumed run equals the uninterrupted one bit for bit, with the
     same step, RHS, Jacobian and LU counts (the integrator memory travels in the checkpoint)."""
-    text = (f'preset = "band-4dof"\n[solver]\nmethod = "{method}"\n'
-            f"[output]\ncheckpoint_interval = {IMPLICIT_INTERVAL}\n")
+    text = IMPLICIT_SCENE.format(method=method, interval=IMPLICIT_INTERVAL)
     ref, res, where = _kill_and_resume(tmp_path, cli, text, IMPLICIT_UNTIL, IMPLICIT_INTERVAL,
                                        round(IMPLICIT_UNTIL / 1e-3) + 1)
     assert _series_equal(ref, res), where
