@@ -214,6 +214,13 @@ class _Run:
         j = int(np.searchsorted(final, final[-1] - EFFICIENCY_WINDOW))
         self.j_window = 0 if j >= len(final) - 1 else j  # run shorter than one output step past the window
         self.interval = float(scene.output.checkpoint_interval)
+        sol = scene.solver
+        if sol.on_failure == "retry":  # the fallback runs adaptive: refuse one without error estimate now
+            try:
+                make_stepper(sol.fallback, lambda t, y: -y, 0.0, [1.0], 1.0, sol.rtol, sol.atol)
+            except InputError:
+                raise InputError("solver.fallback", sol.fallback, "must be a method with an error estimate (it runs "
+                                 "with adaptive steps), e.g. 'Radau', 'BDF', 'trapezoidal'") from None
         self.retry = 0          # retries of `solver.on_failure = "retry"` so far
         self.retry_log: list[str] = []
 

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from cvtfem.analysis.run import run_scene
-from cvtfem.errors import NumericalError
+from cvtfem.errors import InputError, NumericalError
 from cvtfem.io.results import read_results
 from cvtfem.scene.loader import load_scene
 
@@ -108,6 +108,13 @@ def test_on_failure_retry_gives_up_after_max_retries(tmp_path):
     r = read_results(tmp_path / "r.h5")
     assert r.attrs["status"] == "failed" and r.attrs["message"] == str(err.value) and r.stats["retries"] == 1
     assert r.stats["retry_log"].startswith("retry 1 of 1 with BDF, rtol = 0.001 after: step size stalled")
+
+
+def test_fallback_without_error_estimate_is_refused(tmp_path):
+    scene = load_scene("band-4dof", {"solver": {"on_failure": "retry", "fallback": "rk4"}})
+    with pytest.raises(InputError, match="`solver.fallback` must be a method with an error estimate"):
+        run_scene(scene, until=0.01, results=tmp_path / "r.h5", show_progress=False)
+    assert not (tmp_path / "r.h5").exists()
 
 
 @pytest.mark.slow
