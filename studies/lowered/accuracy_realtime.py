@@ -3,7 +3,8 @@
 1 s of the reference stationary regime (3500 rpm, 200 N m, ratio 2.4), started in steady running
 (``--start steady``, the benchmark's start) or at ratio 2.3 and 4 % slow (``--start away``: the loops
 work).  Prints ratio, speeds and output/input work at the end of each run, and their differences to
-the reference; the reference is kept in ``out/studies/lowered/reference-MODEL-START.json``.
+the reference (and the largest difference of the normal force along the arcs, relative to its
+maximum, where the node counts agree); the reference is kept in ``out/studies/lowered/reference-MODEL-START.json``.
 
     .venv/bin/python studies/lowered/accuracy_realtime.py --model band-6+2n --start away \
         --settings Radau:1e-3:1e-5 Radau:1e-4:1e-6
@@ -15,6 +16,7 @@ import json
 import time
 from pathlib import Path
 
+import numpy as np
 from scipy.integrate import solve_ivp
 
 from cvtfem.machines.cvt import closed_loop
@@ -30,8 +32,10 @@ def run(loop, start: str, method: str, rtol: float, atol: float, until: float) -
     wall = time.perf_counter() - t0
     q, v, _, W = loop.split(sol.y[:, -1])
     k1, k2 = loop.model.speed_indices()
+    N = loop.evaluate(sol.t[-1], sol.y[:, -1])[1].get("N", np.zeros(0))  # (2, nodes) N/m; none for 4-DOF
     return {"method": method, "rtol": rtol, "atol": atol, "wall_s": wall, "steps": len(sol.t) - 1, "nfev": sol.nfev,
-            "ratio": v[k1] / v[k2], "omega1": v[k1], "omega2": v[k2], "work_ratio": W[1] / W[0], "status": sol.status}
+            "ratio": v[k1] / v[k2], "omega1": v[k1], "omega2": v[k2], "work_ratio": W[1] / W[0], "status": sol.status,
+            "N": np.asarray(N).tolist()}
 
 
 def main() -> None:
@@ -58,7 +62,9 @@ def main() -> None:
         res = run(loop, args.start, m, float(r), float(a), args.until)
         print(f"{m} {float(r):.0e}/{float(a):.0e} nodes {loop.model.p.n_gauss}: {res['steps']} steps, "
               f"{res['nfev']} nfev, {res['wall_s']:.3f} s wall; "
-              + ", ".join(f"{k} {res[k]:.9f} ({res[k] - ref[k]:+.1e})" for k in keys), flush=True)
+              + ", ".join(f"{k} {res[k]:.9f} ({res[k] - ref[k]:+.1e})" for k in keys)
+              + (f"; normal force max |dN| / max N {np.abs(np.subtract(res['N'], ref['N'])).max() / np.max(ref['N']):.1e}"
+                 if 0 < len(res["N"]) == len(ref["N"]) else ""), flush=True)
 
 
 if __name__ == "__main__":

@@ -151,16 +151,17 @@ class CompressibleBand:
         """Accelerations and diagnostics (``N`` (2, g) N/m, ``dissipation``, ``clamp_power`` W, slips)."""
         if self.backend == "numpy":
             return self.accel_numpy(q, v, F, M)
+        c = np.ascontiguousarray  # one compiled signature (C-contiguous float64) whatever the caller passes
         a, N, eps, slip, slip_max, dissipation, clamp_power = ker.accel_kernel(
-            np.asarray(q, float), np.asarray(v, float), np.asarray(F, float), np.asarray(M, float),
-            *self._c["packed"])
+            c(q, float), c(v, float), c(F, float), c(M, float), *self._c["packed"])
         return a, {"N": N, "eps": eps, "slip": slip, "slip_max": slip_max,
                    "dissipation": dissipation, "clamp_power": clamp_power}
 
     def jacobian(self, q, v, F, M):
         """Forward-difference Jacobian of ``[a, dissipation, clamp_power]`` (n2 + 2 rows) with respect to
         ``[q, v, F, M]`` (2 n2 + 4 columns), see ``compressible_kernel.jacobian_kernel``."""
-        args = (np.asarray(q, float), np.asarray(v, float), np.asarray(F, float), np.asarray(M, float))
+        c = np.ascontiguousarray
+        args = (c(q, float), c(v, float), c(F, float), c(M, float))
         if self.backend == "numba":
             return ker.jacobian_kernel(*args, *self._c["packed"])
         return self.jacobian_numpy(*args)

@@ -140,7 +140,11 @@ def phi_for_ratios(ratios, length: float, L: float) -> np.ndarray:
     ratios = np.asarray(ratios, dtype=float)
     lo, hi = admissible_phi(length, L)
     target = np.log(ratios)
-    g = lambda p: np.log(radii(p, length, L)[0][1] / radii(p, length, L)[0][0]) - target  # noqa: E731
+
+    def g(p):
+        r = radii(p, length, L)[0]
+        return np.log(r[1] / r[0]) - target
+
     bad = (g(np.full_like(target, lo)) < 0) | (g(np.full_like(target, hi)) > 0) | ~(ratios > 0)
     if bad.any():
         phi_for_ratio(float(ratios[bad][0]), length, L)  # raises the InputError that names the ratio
