@@ -29,12 +29,12 @@ def _band(model: str, ritz_order: int, nodes: int) -> Layout:
     outputs += [OutputSpec("band.slip_speed", "m/s", "Circumferential slip speed at the middle of each arc.", 2),
                 OutputSpec("band.slip_max", "m/s", "Largest slip speed along each arc.", 2),
                 OutputSpec("band.mean_normal_force", "N/m", "Mean normal force per sheave on each arc.", 2)]
+    kernel = "numba" if importlib.util.find_spec("numba") else "numpy (numba not installed)"
     if model == "band-4dof":
-        return Layout("band", model, 2, outputs=tuple(outputs), note="phi, sigma")
+        return Layout("band", model, 2, outputs=tuple(outputs), note=f"phi, sigma; right-hand side: {kernel}")
     outputs += [OutputSpec("band.normal_force", "N/m",
                            f"Normal force per sheave at the {nodes} Gauss nodes of each arc (arc 1, then arc 2).",
                            2 * nodes)]
-    kernel = "numba" if importlib.util.find_spec("numba") else "numpy (numba not installed)"
     return Layout("band", model, 2 + 2 * ritz_order, outputs=tuple(outputs),
                   note=f"phi, sigma and {ritz_order} Ritz coefficients per arc; right-hand side: {kernel}")
 

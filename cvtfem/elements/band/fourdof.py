@@ -40,17 +40,33 @@ def generalized_inertia(phi, p: BandParams):
 
 @dataclass(frozen=True)
 class FourDofBand:
-    """The 4-DOF band model as a pure kernel around :class:`BandParams`."""
+    """The 4-DOF band model as a pure kernel around :class:`BandParams`.
+
+    ``use_numba``: :meth:`accel` runs the compiled kernel of ``fourdof_kernel`` (when numba is
+    installed); :meth:`accel_numpy` is its reference twin.
+    """
 
     p: BandParams
     names: tuple[str, ...] = ("phi", "sigma", "phi1", "phi2")
+    use_numba: bool = True
     _xi: np.ndarray = field(init=False, repr=False)
     _wq: np.ndarray = field(init=False, repr=False)
+    _packed: tuple = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
+        from cvtfem.elements.band import fourdof_kernel
+
         xi, wq = gauss_nodes(self.p.n_gauss)
         object.__setattr__(self, "_xi", xi)
         object.__setattr__(self, "_wq", wq)
+        object.__setattr__(self, "_packed", fourdof_kernel.pack(self))
+
+    @property
+    def backend(self) -> str:
+        """``"numba"`` (compiled right-hand side) or ``"numpy"`` (numba off or not installed)."""
+        from cvtfem.elements.band.compressible_kernel import HAVE_NUMBA
+
+        return "numba" if self.use_numba and HAVE_NUMBA else "numpy"
 
     n2 = 4
 
@@ -59,7 +75,19 @@ class FourDofBand:
         return wrap_half_angles(phi)[:, None] * self._xi
 
     def accel(self, q, v, F, M):
-        """Accelerations and diagnostics.
+        """Accelerations and diagnostics (see :meth:`accel_numpy`), compiled when :attr:`backend` is numba."""
+        if self.backend == "numpy":
+            return self.accel_numpy(q, v, F, M)
+        from cvtfem.elements.band.fourdof_kernel import accel4_kernel
+
+        c = np.ascontiguousarray  # one compiled signature (C-contiguous float64)
+        a, N, slip, slip_max, dissipation, clamp_power = accel4_kernel(c(q, float), c(v, float), c(F, float),
+                                                                       c(M, float), *self._packed)
+        return a, {"N": N, "dissipation": dissipation, "slip": slip, "slip_max": slip_max,
+                   "clamp_power": clamp_power}
+
+    def accel_numpy(self, q, v, F, M):
+        """Accelerations and diagnostics (numpy reference of the compiled kernel).
 
         Parameters
         ----------
