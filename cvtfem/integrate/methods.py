@@ -3,7 +3,7 @@ from __future__ import annotations
 
 from types import MappingProxyType
 
-from cvtfem.integrate import extrapolation, rk, rock, stabilized, theta, wmethods
+from cvtfem.integrate import dumka3, extrapolation, rk, rock, stabilized, theta, wmethods
 
 __all__ = ["METHODS", "SCIPY_METHODS", "UNAVAILABLE", "all_options"]
 
@@ -12,14 +12,11 @@ METHODS = MappingProxyType({cls.name: cls for cls in (
     extrapolation.EulerExtrapolation, extrapolation.GBS, extrapolation.GBSSmooth,
     wmethods.SW24, wmethods.W1, wmethods.W1Extrapolation,
     theta.Theta, theta.Trapezoidal, theta.ImplicitEuler,
-    stabilized.RKC, rock.ROCK2, rock.ROCK4)})
+    stabilized.RKC, rock.ROCK2, rock.ROCK4, dumka3.DUMKA3)})
 SCIPY_METHODS = frozenset({"RK23", "RK45", "DOP853", "Radau", "BDF", "LSODA"})
-#: Names from the issue that are not implemented, with the reason (shown in the InputError).
-_TABLES = ("its stability polynomials come from published coefficient tables ({}) that are "
-           "not vendored in cvtfem yet; use 'rkc' (analytic coefficients) meanwhile")
-UNAVAILABLE = MappingProxyType({
-    "dumka3": _TABLES.format("Medovikov 1998, 14 polynomials; the public port is GPL-3"),
-})
+#: Names from the issue that are not implemented, with the reason (shown in the InputError);
+#: empty since DUMKA3 exists (kept for the driver's check).
+UNAVAILABLE: MappingProxyType = MappingProxyType({})
 
 
 def all_options() -> frozenset[str]:

@@ -176,7 +176,7 @@ def heat_benchmark(N: int = 1000, t_end: float = 0.1, target: float = 1e-4, repe
     tol = [{"rtol": r, "atol": r * 1e-3, "t_eval": last} for r in rtols]
     plan = {
         "rk4": [{"h": t_end / np.ceil(t_end / (0.98 * 2.785 / rho)), "t_eval": last}],
-        "dopri45": tol, "dumka3": [], "rock2": tol, "rock4": tol, "rkc": tol,
+        "dopri45": tol, "dumka3": tol, "rock2": tol, "rock4": tol, "rkc": tol,
         "trapezoidal": [{"h": t_end / n, "t_eval": last} for n in (10, 20, 40, 80, 160)],
         "Radau": tol, "BDF": tol,
     }

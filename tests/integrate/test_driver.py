@@ -24,7 +24,7 @@ def test_result_shape_and_stats_like_solve_ivp():
 @pytest.mark.parametrize("kw,where", [
     (dict(method="nope"), "method"), (dict(h=-1.0), "h"), (dict(t_span=(1.0, 0.0)), "t_span"),
     (dict(y0=[np.nan, 0.0]), "y0"), (dict(method="rk4"), "method"),
-    (dict(method="dumka3", h=0.1), "method"), (dict(method="rk4", h=0.1, bogus=1), "bogus"),
+    (dict(method="dumka3", h=0.1, stages=10), "stages"), (dict(method="rk4", h=0.1, bogus=1), "bogus"),
     (dict(method="theta", h=0.1, alpha=2.0), "alpha"), (dict(method="trapezoidal", h=0.1, newton="x"), "newton"),
 ])
 def test_bad_input_names_the_argument(kw, where):

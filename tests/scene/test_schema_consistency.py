@@ -8,5 +8,4 @@ SCIPY = {"RK23", "RK45", "DOP853", "Radau", "BDF", "LSODA"}
 
 
 def test_solver_methods_match_integrators():
-    # dumka3 is named by the issue; `solve` rejects it with a clear message until it exists
-    assert set(SCENE_METHODS) == set(METHODS) | SCIPY | {"dumka3"}
+    assert set(SCENE_METHODS) == set(METHODS) | SCIPY

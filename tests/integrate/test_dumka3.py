@@ -1,0 +1,165 @@
+"""DUMKA3 with regenerated polynomials: lengths vs published, order conditions, orders,
+internal stability, automatic polynomial choice (spec §5, §11.6; issue 4)."""
+import numpy as np
+import pytest
+
+from cvtfem.errors import InputError
+from cvtfem.integrate import solve
+from cvtfem.integrate.dumka3 import (DEGREES, PUBLISHED_BETA, butcher, polynomial, product_form,
+                                     stability_length, stability_polynomial)
+from cvtfem.integrate.study import amplification, effective_order, local_errors, real_stability_length
+from cvtfem.problems import heat1d, limit_cycle, van_der_pol
+
+K = range(len(DEGREES))
+
+
+def _length_of_product(k):
+    """Real stability length of the stepping scheme's factor product, sampled then bisected."""
+    p = polynomial(k)
+    L = 1.2 * PUBLISHED_BETA[k]
+    x = np.concatenate([p["beta"] * (1 - np.cos(np.linspace(0, np.pi, 40 * p["s"]))) / 2,
+                        np.linspace(p["beta"], L, 40 * p["s"])])
+    bad = np.flatnonzero(np.abs(product_form(k, -x)) > 1 + 1e-9)
+    lo, hi = x[bad[0] - 1], x[bad[0]]
+    for _ in range(50):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if abs(product_form(k, -mid)) <= 1 + 1e-9 else (lo, mid)
+    return lo
+
+
+@pytest.mark.parametrize("k", K)
+def test_stability_length_matches_published(k):
+    """Acceptance of issue 4: real stability length within 1 % of Medovikov's published bound
+    (``_STAB_REG`` of his code). Measured on the product of the sub-step factors, i.e. the
+    polynomial a step actually applies; the degree-3 polynomial is unique (0.49 % above)."""
+    L = _length_of_product(k)
+    assert abs(L / PUBLISHED_BETA[k] - 1) < 0.01, (L, PUBLISHED_BETA[k])
+    assert abs(L / stability_length(k) - 1) < 1e-6
+
+
+@pytest.mark.parametrize("k", K)
+def test_product_form_equals_generated_polynomial(k):
+    """Roots, ordering and finishing block reproduce the Chebyshev-form polynomial."""
+    p = polynomial(k)
+    z = -p["beta"] * (1 - np.cos(np.linspace(0, np.pi, 10 * p["s"]))) / 2
+    assert np.max(np.abs(product_form(k, z) - stability_polynomial(k, z))) < 1e-9
+    assert len(p["items"]) + 3 <= p["s"]
+
+
+@pytest.mark.parametrize("k", K)
+def test_composed_tableau_is_order_three(k):
+    """Butcher tableau of the whole step: all four order-3 conditions to 1e-10
+    (``sum b c^2 = 1/3`` is the one imposed through the finishing block)."""
+    A, b, c = butcher(k)
+    assert A.shape == (DEGREES[k], DEGREES[k])
+    got = [b.sum(), b @ c, b @ c ** 2, b @ A @ c]
+    assert np.allclose(got, [1, 1 / 2, 1 / 3, 1 / 6], atol=1e-10, rtol=0), got
+    assert abs(b @ A @ A @ c - 1 / 24) > 1e-6 or abs(b @ c ** 3 - 1 / 4) > 1e-6   # not order 4
+    # linear stability function of the tableau equals the polynomial
+    z = -0.3 * stability_length(k)
+    r = 1 + z * b @ np.linalg.solve(np.eye(len(b)) - z * A, np.ones(len(b)))
+    assert abs(r - product_form(k, z)) < 1e-8
+
+
+def test_damping_inside_interval():
+    """``|R| <= 1 - eta`` on the damped part of ``[-beta, 0]``, ``|R| <= 1`` everywhere."""
+    for k in K:
+        p = polynomial(k)
+        x = np.linspace(0, p["length"], 20 * p["s"] ** 2 // 10 + 100)
+        r = np.abs(stability_polynomial(k, -x))
+        assert r.max() <= 1 + 1e-9
+        far = (x >= p["zeta"]) & (x <= p["beta"])
+        if p["eta"] > 0:
+            assert r[far].max() <= 1 - p["eta"] + 1e-5   # eta was sampled on another grid
+
+
+@pytest.mark.parametrize("k,hs", [(2, [0.1, 0.05]), (6, [0.2, 0.1]), (10, [0.2, 0.1])])
+def test_order_three_on_nonlinear_problem(k, hs):
+    """Effective order 3 (local error, spec (2.8)) on the limit cycle, within 0.3."""
+    errs = local_errors(limit_cycle(r0=0.3), "dumka3", hs, polynomial=k)
+    assert np.all(errs > 1e-14)
+    assert abs(effective_order(hs, errs)[-1] - 3) <= 0.3, errs
+
+
+@pytest.mark.parametrize("k", [1, 4, 9, 13])
+def test_global_order_three_van_der_pol(k):
+    """Global error at t = 1 of Van der Pol (mu = 1, nonlinear) at fixed steps h = 0.05, 0.025:
+    order 3 +- 0.3 (measured 2.97-2.99; P4 is pre-asymptotic at h = 0.1: 2.68)."""
+    p = van_der_pol(mu=1.0)
+    kw = {**p.solve_kwargs(), "t_span": (0.0, 1.0)}
+    kw.pop("jac", None)
+    ref = solve(**kw, method="DOP853", rtol=1e-13, atol=1e-13).y[:, -1]
+    errs = [np.max(np.abs(solve(**kw, method="dumka3", polynomial=k, h=h).y[:, -1] - ref))
+            for h in (0.05, 0.025)]
+    assert abs(np.log2(errs[0] / errs[1]) - 3) <= 0.3, errs
+
+
+def test_stepping_length_equals_polynomial():
+    """The real stability length measured by stepping ``x' = -x x`` (P4)."""
+    L = real_stability_length("dumka3", x_max=160.0, n=40_000, polynomial=4)
+    assert abs(L / stability_length(4) - 1) < 1e-6
+
+
+def test_internal_stability_s324_heat():
+    """P13 (324 stages) on heat N = 200 at 0.95 of its bound, rough initial data: 20 steps follow
+    the exact-arithmetic result ``V R(h Lambda)^n V^T x0`` to 1e-9 (rounding is not amplified)."""
+    p = heat1d(200)
+    A = p.jac(0, p.y0).toarray()
+    lam, V = np.linalg.eigh(A)
+    h = 0.95 * stability_length(13) / np.max(np.abs(lam))
+    x0 = p.y0 + 0.1 * np.random.default_rng(1).standard_normal(len(p.y0))
+    res = solve(p.fun, (0, 20 * h), x0, method="dumka3", polynomial=13, h=h)
+    expect = V @ (product_form(13, h * lam).real ** 20 * (V.T @ x0))
+    assert res.success and res.stats["nfev"] == 20 * 324
+    assert np.max(np.abs(res.y[:, -1] - expect)) < 1e-9 * np.max(np.abs(x0))
+    assert np.max(np.abs(res.y)) <= np.max(np.abs(x0))
+
+
+def test_region_p13_connected():
+    """Spec §5 reports Medovikov's P13 region disconnected; ours: one component (|R| <= 1 on a
+    grid around [-1.05 L, 0] x [-30, 30]), which contains the whole real interval."""
+    from scipy import ndimage
+
+    L = stability_length(13)
+    xr = np.linspace(-1.05 * L, 1.0, 2400)
+    yi = np.linspace(-30.0, 30.0, 121)
+    inside = np.abs(product_form(13, xr[None, :] + 1j * yi[:, None])) <= 1
+    labels, n = ndimage.label(inside)
+    assert n == 1
+    assert np.all(inside[60, xr >= -L * (1 - 1e-4)][:-2])
+
+
+def test_automatic_choice_heat_adaptive():
+    """Default: smallest polynomial covering ``h rho``; heat N = 200 to 0.05 at rtol 1e-5."""
+    p = heat1d(200, 0.05)
+    res = solve(**p.solve_kwargs(), method="dumka3", rtol=1e-5, atol=1e-8)
+    err = np.max(np.abs(res.y[:, -1] - p.exact(0.05))) / np.max(np.abs(p.exact(0.05)))
+    assert res.success and err < 1e-4, err
+    rk4_calls = 4 * 0.05 * p.info["rho"] / 2.785          # RK4 at its stability limit
+    assert res.stats["nfev"] < rk4_calls / 5, (res.stats["nfev"], rk4_calls)
+
+
+def test_adaptive_nonlinear_tolerance_proportionality():
+    """Van der Pol (mu = 1): error falls with rtol (the estimate controls a real error)."""
+    p = van_der_pol(mu=1.0)
+    kw = p.solve_kwargs()
+    kw.pop("jac", None)
+    ref = solve(**kw, method="DOP853", rtol=1e-13, atol=1e-13).y[:, -1]
+    e = [np.max(np.abs(solve(**kw, method="dumka3", polynomial=2, rtol=r, atol=r).y[:, -1] - ref))
+         for r in (1e-5, 1e-7)]
+    assert e[1] < e[0] / 10 and e[1] < 1e-5, e
+
+
+@pytest.mark.parametrize("kw,where", [(dict(stages=10), "stages"), (dict(polynomial=14), "polynomial"),
+                                      (dict(stages=9, polynomial=2), "stages")])
+def test_bad_options(kw, where):
+    with pytest.raises(InputError) as err:
+        solve(lambda t, y: -y, (0, 1), [1.0], method="dumka3", h=0.1, **kw)
+    assert f"`{where}`" in str(err.value)
+
+
+def test_amplification_of_degree_three_is_taylor():
+    """P0 is the unique 3-stage order-3 polynomial 1 + z + z^2/2 + z^3/6."""
+    z = np.array([-2.0, -1.0 + 1.0j, 0.5j])
+    assert np.allclose(amplification("dumka3", z, polynomial=0), np.abs(1 + z + z ** 2 / 2 + z ** 3 / 6),
+                       rtol=1e-12)
