@@ -68,7 +68,7 @@ def make_stepper(method: str, fun, t0: float, y0, t_end: float, rtol: float, ato
 
 
 def _unavailable_hint(method: str) -> str:
-    """Why ``cvtfem.integrate`` refuses a method it names (e.g. DUMKA3), else empty."""
+    """Why ``cvtfem.integrate`` refuses a method it names (none at present), else empty."""
     from cvtfem.integrate import solve
 
     try:
