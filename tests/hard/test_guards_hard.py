@@ -110,6 +110,34 @@ def test_on_failure_retry_gives_up_after_max_retries(tmp_path):
     assert r.stats["retry_log"].startswith("retry 1 of 1 with BDF, rtol = 0.001 after: step size stalled")
 
 
+def test_scipy_stepper_fooled_by_a_switched_force_is_stopped(monkeypatch):
+    """The growth guard of `cvtfem run` for scipy steppers: the band-4dof right-hand side plus a force of
+    1e20 switched on at t = 0.0100005 s in the last state (a discontinuity RK45's embedded estimate does
+    not see at rtol 1e-2): the accepted step that jumps from 734 to 1.6e15 stops the run with the guard's
+    message, its component, time and step."""
+    import cvtfem.analysis.run as run_mod
+
+    make = run_mod.make_stepper
+
+    def switched(method, fun, *args, **kwargs):
+        def fun_on(t, y):
+            f = np.array(fun(t, y), dtype=float)
+            f[-1] += 1e20 if t >= 0.0100005 else 0.0
+            return f
+        return make(method, fun_on, *args, **kwargs)
+
+    monkeypatch.setattr(run_mod, "make_stepper", switched)
+    scene = load_scene("band-4dof", {"solver": {"method": "RK45", "rtol": 1e-2}})
+    with pytest.raises(NumericalError) as err:
+        run_scene(scene, until=0.02, show_progress=False)
+    text = str(err.value)
+    assert text.startswith("RK45 failed: instability (RK45): |x| grew by a factor 2.18e+12 in one accepted step "
+                           "(component 15), from 734 to 1.6e+15 (more than growth_limit = 1e+08 times the largest "
+                           "|x| so far) at t = 0.010014 s with adaptive step h = 1.77e-05 s: the error estimate did "
+                           "not reject it")
+    assert err.value.t == pytest.approx(0.010014, abs=1e-6) and err.value.component == "band model band-4dof"
+
+
 def test_fallback_without_error_estimate_is_refused(tmp_path):
     scene = load_scene("band-4dof", {"solver": {"on_failure": "retry", "fallback": "rk4"}})
     with pytest.raises(InputError, match="`solver.fallback` must be a method with an error estimate"):
