@@ -134,3 +134,18 @@ def test_embedded_estimate_costs_nothing():
     assert res.stats["err_check_max"] > 1 and "Warning" in res.message
     with pytest.raises(InputError, match="`error_check` must be a whole number"):
         solve(f, (0.0, 1.0), [1.0, 0.0], method="rk4", h=0.1, error_check=-1)
+
+
+@pytest.mark.parametrize("method", ["trapezoidal", "implicit-euler", "sw24"])
+def test_embedded_check_of_implicit_methods_leaves_the_solution_unchanged(method):
+    """Implicit and W-methods compute their estimate only on the checked steps (filtered through their
+    current LU, no refactorisation): same states and LU count as without the check. The damped oscillator
+    x'' = -1e4 x - 10 x' at h = 1e-3 (h omega = 0.1) is far outside rtol = 1e-6, so the check warns."""
+    def f(t, y):
+        return np.array([y[1], -1e4 * y[0] - 10 * y[1] + np.sin(50 * t)])
+
+    checked = solve(f, (0.0, 0.1), [1.0, 0.0], method=method, h=1e-3, n2=1, error_check=5)
+    plain = solve(f, (0.0, 0.1), [1.0, 0.0], method=method, h=1e-3, n2=1)
+    assert np.array_equal(checked.y, plain.y) and checked.stats["nlu"] == plain.stats["nlu"]
+    assert checked.stats["nerr_checks"] == 20 and checked.stats["nfev_err_check"] == 0
+    assert checked.stats["err_check_max"] > 1 and "Warning: fixed step too large" in checked.message
