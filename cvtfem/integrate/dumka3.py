@@ -44,8 +44,9 @@ def _data() -> dict:
 @lru_cache(maxsize=None)
 def polynomial(k: int) -> dict:
     """Data of polynomial ``Pk``: ``s``, ``beta`` (interval of the Chebyshev form), ``eta``
-    (damping: ``|R| <= 1 - eta`` on ``[-beta, -zeta]``), ``zeta``, ``length`` (real stability length), ``cheb``, ``items`` (chain sub-steps as
-    ``("euler", tau)`` or ``("pair", (a, b1, b2))``), ``finish`` ``(a21, a31, a32, a43)``."""
+    (damping: ``|R| <= 1 - eta`` on ``[-beta, -zeta]``), ``zeta``, ``length`` (real stability
+    length), ``cheb``, ``items`` (chain sub-steps as ``("euler", tau)`` or
+    ``("pair", (a, b1, b2))``), ``finish`` ``(a21, a31, a32, a43)``, ``amplification``."""
     if not (isinstance(k, (int, np.integer)) and 0 <= k < len(DEGREES)):
         raise InputError("polynomial", k, f"must be an integer in 0..{len(DEGREES) - 1}")
     d = {key[: -len(f"_{k}")]: v for key, v in _data().items() if key.endswith(f"_{k}")}
@@ -129,13 +130,15 @@ class DUMKA3(SpectralRadiusTracker, Stepper):
             raise InputError("stages", stages, "cannot be combined with `polynomial`; give one of them")
         if stages is not None:
             if stages not in DEGREES:
-                raise InputError("stages", stages, f"must be one of the DUMKA3 degrees {list(DEGREES)} or None")
+                raise InputError("stages", stages,
+                                 f"must be one of the DUMKA3 degrees {list(DEGREES)} or None")
             polynomial = DEGREES.index(stages)
         if polynomial is not None and not (isinstance(polynomial, (int, np.integer))
                                            and 0 <= polynomial < len(DEGREES)):
             raise InputError("polynomial", polynomial, f"must be an integer in 0..{len(DEGREES) - 1} or None")
         if spectral_radius is not None and not (callable(spectral_radius) or spectral_radius > 0):
-            raise InputError("spectral_radius", spectral_radius, "must be a positive number, a callable or None")
+            raise InputError("spectral_radius", spectral_radius,
+                             "must be a positive number, a callable or None")
         self.fixed = None if polynomial is None else int(polynomial)
         self._init_rho(spectral_radius, rho_every)
         self.stages = DEGREES[self.fixed or 0]

@@ -7,9 +7,10 @@ cvtfem regenerates Medovikov's 14 third-order stability polynomials from their d
    O(z^4)``. For a given ``beta`` a linear programme (HiGHS) minimises the damping bound
    ``t = max |R|`` over ``[-beta, -zeta]`` (``|R| <= 1`` on ``[-zeta, 0]``, ``zeta = -2 ln t``);
    ``eta = 1 - t`` (then re-measured on an 80x finer grid: the LP bound holds at its grid
-   points only; this verified ``eta`` is stored). ``beta`` is adjusted (secant) until the real stability length of ``R``
-   (largest ``L`` with ``|R| <= 1`` on ``[-L, 0]``) equals the published DUMKA3 bound, so
-   ``eta`` is the damping that reproduces the published length (degree 3 has no freedom).
+   points only; this verified ``eta`` is stored). ``beta`` is adjusted (secant) until the
+   real stability length of ``R`` (largest ``L`` with ``|R| <= 1`` on ``[-L, 0]``) equals the
+   published DUMKA3 bound, so ``eta`` is the damping that reproduces the published length
+   (degree 3 has no freedom).
 2. Roots of ``R`` (colleague matrix). The complex pair nearest 0 and one real root form the
    finishing block ``Q(z) = (1 + a43 z)(1 + (a31 + a32) z + a32 a21 z^2)`` (three
    evaluations, DUMKA3's six-coefficient shape with ``a41 = a31, a42 = a32``); the real root is
@@ -108,7 +109,7 @@ def fit_polynomial(s: int, target: float):
         z = target * (x - 1) / 2
         cheb = C.chebfit(x, 1 + z + z * z / 2 + z ** 3 / 6, 3)
         return cheb, target, 0.0, 0.0, cheb_length(cheb, target, 1.2 * target)
-    b0, (c0, t0, z0, l0) = target, run(target)
+    b0, l0 = target, run(target)[3]
     b1 = target * target / l0
     c1, t1, z1, l1 = run(b1)
     for _ in range(8):   # secant on L(beta) ~ beta, steps limited to 5 %
@@ -209,7 +210,8 @@ def build(k: int) -> dict:
     fin = finishing_block(pair, r3, sp, cg)
     kinds = np.array([0 if kind == "euler" else 1 for kind, _ in items], dtype=np.int8)
     vals = np.array([r for _, r in items], dtype=complex)
-    return {"s": s, "beta": beta, "eta": eta, "eta_lp": eta_lp, "zeta": zeta, "length": length, "cheb": cheb, "kinds": kinds,
+    return {"s": s, "beta": beta, "eta": eta, "eta_lp": eta_lp, "zeta": zeta, "length": length,
+            "cheb": cheb, "kinds": kinds,
             "roots": vals, "finish": np.array(fin), "amplification": amp}
 
 

@@ -171,3 +171,16 @@ def test_amplification_of_degree_three_is_taylor():
     z = np.array([-2.0, -1.0 + 1.0j, 0.5j])
     assert np.allclose(amplification("dumka3", z, polynomial=0), np.abs(1 + z + z ** 2 / 2 + z ** 3 / 6),
                        rtol=1e-12)
+
+
+@pytest.mark.parametrize("k", [1, 2, 3])
+def test_generator_reproduces_stored_data(k):
+    """``dumka3_gen.build`` regenerates the shipped data (small degrees; all 14 were checked
+    bit-identical by a full run of studies/integrators/generate_dumka3.py)."""
+    from cvtfem.integrate import dumka3_gen
+
+    d = dumka3_gen.build(k)
+    p = polynomial(k)
+    assert np.max(np.abs(d["cheb"] - p["cheb"])) < 1e-12
+    assert np.allclose(d["finish"], p["finish"], rtol=1e-12, atol=0)
+    assert d["eta"] == pytest.approx(p["eta"], abs=1e-12)
