@@ -184,3 +184,13 @@ def test_generator_reproduces_stored_data(k):
     assert np.max(np.abs(d["cheb"] - p["cheb"])) < 1e-12
     assert np.allclose(d["finish"], p["finish"], rtol=1e-12, atol=0)
     assert d["eta"] == pytest.approx(p["eta"], abs=1e-12)
+
+
+def test_heat_benchmark_row():
+    """The issue-4 benchmark includes DUMKA3 (here N = 100): target met with at least 10x fewer
+    RHS calls than RK4 at its stability limit (measured 490 vs 5 985)."""
+    from cvtfem.integrate.study import heat_benchmark
+
+    rows = {r["method"]: r for r in heat_benchmark(N=100, repeats=1, methods=["dumka3", "rk4"])}
+    assert rows["dumka3"]["met"] and rows["rk4"]["met"]
+    assert rows["dumka3"]["nfev"] * 10 <= rows["rk4"]["nfev"]
