@@ -23,8 +23,9 @@ from cvtfem.errors import InputError
 from cvtfem.io.results import ResultsWriter, read_results
 from cvtfem.scene.loader import load_scene
 
-UNTIL = 0.025         # s simulated: 2500 rk4 steps, ~2.5 s wall per run
-INTERVAL = 0.005      # s simulated between checkpoints: 4 before the end, ~0.5 s wall apart
+UNTIL = 0.05          # s simulated: 5000 rk4 steps, ~1.8 s wall per run (compiled right-hand side)
+INTERVAL = 0.005      # s simulated between checkpoints: 9 before the end, ~0.18 s wall apart, so a kill
+                      # within 0.3 s of checkpoint 1 or 2 always lands mid-run
 SCENE = f"""preset = "band-4dof"
 [solver]
 method = "rk4"
