@@ -10,120 +10,20 @@ from __future__ import annotations
 import logging
 import math
 import time
-from dataclasses import asdict, dataclass, field
 from collections.abc import Callable
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 
+from cvtfem.analysis.steppers import SCIPY_STEPPERS, make_stepper
+from cvtfem.analysis.summary import EFFICIENCY_WINDOW, RunSummary, sample_outputs, summarise
 from cvtfem.errors import InputError, NumericalError
 
-SCIPY_STEPPERS = ("RK23", "RK45", "DOP853", "Radau", "BDF", "LSODA")
-EFFICIENCY_WINDOW = 0.05  # s, moving average of the efficiency (section 6.1)
 #: Stall guard: a run fails when STALL_STEPS consecutive accepted steps each advance time by less than
 #: STALL_FRACTION * t_end (1e-10 s for a 0.1 s run; the band models' fastest time scales are ~1e-5 s).
 STALL_STEPS = 50
 STALL_FRACTION = 1e-9
 log = logging.getLogger(__name__)
-
-
-def make_stepper(method: str, fun, t0: float, y0, t_end: float, rtol: float, atol: float, h: float = 0.0,
-                 jac=None, n2: int = 0, first_step: float = 0.0, error_check: int = 0):
-    """A step-by-step ODE solver with ``step()``, ``t``, ``y``, ``dense_output()`` and counters.
-
-    The single place that picks the integrator: the ``cvtfem.integrate`` methods through
-    :class:`~cvtfem.integrate.CvtfemSolver` (``h > 0``: fixed step, else adaptive with rtol/atol),
-    otherwise scipy's ``OdeSolver`` classes (``h > 0``: first step).  ``n2``: second-order pairs
-    ``x = [u, v, ...]`` with ``fun[:n2] = v`` (cvtfem implicit methods then solve for ``v`` only).
-    ``first_step > 0`` (a resumed run: the step size saved at the checkpoint) overrides ``h`` as the first
-    step of adaptive methods.  ``error_check``: local-error check of fixed-step cvtfem methods every that many
-    steps (``CvtfemSolver.monitor``; 0: off).
-    """
-    from cvtfem.integrate import METHODS, CvtfemSolver
-
-    if method in METHODS:
-        try:
-            return CvtfemSolver(fun, t0, np.asarray(y0, float), t_end, cvtfem_method=method, h=h or None, rtol=rtol,
-                                atol=atol, n2=n2, jac=jac, first_step=(first_step or None) if not h else None,
-                                error_check=error_check)
-        except InputError as err:  # name the scene key, not the adapter's argument
-            if err.where != "h":
-                raise
-            raise InputError("solver.h", h, f"must be a positive fixed step for {method!r} (it has no error "
-                             "estimate, so no adaptive steps)") from None
-    if method not in SCIPY_STEPPERS:
-        raise InputError("solver.method", method, "must be one of " + ", ".join(SCIPY_STEPPERS + tuple(sorted(METHODS)))
-                         + " for `cvtfem run`", _unavailable_hint(method))
-    import scipy.integrate as si
-
-    options: dict[str, Any] = {"rtol": rtol, "atol": atol}
-    if first_step > 0:
-        options["first_step"] = min(first_step, t_end - t0)
-    elif h > 0:
-        options["first_step"] = h
-    if jac is not None and method in ("Radau", "BDF", "LSODA"):
-        options["jac"] = jac
-    return getattr(si, method)(fun, t0, np.asarray(y0, float), t_end, **options)
-
-
-def _unavailable_hint(method: str) -> str:
-    """Why ``cvtfem.integrate`` refuses a method it names (none at present), else empty."""
-    from cvtfem.integrate import solve
-
-    try:
-        solve(lambda t, y: -y, (0.0, 1.0), [1.0], method=method, h=0.1)
-    except InputError as err:
-        return err.rule + (f"; {err.hint}" if err.hint else "")
-    except Exception:  # noqa: BLE001 - only a hint
-        return ""
-    return ""
-
-
-@dataclass
-class RunSummary:
-    """What a run reports (also written as ``--summary-json``)."""
-
-    scene: str
-    model: str
-    n_coordinates: int
-    simulated_time_s: float
-    wall_time_s: float
-    ratio: float
-    target_ratio: float
-    input_speed_rpm: float
-    output_speed_rpm: float
-    target_output_speed_rpm: float
-    efficiency: float | None  # None: undefined (no input work over the window), see efficiency_note
-    efficiency_kinetic: float | None
-    slip_speed_m_s: list[float]
-    clamping_force_N: list[float]
-    status: str
-    solver: dict[str, Any] = field(default_factory=dict)
-    results: str = ""
-    efficiency_note: str = ""  # why efficiency is None, else empty
-
-    def to_dict(self) -> dict[str, Any]:
-        return asdict(self)
-
-
-def sample_outputs(loop, t: float, x) -> dict[str, Any]:
-    """Named outputs (see ``cvtfem describe``) of closed-loop state ``x`` at time ``t``."""
-    _, info = loop.evaluate(t, x)
-    q, v, _, W = loop.split(x)
-    N = np.asarray(info["N"])
-    w, M, F = info["w"], info["M"], info["F"]
-    P = np.array([M[0] * w[0], -M[1] * w[1], info["dissipation"], info["clamp_power"]])
-    out = {"band.span_angle": q[0], "band.slip_speed": info["slip"], "band.slip_max": info["slip_max"],
-           "band.mean_normal_force": N.mean(axis=-1) if N.ndim == 2 else N,
-           "driving.speed": w[0], "driving.torque": M[0], "driving.clamping_force": F[0],
-           "driven.speed": w[1], "driven.torque": M[1], "driven.clamping_force": F[1],
-           "control.ratio_estimate": info["ratio_estimate"], "control.resistance": info["resistance"],
-           "efficiency": P[1] / P[0] if P[0] else math.nan, "ratio": w[0] / w[1] if w[1] else math.nan,
-           "power": P, "work": W, "energy": loop.energy(x)}
-    if N.ndim == 2:
-        out["band.normal_force"] = N.ravel()
-    return out
 
 
 def run_scene(scene, until: float | None = None, results: str | Path | None = None, show_progress: bool = True,
@@ -429,14 +329,15 @@ class _Run:
                 bar.close()
         wall = wall_before + time.perf_counter() - wall0
         stats = {"name": method, "steps": steps, "nfev": int(stepper.nfev), "njev": int(getattr(stepper, "njev", 0)),
-                 "nlu": int(getattr(stepper, "nlu", 0)), "rtol": rtol, "atol": atol}
+                 "nlu": int(getattr(stepper, "nlu", 0)), "rtol": rtol, "atol": atol,
+                 "kernel": getattr(loop.model, "backend", "numpy")}  # compiled (numba) or numpy right-hand side
         if monitor is not None and monitor.active:
             stats.update(monitor.stats())
             warning = monitor.warning()
             if warning is not None:
                 stats["warning"] = warning
                 log.warning("%s", warning)
-        summary = _summarise(scene, loop, last, (t_out[self.j_window], x_window), t_end, wall, stats, status)
+        summary = summarise(scene, loop, last, (t_out[self.j_window], x_window), t_end, wall, stats, status)
         if writer is not None:
             extra = {"checkpoints": seq} if checkpoints else {}
             if resumed is not None:
@@ -460,31 +361,3 @@ def _stall_message(loop, method: str, t: float, x, h: float, h_stall: float) -> 
             "Likely cause: a non-smooth right-hand side the solver cannot step over (anti-windup switching of the "
             "control loops, gross slip under a vanishing clamping force at near-zero torque); raise the torque "
             "or the clamping safety factor, or try another `solver.method`")
-
-
-def _summarise(scene, loop, last, window, t_end, wall, stats, status) -> RunSummary:
-    """Final ratio and speeds (raw, at the last sample ``last = (t, x)``), efficiency over the last window
-    from the work integrals (``window = (t, x)``: the sample that starts it)."""
-    t_last, x = last
-    t_j, x_j = window
-    _, info = loop.evaluate(t_last, x)
-    w1d, _, i_d = info["targets"]
-    W0, W1 = loop.split(x_j)[3], loop.split(x)[3]
-    dW = W1 - W0
-    dE = loop.energy(x) - loop.energy(x_j)
-    eff: float | None = None
-    eff_kin: float | None = None
-    note = ""
-    if dW[0] > 0:
-        eff, eff_kin = float(dW[1] / dW[0]), float(1 - (dW[0] - dW[1] - dE) / dW[0])
-    else:  # zero driving torque (or speed): output over input is 0/0
-        note = (f"undefined: input work {dW[0]:.3g} J over the last {t_last - t_j:.3g} s (driving torque "
-                f"{info['M'][0]:.3g} N m); efficiency needs positive input power")
-    rpm = 30 / math.pi
-    w = info["w"]
-    return RunSummary(scene=scene.source, model=scene.cvt.model, n_coordinates=loop.model.n2,
-                      simulated_time_s=float(t_last), wall_time_s=wall, ratio=float(w[0] / w[1]), target_ratio=i_d,
-                      input_speed_rpm=float(w[0] * rpm), output_speed_rpm=float(w[1] * rpm),
-                      target_output_speed_rpm=float(w1d / i_d * rpm), efficiency=eff,
-                      efficiency_kinetic=eff_kin, efficiency_note=note, slip_speed_m_s=[float(s) for s in info["slip"]],
-                      clamping_force_N=[float(f) for f in info["F"]], status=status, solver=stats)

@@ -57,7 +57,8 @@ def run(args: argparse.Namespace) -> int:
                             on_checkpoint=on_checkpoint)
     s = summary
     print(f"{s.model}: {s.simulated_time_s:g} s simulated in {s.wall_time_s:.3g} s wall "
-          f"({s.solver['name']}, {s.solver['steps']} steps, {s.solver['nfev']} RHS calls)")
+          f"({s.solver['name']}, {s.solver['steps']} steps, {s.solver['nfev']} RHS calls, "
+          f"{s.solver['kernel']} right-hand side)")
     print(f"  ratio {s.ratio:.4f} (target {s.target_ratio:g}), input {s.input_speed_rpm:.1f} rpm, "
           f"output {s.output_speed_rpm:.1f} rpm (target {s.target_output_speed_rpm:.1f})")
     eff = (f"efficiency {s.efficiency:.4f} (kinetic-energy corrected {s.efficiency_kinetic:.4f})"

@@ -19,6 +19,9 @@ def test_run_writes_results_and_summary(cli, tmp_path):
         assert key in s
     assert s["simulated_time_s"] == pytest.approx(0.05)
     assert s["solver"]["name"] == "BDF" and s["solver"]["nfev"] > 0  # the band-4dof preset's method
+    from cvtfem.elements.band.compressible_kernel import HAVE_NUMBA
+    assert s["solver"]["kernel"] == ("numba" if HAVE_NUMBA else "numpy")  # which right-hand side ran
+    assert f"{s['solver']['kernel']} right-hand side" in proc.stdout
     assert s["ratio"] == pytest.approx(2.4, rel=0.01)
     assert s["input_speed_rpm"] == pytest.approx(3500, rel=0.01)
     assert 0.9 < s["efficiency"] < 1.0

@@ -1,0 +1,84 @@
+"""What a time run reports: named output samples of a closed-loop state and the final :class:`RunSummary`."""
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass, field
+from typing import Any
+
+import numpy as np
+
+EFFICIENCY_WINDOW = 0.05  # s, moving average of the efficiency (section 6.1)
+
+
+@dataclass
+class RunSummary:
+    """What a run reports (also written as ``--summary-json``)."""
+
+    scene: str
+    model: str
+    n_coordinates: int
+    simulated_time_s: float
+    wall_time_s: float
+    ratio: float
+    target_ratio: float
+    input_speed_rpm: float
+    output_speed_rpm: float
+    target_output_speed_rpm: float
+    efficiency: float | None  # None: undefined (no input work over the window), see efficiency_note
+    efficiency_kinetic: float | None
+    slip_speed_m_s: list[float]
+    clamping_force_N: list[float]
+    status: str
+    solver: dict[str, Any] = field(default_factory=dict)
+    results: str = ""
+    efficiency_note: str = ""  # why efficiency is None, else empty
+
+    def to_dict(self) -> dict[str, Any]:
+        return asdict(self)
+
+
+def sample_outputs(loop, t: float, x) -> dict[str, Any]:
+    """Named outputs (see ``cvtfem describe``) of closed-loop state ``x`` at time ``t``."""
+    _, info = loop.evaluate(t, x)
+    q, v, _, W = loop.split(x)
+    N = np.asarray(info["N"])
+    w, M, F = info["w"], info["M"], info["F"]
+    P = np.array([M[0] * w[0], -M[1] * w[1], info["dissipation"], info["clamp_power"]])
+    out = {"band.span_angle": q[0], "band.slip_speed": info["slip"], "band.slip_max": info["slip_max"],
+           "band.mean_normal_force": N.mean(axis=-1) if N.ndim == 2 else N,
+           "driving.speed": w[0], "driving.torque": M[0], "driving.clamping_force": F[0],
+           "driven.speed": w[1], "driven.torque": M[1], "driven.clamping_force": F[1],
+           "control.ratio_estimate": info["ratio_estimate"], "control.resistance": info["resistance"],
+           "efficiency": P[1] / P[0] if P[0] else math.nan, "ratio": w[0] / w[1] if w[1] else math.nan,
+           "power": P, "work": W, "energy": loop.energy(x)}
+    if N.ndim == 2:
+        out["band.normal_force"] = N.ravel()
+    return out
+
+
+def summarise(scene, loop, last, window, t_end, wall, stats, status) -> RunSummary:
+    """Final ratio and speeds (raw, at the last sample ``last = (t, x)``), efficiency over the last window
+    from the work integrals (``window = (t, x)``: the sample that starts it)."""
+    t_last, x = last
+    t_j, x_j = window
+    _, info = loop.evaluate(t_last, x)
+    w1d, _, i_d = info["targets"]
+    W0, W1 = loop.split(x_j)[3], loop.split(x)[3]
+    dW = W1 - W0
+    dE = loop.energy(x) - loop.energy(x_j)
+    eff: float | None = None
+    eff_kin: float | None = None
+    note = ""
+    if dW[0] > 0:
+        eff, eff_kin = float(dW[1] / dW[0]), float(1 - (dW[0] - dW[1] - dE) / dW[0])
+    else:  # zero driving torque (or speed): output over input is 0/0
+        note = (f"undefined: input work {dW[0]:.3g} J over the last {t_last - t_j:.3g} s (driving torque "
+                f"{info['M'][0]:.3g} N m); efficiency needs positive input power")
+    rpm = 30 / math.pi
+    w = info["w"]
+    return RunSummary(scene=scene.source, model=scene.cvt.model, n_coordinates=loop.model.n2,
+                      simulated_time_s=float(t_last), wall_time_s=wall, ratio=float(w[0] / w[1]), target_ratio=i_d,
+                      input_speed_rpm=float(w[0] * rpm), output_speed_rpm=float(w[1] * rpm),
+                      target_output_speed_rpm=float(w1d / i_d * rpm), efficiency=eff,
+                      efficiency_kinetic=eff_kin, efficiency_note=note, slip_speed_m_s=[float(s) for s in info["slip"]],
+                      clamping_force_N=[float(f) for f in info["F"]], status=status, solver=stats)
