@@ -5,10 +5,9 @@ After Medovikov (BIT 38(2) 1998): polynomial ``Pk`` has degree ``s_k`` in
 step. cvtfem does not ship Medovikov's tables: the polynomials and the scheme's coefficients
 are regenerated (:mod:`cvtfem.integrate.dumka3_gen`, data in ``dumka3_data.npz``).
 
-A step is a chain of forward-Euler sub-steps ``y += h tau F(y)`` (``tau = -1/r`` for each
-real root ``r`` of ``R_s``; a complex pair ``r, conj(r)`` gives a 2-stage sub-step with
-stability factor ``1 + alpha z + beta z^2``), ordered for internal stability, then a finishing
-block of three evaluations,
+A step is a chain of forward-Euler sub-steps ``y += h tau F(y)`` (``tau = -1/r`` for the
+real roots ``r`` of ``R_s`` but one), ordered for internal stability, then a finishing block
+of three evaluations (the remaining real root and the complex pair),
 ``Y1 = g + h a21 F(g)``, ``Y2 = g + h (a31 F(g) + a32 F(Y1))``, ``x1 = Y2 + h a43 F(Y2)``,
 whose coefficients realise the remaining cubic factor of ``R_s`` and make the composed method
 order 3 for nonlinear problems (``sum b c^2 = 1/3``).
@@ -45,20 +44,13 @@ def _data() -> dict:
 def polynomial(k: int) -> dict:
     """Data of polynomial ``Pk``: ``s``, ``beta`` (interval of the Chebyshev form), ``eta``
     (damping: ``|R| <= 1 - eta`` on ``[-beta, -zeta]``), ``zeta``, ``length`` (real stability
-    length), ``cheb``, ``items`` (chain sub-steps as ``("euler", tau)`` or
-    ``("pair", (a, b1, b2))``), ``finish`` ``(a21, a31, a32, a43)``, ``amplification``."""
+    length), ``cheb``, ``taus`` (Euler sub-steps, in order), ``finish``
+    ``(a21, a31, a32, a43)``, ``amplification`` (rounding-error growth bound)."""
     if not (isinstance(k, (int, np.integer)) and 0 <= k < len(DEGREES)):
         raise InputError("polynomial", k, f"must be an integer in 0..{len(DEGREES) - 1}")
     d = {key[: -len(f"_{k}")]: v for key, v in _data().items() if key.endswith(f"_{k}")}
-    items = []
-    for kind, r in zip(d["kinds"], d["roots"]):
-        if kind == 0:
-            items.append(("euler", -1 / r.real))
-        else:
-            a = abs(1 / r)
-            items.append(("pair", (a, -2 * (1 / r).real - a, a)))
     return {"s": int(d["s"]), "beta": float(d["beta"]), "eta": float(d["eta"]), "zeta": float(d["zeta"]),
-            "length": float(d["length"]), "cheb": d["cheb"], "items": tuple(items),
+            "length": float(d["length"]), "cheb": d["cheb"], "taus": tuple(-1 / d["roots"]),
             "finish": tuple(float(v) for v in d["finish"]),
             "amplification": float(d["amplification"])}
 
@@ -74,8 +66,8 @@ def product_form(k: int, z) -> np.ndarray:
     p = polynomial(k)
     z = np.asarray(z, dtype=complex)
     out = np.ones_like(z)
-    for kind, c in p["items"]:
-        out = out * (1 + c * z) if kind == "euler" else out * (1 + (c[1] + c[2]) * z + c[0] * c[2] * z * z)
+    for tau in p["taus"]:
+        out = out * (1 + tau * z)
     a21, a31, a32, a43 = p["finish"]
     return out * (1 + a43 * z) * (1 + (a31 + a32) * z + a21 * a32 * z * z)
 
@@ -90,29 +82,19 @@ def butcher(k: int):
     p = polynomial(k)
     s = p["s"]
     A = np.zeros((s, s))
-    w = np.zeros(s)          # weights of the current chain value y in terms of the stages
-    i = 0                    # next stage index; stage i is F at the current y
-    for kind, c in p["items"]:
-        if kind == "euler":
-            w[i] += c
-            A[i + 1] = w
-            i += 1
-        else:
-            a, b1, b2 = c
-            A[i + 1] = w
-            A[i + 1, i] += a
-            w[i] += b1
-            w[i + 1] += b2
-            A[i + 2] = w
-            i += 2
+    w = np.zeros(s)          # the chain value y = x + h sum_j w_j k_j
+    n = len(p["taus"])
+    for i, tau in enumerate(p["taus"]):   # stage i is F at the chain value before sub-step i
+        w[i] = tau
+        A[i + 1] = w
     a21, a31, a32, a43 = p["finish"]
-    A[i + 1] = w
-    A[i + 1, i] += a21
-    A[i + 2] = w
-    A[i + 2, i] += a31
-    A[i + 2, i + 1] += a32
-    b = A[i + 2].copy()
-    b[i + 2] += a43
+    A[n + 1] = w
+    A[n + 1, n] += a21
+    A[n + 2] = w
+    A[n + 2, n] += a31
+    A[n + 2, n + 1] += a32
+    b = A[n + 2].copy()
+    b[n + 2] += a43
     return A, b, A.sum(axis=1)
 
 
@@ -157,15 +139,9 @@ class DUMKA3(SpectralRadiusTracker, Stepper):
         p = polynomial(self._choose(t, x, f0, h))
         self.stages = p["s"]
         y, c, fy = x, 0.0, f0
-        for kind, co in p["items"]:
-            if kind == "euler":
-                y = y + (h * co) * fy
-                c += co
-            else:
-                a, b1, b2 = co
-                f1 = self.f(t + (c + a) * h, y + (h * a) * fy)
-                y = y + h * (b1 * fy + b2 * f1)
-                c += b1 + b2
+        for tau in p["taus"]:
+            y = y + (h * tau) * fy
+            c += tau
             fy = self.f(t + c * h, y)
         a21, a31, a32, a43 = p["finish"]
         alpha = a31 + a32

@@ -16,7 +16,7 @@ cvtfem regenerates Medovikov's 14 third-order stability polynomials from their d
    evaluations, DUMKA3's six-coefficient shape with ``a41 = a31, a42 = a32``); the real root is
    the one minimising ``max |Q|`` on the interval. ``a32`` is then fixed by the nonlinear
    order-3 condition ``sum b c^2 = 1/3`` of the composed method.
-3. The other roots become forward-Euler sub-steps (complex pairs: 2-stage sub-steps), ordered
+3. The other roots (all real for the 14 degrees) become forward-Euler sub-steps, ordered
    greedily so that ``max|head_k| * max|tail_k|`` (products of the factors before and after
    sub-step ``k``, the rounding-error amplification) stays small.
 
@@ -131,16 +131,16 @@ def verified_damping(cheb: np.ndarray, beta: float, zeta: float) -> float:
 
 
 def _factors(roots: np.ndarray):
-    """Real roots and complex pairs (upper half-plane member) of a real polynomial."""
+    """Real roots (ascending) and the upper members of complex pairs (by modulus)."""
     real = np.sort(roots[np.abs(roots.imag) <= 1e-9 * np.abs(roots)].real)
     cplx = roots[roots.imag > 1e-9 * np.abs(roots)]
     return real, cplx[np.argsort(np.abs(cplx))]
 
 
-def _log_factor(z: np.ndarray, item) -> np.ndarray:
-    kind, r = item
+def _log_factor(z: np.ndarray, r, pair: bool = False) -> np.ndarray:
+    """``log |1 - z/r|`` (``pair``: of ``(1 - z/r)(1 - z/conj(r))``) on the grid ``z``."""
     f = np.abs(1 - z / r)
-    return np.log(np.maximum(f * f if kind == "pair" else f, 1e-300))
+    return np.log(np.maximum(f * f if pair else f, 1e-300))
 
 
 def finishing_block(pair: complex, r3: float, sp: float, cg: float):
@@ -152,28 +152,23 @@ def finishing_block(pair: complex, r3: float, sp: float, cg: float):
     return bq / a32, alpha - a32, a32, a43
 
 
-def chain_moments(items):
-    """``(sum b, sum b c^2)`` of a chain of Euler (``tau``) / pair (``a, b1, b2``) sub-steps."""
+def chain_moments(roots):
+    """``(sum b, sum b c^2)`` of the chain of Euler sub-steps ``tau = -1/r``."""
     c = sp = 0.0
-    for kind, r in items:
-        if kind == "euler":
-            tau = -1 / r
-            sp += tau * c * c
-            c += tau
-        else:
-            a = b2 = abs(1 / r)
-            b1 = -2 * (1 / r).real - b2
-            sp += b1 * c * c + b2 * (c + a) ** 2
-            c += b1 + b2
+    for r in roots:
+        tau = -1 / r
+        sp += tau * c * c
+        c += tau
     return c, sp
 
 
-def order_chain(items, fixed_tail, z):
-    """Greedy order of ``items`` minimising ``max log|head| + max log|tail|`` at each step."""
-    logs = np.array([_log_factor(z, it) for it in items])
+def order_chain(roots, tail_log, z):
+    """Greedy order of ``roots`` minimising ``max log|head| + max log|tail|`` at each sub-step;
+    ``tail_log`` is the log modulus of the fixed last factor. Returns the order and the bound."""
+    logs = np.array([_log_factor(z, r) for r in roots])
     head = np.zeros_like(z)
-    tail = logs.sum(axis=0) + sum(_log_factor(z, it) for it in fixed_tail)
-    left, out, worst = list(range(len(items))), [], 0.0
+    tail = logs.sum(axis=0) + tail_log
+    left, out, worst = list(range(len(roots))), [], 0.0
     while left:
         cand = logs[left]
         cost = np.max(head + cand, axis=1) + np.max(tail - cand, axis=1)
@@ -181,8 +176,8 @@ def order_chain(items, fixed_tail, z):
         worst = max(worst, float(cost[j]))
         i = left.pop(j)
         head, tail = head + logs[i], tail - logs[i]
-        out.append(items[i])
-    return out, float(np.exp(worst))
+        out.append(roots[i])
+    return np.array(out), float(np.exp(worst))
 
 
 def build(k: int) -> dict:
@@ -190,29 +185,24 @@ def build(k: int) -> dict:
     s, target = DEGREES[k], PUBLISHED_BETA[k]
     cheb, beta, eta_lp, zeta, length = fit_polynomial(s, target)
     eta = verified_damping(cheb, beta, zeta) if eta_lp > 0 else 0.0
-    roots = (C.chebroots(cheb) - 1) * beta / 2
-    real, cplx = _factors(roots)
-    pair, others = cplx[0], cplx[1:]
+    real, cplx = _factors((C.chebroots(cheb) - 1) * beta / 2)
+    if len(cplx) != 1:   # the finishing block holds one pair; the chain is Euler steps only
+        raise RuntimeError(f"DUMKA3 s = {s}: {len(cplx)} complex pairs, the scheme expects one")
+    pair = cplx[0]
     m = 8 * s + 200
     z = beta * (np.cos(np.pi * np.arange(m + 1) / m) - 1) / 2
-    best = None
-    for r3 in real:   # finishing real root: smallest max |Q| on the interval
-        q = _log_factor(z, ("euler", r3)) + _log_factor(z, ("pair", pair))
-        if best is None or q.max() < best[0]:
-            best = (q.max(), r3)
-    r3 = best[1]
-    items = [("euler", r) for r in real if r != r3] + [("pair", r) for r in others]
-    if items:
-        items, amp = order_chain(items, [("euler", r3), ("pair", pair)], z)
+    q_log = [_log_factor(z, r3) + _log_factor(z, pair, pair=True) for r3 in real]
+    i3 = int(np.argmin([q.max() for q in q_log]))   # finishing real root: smallest max |Q|
+    r3 = real[i3]
+    chain = real[np.arange(len(real)) != i3]
+    if len(chain):
+        chain, amp = order_chain(chain, q_log[i3], z)
     else:
-        amp = float(np.exp(best[0]))
-    cg, sp = chain_moments(items)
+        amp = float(np.exp(q_log[i3].max()))
+    cg, sp = chain_moments(chain)
     fin = finishing_block(pair, r3, sp, cg)
-    kinds = np.array([0 if kind == "euler" else 1 for kind, _ in items], dtype=np.int8)
-    vals = np.array([r for _, r in items], dtype=complex)
     return {"s": s, "beta": beta, "eta": eta, "eta_lp": eta_lp, "zeta": zeta, "length": length,
-            "cheb": cheb, "kinds": kinds,
-            "roots": vals, "finish": np.array(fin), "amplification": amp}
+            "cheb": cheb, "roots": chain, "finish": np.array(fin), "amplification": amp}
 
 
 def generate(out: Path = DATA_FILE, report=None) -> dict:

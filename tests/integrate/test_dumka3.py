@@ -43,7 +43,7 @@ def test_product_form_equals_generated_polynomial(k):
     p = polynomial(k)
     z = -p["beta"] * (1 - np.cos(np.linspace(0, np.pi, 10 * p["s"]))) / 2
     assert np.max(np.abs(product_form(k, z) - stability_polynomial(k, z))) < 1e-9
-    assert len(p["items"]) + 3 <= p["s"]
+    assert len(p["taus"]) + 3 == p["s"]          # s RHS calls per step: chain + finishing block
 
 
 @pytest.mark.parametrize("k", K)
@@ -183,6 +183,7 @@ def test_generator_reproduces_stored_data(k):
     p = polynomial(k)
     assert np.max(np.abs(d["cheb"] - p["cheb"])) < 1e-12
     assert np.allclose(d["finish"], p["finish"], rtol=1e-12, atol=0)
+    assert np.allclose(-1 / d["roots"], p["taus"], rtol=1e-12, atol=0)
     assert d["eta"] == pytest.approx(p["eta"], abs=1e-12)
 
 
