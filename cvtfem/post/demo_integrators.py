@@ -23,9 +23,9 @@ def run(outdir: Path) -> list[str]:
     lines = []
     methods = [("rk4", "rk4", {}), ("dopri78", "dopri78", {}), ("GBS2s", "gbs-smooth", {"stages": 2}),
                ("SW24-0.5", "sw24", {"d": 0.5}), ("W1-0.5-X4", "w1-extrapolation", {"d": 0.5, "stages": 4}),
-               ("RKC s=5", "rkc", {"stages": 5})]
+               ("RKC s=5", "rkc", {"stages": 5}), ("DUMKA3 P0", "dumka3", {"polynomial": 0})]
     f = plot_stability(methods, outdir / "integrators_stability.png", extent=6.0, n=161)
-    lines.append(f"{f.name}: stability regions |R(z)| <= 1 of six methods, linear plane (brute force)")
+    lines.append(f"{f.name}: stability regions |R(z)| <= 1 of seven methods, linear plane (brute force)")
     f = plot_stability(methods, outdir / "integrators_stability_log.png", log=True, n=161)
     lines.append(f"{f.name}: the same on the source's signed-log plane (x* = 1e-3)")
 
@@ -34,12 +34,13 @@ def run(outdir: Path) -> list[str]:
     curves, orders = [], {}
     for label, method, opts, p in [("rk4", "rk4", {}, 4), ("dopri45", "dopri45", {}, 5),
                                    ("dopri56", "dopri56", {}, 6), ("GBS3", "gbs", {"stages": 3}, 6),
-                                   ("trapezoid", "trapezoidal", {}, 2), ("SW24", "sw24", {}, 2)]:
+                                   ("trapezoid", "trapezoidal", {}, 2), ("SW24", "sw24", {}, 2),
+                                   ("DUMKA3 P6", "dumka3", {"polynomial": 6}, 3)]:
         errs = local_errors(problem, method, hs, **opts)
         curves.append((label, hs, errs, p))
         orders[label] = {"nominal": p, "measured": float(effective_order(hs, errs)[-1])}
     f = plot_effective_order(curves, outdir / "integrators_order.png", "effective order (local error), limit cycle")
-    lines.append(f"{f.name}: local error e(h) and effective order p~(h) of six methods")
+    lines.append(f"{f.name}: local error e(h) and effective order p~(h) of seven methods")
 
     ball = bouncing_ball(x0=1.0, v0=0.5, e=0.8, t_end=3.5)
     res = solve(**ball.solve_kwargs(), method="dopri45", rtol=1e-8, t_eval=np.linspace(0, 3.5, 701))
@@ -57,11 +58,11 @@ def run(outdir: Path) -> list[str]:
     plt.close(fig)
     lines.append("integrators_bouncing_ball.png: bouncing ball with events, impact times vs closed form")
 
-    rows = heat_benchmark(N=200, repeats=1, methods=["rk4", "rkc", "trapezoidal", "BDF"])
+    rows = heat_benchmark(N=200, repeats=1, methods=["rk4", "rkc", "dumka3", "trapezoidal", "BDF"])
     summary = {"effective_orders": orders, "heat_N200_target_1e-4": [
         {k: (float(v) if isinstance(v, (float, np.floating)) else v) for k, v in r.items()}
         for r in rows]}
     (outdir / "integrators_summary.json").write_text(json.dumps(summary, indent=1, default=str))
     lines.append("integrators_summary.json: measured orders; heat equation N=200 RHS calls and time "
-                 "(RK4, RKC, sparse trapezoid, scipy BDF)")
+                 "(RK4, RKC, DUMKA3, sparse trapezoid, scipy BDF)")
     return lines

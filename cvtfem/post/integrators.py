@@ -87,8 +87,9 @@ def plot_effective_order(curves, path: Path, title: str = "") -> Path:
     a2.set_xlabel("h")
     a2.set_ylabel("effective order p~ = dln e/dln h - 1")
     a1.legend(fontsize=7)
-    a1.grid(True, which="both", lw=0.3)
-    a2.grid(True, which="both", lw=0.3)
+    for ax in (a1, a2):
+        ax.grid(True, which="both", lw=0.3)
+        ax.xaxis.set_minor_formatter(plt.NullFormatter())  # minor labels of a short log range overlap
     fig.suptitle(title or "effective order test", fontsize=10)
     fig.tight_layout()
     fig.savefig(path, dpi=110)
