@@ -94,6 +94,10 @@ class Stepper:
     def reset(self) -> None:
         """Forget the history (after an event switch changes the state or ``phi``)."""
 
+    def max_step(self) -> float:
+        """Largest step, s, worth attempting now (adaptive runs cap their proposals there); no cap here."""
+        return np.inf
+
 
 def hermite(att: Attempt, f1: np.ndarray, t: np.ndarray | float) -> np.ndarray:
     """Cubic Hermite interpolant of a step, ``(n,)`` or ``(n, len(t))``; order 3 in ``h``."""

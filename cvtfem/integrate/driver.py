@@ -213,7 +213,7 @@ def _integrate(stepper, ctrl, system, t0, tf, y0, h, rtol, atol, t_eval, event_l
         if st["nsteps"] >= max_steps:
             status, message = -1, f"`max_steps` = {max_steps} reached at t = {t:.6g} s"
             break
-        h_try = min(h, tf - t)
+        h_try = min(h, tf - t, stepper.max_step()) if adaptive else min(h, tf - t)
         if tf - (t + h_try) < 1e-9 * h_try:
             h_try = tf - t
         if monitor is not None:
