@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from cvtfem.errors import InputError
-from cvtfem.integrate.base import Attempt, Stepper
+from cvtfem.integrate.base import Attempt, StepFailure, Stepper
 
 __all__ = ["RKC", "rkc_coefficients", "rkc_stability_length", "spectral_radius"]
 
@@ -69,7 +69,10 @@ def spectral_radius(f, t, x, f0, v0=None, max_iter: int = 50, rtol: float = 0.01
     if v0 is None:   # F(x) plus a fixed rough vector, so that high modes are present
         rough = np.random.default_rng(12345).standard_normal(x.shape)
         nf = np.linalg.norm(f0)
-        v = (f0 / nf if nf > 0 else 0.0) + rough / np.linalg.norm(rough)
+        rough /= np.linalg.norm(rough)
+        v = f0 / nf + rough if nf > 0 else rough
+        if np.linalg.norm(v) < 0.5:   # F and the rough vector nearly cancel (e.g. one equation)
+            v = rough
     else:
         v = np.array(v0, dtype=float)
     xnorm = np.linalg.norm(x)
@@ -106,8 +109,10 @@ class SpectralRadiusTracker:
         if self.rho_user is not None:
             return float(self.rho_user)
         if self._rho is None or self._rho_age >= self.rho_every:
-            self._rho = RHO_SAFETY * spectral_radius(self.f, t, x, f0)
-            self._rho_age = 0
+            rho = RHO_SAFETY * spectral_radius(self.f, t, x, f0)
+            if not np.isfinite(rho):   # the state or F overflowed: a failed attempt, not a crash
+                raise StepFailure(f"spectral-radius estimate is {rho} at t = {t:.6g} s")
+            self._rho, self._rho_age = rho, 0
         return self._rho
 
     def accept(self, att):

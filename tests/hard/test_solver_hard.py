@@ -143,6 +143,35 @@ def test_step_size_underflow_at_a_finite_time_blow_up(method, rtol):
     assert np.all(np.abs(res.y[0, early] / y_exact - 1) <= 1e3 * rtol * y_exact)
 
 
+
+@pytest.mark.timeout(60)
+@pytest.mark.parametrize("method", ["rkc", "rock2", "rock4", "dumka3"])
+def test_stabilized_methods_at_a_finite_time_blow_up(method):
+    """y' = y^2 with the stabilized methods: the power iteration near the pole once returned NaN (RKC
+    crashed with a raw ValueError) and divided by zero on one equation; now a non-finite estimate is a
+    rejected attempt and the run ends in a reported step-size underflow. Their error estimates accept a
+    last step just across the pole (measured t_end - 1: 1.1e-6 ROCK2, 1.5e-6 ROCK4, 7e-7 DUMKA3, 7.3e-5
+    RKC at rtol 1e-6), so t_end is bounded by 1e-4, not by round-off as for DOPRI45."""
+    rtol = 1e-6
+    with np.errstate(all="raise"):
+        res = solve(lambda t, y: y * y, (0.0, 2.0), [1.0], method=method, rtol=rtol, atol=1e-2 * rtol)
+    assert res.status == -1 and res.message.startswith("step size underflow (h = ")
+    assert 1.0 - 1e-3 < res.t[-1] < 1.0 + 1e-4 and np.all(np.isfinite(res.y))
+    early = res.t < 0.999
+    y_exact = 1 / (1 - res.t[early])
+    assert np.all(np.abs(res.y[0, early] / y_exact - 1) <= 1e3 * rtol * y_exact)
+
+
+@pytest.mark.parametrize("method", ["rkc", "rock2", "rock4", "dumka3"])
+def test_stabilized_methods_on_one_growing_equation(method):
+    """y' = y (positive eigenvalue, one equation): F and the power iteration's rough start vector may
+    cancel exactly; the estimate falls back to the rough vector (no division by zero) and the run
+    follows e^t."""
+    with np.errstate(all="raise"):
+        res = solve(lambda t, y: y, (0.0, 5.0), [1.0], method=method, rtol=1e-6)
+    assert res.success and abs(res.y[0, -1] / np.exp(5.0) - 1) < 1e-3
+
+
 def test_invalid_step_sizes_are_input_errors():
     for h in (0.0, -1e-3, math.nan, math.inf):
         with pytest.raises(InputError, match="`h` must be a positive step size in s"):
