@@ -55,6 +55,27 @@ def test_stability_length_published(family, k, c):
     assert abs(stability_length(family, k) / (c * s * s) - 1) < 0.01
 
 
+#: Abdulle (2002), SIAM J. Sci. Comput. 23(6), Table 2.1: real stability length l_s of the ROCK4
+#: polynomial of degree s (s = 50 and 100 are not degrees of the ROCK4 code: bracketed below)
+ROCK4_TABLE_2_1 = {5: 5.9983, 10: 32.4470, 20: 138.3586}
+
+
+@pytest.mark.parametrize("s", sorted(ROCK4_TABLE_2_1))
+def test_rock4_stability_length_table(s):
+    """Measured 6.0120 / 32.4567 / 138.3679: +0.23 %, +0.03 %, +0.007 % of the published lengths."""
+    k = list(D.MS4).index(s - 4)
+    assert abs(stability_length(4, k) / ROCK4_TABLE_2_1[s] - 1) < 0.01
+
+
+@pytest.mark.parametrize("s_lo,s_hi,c_pub", [(48, 51, 0.351955), (96, 102, 0.353813)])
+def test_rock4_stability_constant_brackets_table(s_lo, s_hi, c_pub):
+    """c(s) = l_s / s^2 grows with s; the published c(50), c(100) of Table 2.1 lie between ours at the
+    neighbouring degrees of the code (measured 0.351844 < 0.351955 < 0.352013, 0.353789 < 0.353813 <
+    0.353909)."""
+    c = [stability_length(4, list(D.MS4).index(s - 4)) / s ** 2 for s in (s_lo, s_hi)]
+    assert c[0] < c_pub < c[1]
+
+
 @pytest.mark.parametrize("method,stages,k", [("rock2", 10, 7), ("rock4", 12, 7)])
 def test_stability_length_by_stepping(method, stages, k):
     fam = int(method[-1])
