@@ -8,9 +8,19 @@ pattern), ``hart`` (secant update of the LU factors on their patterns, no refact
 ``trim_threshold * max|B|`` dropped).
 Line search (2.21)-(2.22) with the ratio new/old (errata #20): the first ``alpha = 2^-i``,
 ``i = 0..9``, with ratio <= 0.8, else the minimiser; all ratios >= 1 means divergence.
-Stopping (2.23): ``||G|| < eps_abs`` and ``||dx|| < eps_rel ||x|| + eps_abs`` (inf-norms).
+Stopping (2.23): ``||G|| < eps_abs`` and ``||dx|| < eps_rel ||x|| + eps_abs`` (inf-norms;
+``eps_abs`` is relative to ``max(1, |x_i|)`` per component, so the test stays above round-off).
 Divergence or ``max_iter`` iterations refresh the Jacobian; a failure right after a refresh
-raises :class:`~cvtfem.integrate.base.StepFailure`.
+raises :class:`~cvtfem.integrate.base.StepFailure`. This is ``stop="source"`` (the default
+``"auto"`` uses it when no error-norm scales are given: fixed-step runs).
+
+``stop="rate"`` (``"auto"`` with scales: adaptive runs; Hairer-Wanner IV.8, as Radau5): no line search;
+the contraction rate ``theta_k = ||d_k|| / ||d_{k-1}||`` is measured in the weighted RMS norm of
+the local error (``scale = atol + rtol |y|``); converged when ``theta/(1-theta) ||d_k|| <= kappa``
+(the first iteration uses the previous solve's rate); divergence when ``theta >= 1`` or when the
+remaining iterations cannot reach ``kappa`` at the observed rate. A failure with a Jacobian of an
+earlier step refreshes it and restarts from the guess; a solve that needed more than two
+iterations at a rate above ``RATE_REFRESH`` marks the Jacobian stale for the next solve.
 """
 from __future__ import annotations
 
@@ -30,6 +40,9 @@ __all__ = ["NewtonOptions", "NewtonSolver", "VARIANTS"]
 VARIANTS = ("exact", "const", "broyden", "fake-broyden", "hart", "trim")
 ETA_ACCEPT = 0.8
 N_ALPHA = 10
+STOPS = ("auto", "rate", "source")   # auto: rate when error-norm scales are given
+RATE_REFRESH = 0.3    # stop="rate": slower contraction than this (after > 2 iterations) -> new Jacobian
+EPS = np.finfo(float).eps
 
 
 @dataclass(frozen=True)
@@ -41,10 +54,13 @@ class NewtonOptions:
     eps_rel: float = 1e-8
     max_iter: int = 12
     trim_threshold: float = 1e-3
+    stop: str = "auto"
 
     def __post_init__(self) -> None:
         if self.variant not in VARIANTS:
             raise InputError("newton", self.variant, f"must be one of {VARIANTS}")
+        if self.stop not in STOPS:
+            raise InputError("newton_stop", self.stop, f"must be one of {STOPS}")
         if not (self.eps_abs > 0 and self.eps_rel >= 0):
             raise InputError("newton_tol", (self.eps_abs, self.eps_rel), "must be positive")
 
@@ -56,6 +72,8 @@ class NewtonSolver:
         self.stats, self.opt = stats, options
         self.B = None
         self._lu = None
+        self.stale = False   # the matrix B comes from a Jacobian of an earlier solve
+        self._eta = 1.0      # stop="rate": theta/(1-theta) of the previous solve
 
     def invalidate(self) -> None:
         """Drop ``B`` (the step size changed, so the frozen matrix is rebuilt next solve)."""
@@ -99,15 +117,21 @@ class NewtonSolver:
             r = dg - self.B @ s
             self._set(self.B + (self.B != 0) * np.outer(r, s) / ss)
 
-    def solve(self, residual, y, make_matrix, eps_abs=None):
+    def solve(self, residual, y, make_matrix, eps_abs=None, scale=None, kappa=0.03):
         """Solve ``residual(y) = 0`` from the guess ``y``; returns ``(y, residual(y))``.
 
         ``make_matrix(y, fresh)`` returns ``dG/dy`` (``fresh``: from a new Jacobian at ``y``);
         ``eps_abs`` (scalar or per component) overrides the option, e.g. to tie the residual
-        to the local-error tolerance of an adaptive run.
+        to the local-error tolerance of an adaptive run. ``stop="rate"`` needs ``scale``
+        (per component, units of ``y``) and uses ``kappa`` (the tolerance in that norm).
         """
+        if self.opt.stop == "rate" or (self.opt.stop == "auto" and scale is not None):
+            if scale is None:
+                raise InputError("newton_stop", "rate", "needs error-norm scales (an adaptive run)")
+            return self._solve_rate(residual, y, make_matrix, scale, kappa)
         opt, st = self.opt, self.stats
         eps = opt.eps_abs if eps_abs is None else eps_abs
+        eps = eps * np.maximum(1.0, np.abs(y))   # relative above 1: stays above round-off of G
         g = residual(y)
         fresh = opt.variant == "exact"
         if self.B is None or fresh:
@@ -147,6 +171,60 @@ class NewtonSolver:
         st.counts["nnewton_fail"] += 1
         self.invalidate()
         raise StepFailure(f"Newton ({opt.variant}) diverged: |G| = {np.max(np.abs(g)):.3g}")
+
+    def _solve_rate(self, residual, y0, make_matrix, scale, kappa):
+        """Simplified Newton with the contraction-rate test (see module docstring)."""
+        opt, st = self.opt, self.stats
+
+        def norm(v):
+            return float(np.sqrt(np.mean(np.abs(v / scale) ** 2)))
+
+        exact = opt.variant == "exact"
+        fresh = exact or self.stale   # a Jacobian at this step's guess
+        if fresh or self.B is None:   # B None only: new step size, the last Jacobian serves
+            self._set(make_matrix(y0, fresh))
+            self.stale = False
+        while True:
+            y, g = y0, residual(y0)
+            eta = max(self._eta, EPS) ** 0.8
+            dn_old, theta, ok = None, 1.0, False
+            for k in range(opt.max_iter):
+                d = self._direction(g)
+                st.counts["nnewton"] += 1
+                dn = norm(d)
+                if not np.isfinite(dn):
+                    break
+                if dn_old is not None:
+                    theta = dn / dn_old if dn_old > 0 else 0.0
+                    if theta >= 1.0 or theta ** (opt.max_iter - 1 - k) / (1 - theta) * dn > kappa:
+                        break   # diverges, or too slow to reach kappa within max_iter
+                    eta = theta / (1.0 - theta)
+                y = y + d
+                g_new = residual(y)
+                if eta * dn <= kappa or dn == 0.0:
+                    ok = True
+                    g = g_new
+                    break
+                if opt.variant in ("broyden", "fake-broyden", "hart"):
+                    self._update(d, g_new - g)
+                elif exact:
+                    self._set(make_matrix(y, True))
+                g, dn_old = g_new, dn
+            if ok:
+                self._eta = eta
+                if not exact and k + 1 > 2 and theta > RATE_REFRESH:
+                    self.stale = True
+                return y, g
+            self._eta = 1.0
+            if fresh:
+                break
+            st.counts["njac_refresh"] += 1
+            self._set(make_matrix(y0, True))
+            fresh = True
+        st.counts["nnewton_fail"] += 1
+        self.invalidate()
+        raise StepFailure(f"Newton ({opt.variant}) diverged: rate {theta:.3g}, |dy|/tol = {dn:.3g} "
+                          f"after {k + 1} iterations")
 
     def _line_search(self, residual, y, g, d):
         n0 = float(np.vdot(g, g).real)
