@@ -1,6 +1,9 @@
 """``cvtfem study stability|order|work|heat``: integrator studies (PNG + CSV).
 
 Method specs are ``NAME[:key=value...]``, e.g. ``gbs-smooth:stages=2`` or ``sw24:d=0.5``.
+``order`` and ``work`` also run on a band-model scene (``--scene band-6+2n --until 0.05``): its
+closed loop with the second-order structure and analytic Jacobian; ``work`` then measures the
+relative error of ratio, speeds and work ratio at the end against Radau at ``--ref-rtol``.
 """
 from __future__ import annotations
 
@@ -25,12 +28,14 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     a.add_argument("--png", default="stability.png", help="output PNG")
     b = s.add_parser("order", help="effective-order test: local error vs h (spec §9.4)")
     b.add_argument("--problem", default="limit_cycle", help="problem name (cvtfem.problems.PROBLEMS)")
+    _scene_args(b)
     b.add_argument("--methods", default=DEFAULT_ORDER)
     b.add_argument("--hs", default="0.4:0.0125:6", help="H_MAX:H_MIN:COUNT (log spaced)")
     b.add_argument("--png", default="order.png")
     b.add_argument("--csv", default="order.csv")
     c = s.add_parser("work", help="work-precision diagram of methods on a problem")
     c.add_argument("--problem", default="hires")
+    _scene_args(c)
     c.add_argument("--methods", default="trapezoidal,sw24,Radau,BDF")
     c.add_argument("--rtols", default="1e-4,1e-5,1e-6,1e-7", help="tolerances of adaptive runs")
     c.add_argument("--steps", default="", help="fixed steps h instead of tolerances (comma separated)")
@@ -44,6 +49,12 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     d.add_argument("--methods", default="", help="subset (default: the issue's list)")
     d.add_argument("--csv", default="heat_benchmark.csv")
     p.set_defaults(func=run)
+
+
+def _scene_args(p) -> None:
+    p.add_argument("--scene", default="", help="band-model scene or preset instead of --problem")
+    p.add_argument("--until", type=float, default=0.05, help="with --scene: simulated time, s")
+    p.add_argument("--ref-rtol", type=float, default=1e-9, help="with --scene: rtol of the Radau reference")
 
 
 def parse_method(spec: str) -> tuple[str, str, dict]:
@@ -76,9 +87,14 @@ def _floats(text: str, where: str) -> list[float]:
         raise InputError(where, text, "must be comma-separated numbers") from None
 
 
-def _problem(name: str):
+def _problem(name: str, args=None):
     from cvtfem.errors import InputError
     from cvtfem.problems import PROBLEMS
+
+    if args is not None and getattr(args, "scene", ""):
+        from cvtfem.analysis.study_problem import scene_problem
+
+        return scene_problem(args.scene, args.until, ref_rtol=args.ref_rtol)
 
     if name not in PROBLEMS:
         raise InputError("--problem", name, f"must be one of {sorted(PROBLEMS)}")
@@ -103,7 +119,7 @@ def run(args: argparse.Namespace) -> int:
             hs = np.geomspace(float(hmax), float(hmin), int(n))
         except ValueError:
             raise InputError("--hs", args.hs, "must be H_MAX:H_MIN:COUNT") from None
-        problem = _problem(args.problem)
+        problem = _problem(args.problem, args)
         curves, rows = [], []
         for label, method, opts in methods:
             if method not in METHODS:
@@ -119,12 +135,12 @@ def run(args: argparse.Namespace) -> int:
         plots.write_csv(rows, args.csv)
         print(f"wrote {args.png}, {args.csv}")
     elif args.study == "work":
-        problem = _problem(args.problem)
+        problem = _problem(args.problem, args)
         steps = _floats(args.steps, "--steps")
         settings = ([{"h": h} for h in steps] if steps else
                     [{"rtol": r, "atol": r * 1e-3} for r in _floats(args.rtols, "--rtols")])
         runs = [(label, method, {**opts, **s}) for label, method, opts in methods for s in settings]
-        rows = study.work_precision(problem, runs, repeats=args.repeats)
+        rows = study.work_precision(problem, runs, repeats=args.repeats, error=getattr(problem, "error", None))
         _print_rows(rows)
         plots.plot_work_precision(rows, args.png, f"work-precision on {problem.name}")
         plots.write_csv(rows, args.csv)
