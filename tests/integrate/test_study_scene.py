@@ -1,5 +1,6 @@
 """Scene-backed study problem (``cvtfem.analysis.study_problem``, ``cvtfem study work --scene``)."""
 import csv
+import dataclasses
 
 import numpy as np
 
@@ -18,8 +19,9 @@ def test_scene_problem_structure_and_error_metric():
     assert 0.9 < work < 1.0                    # output/input work: efficiency below 1
     errs = [p.error(solve(**p.solve_kwargs(), method="Radau", rtol=r, atol=1e-2 * r)) for r in (1e-4, 1e-7)]
     assert errs[1] < errs[0] / 10
-    bad = solve(**p.solve_kwargs(), method="rk4", h=1e-3)   # far beyond rk4's stability limit
-    assert not bad.success and p.error(bad) == np.inf
+    res = solve(**p.solve_kwargs(), method="Radau", rtol=1e-4, atol=1e-6)
+    assert p.error(dataclasses.replace(res, status=-1)) == np.inf        # failed runs: no error
+    assert p.error(dataclasses.replace(res, t=res.t[:-1], y=res.y[:, :-1])) == np.inf   # t_end missed
 
 
 def test_study_work_on_a_scene(tmp_path, capsys):
