@@ -73,11 +73,12 @@ class NewtonSolver:
         self.B = None
         self._lu = None
         self.stale = False   # the matrix B comes from a Jacobian of an earlier solve
+        self._fresh = False  # B comes from a Jacobian of the current solve
         self._eta = 1.0      # stop="rate": theta/(1-theta) of the previous solve
 
     def invalidate(self) -> None:
         """Drop ``B`` (the step size changed, so the frozen matrix is rebuilt next solve)."""
-        self.B, self._lu = None, None
+        self.B, self._lu, self._fresh = None, None, False
 
     def _set(self, B) -> None:
         st = self.stats
@@ -172,6 +173,21 @@ class NewtonSolver:
         self.invalidate()
         raise StepFailure(f"Newton ({opt.variant}) diverged: |G| = {np.max(np.abs(g)):.3g}")
 
+    def prepare(self, y, make_matrix) -> bool:
+        """Build ``B`` if missing (new step size: the last Jacobian serves) or stale (a new
+        Jacobian at ``y``); True when ``B`` comes from a Jacobian of the current solve."""
+        fresh = self.opt.variant == "exact" or self.stale
+        if fresh and self._fresh and self.B is not None:
+            return True                      # already built for this solve
+        if fresh or self.B is None:
+            self._set(make_matrix(y, fresh))
+            self.stale, self._fresh = False, fresh
+        return self._fresh
+
+    def solve_linear(self, r):
+        """``B^-1 r`` with the current matrix (e.g. a linearly implicit predictor)."""
+        return -self._direction(r)
+
     def _solve_rate(self, residual, y0, make_matrix, scale, kappa):
         """Simplified Newton with the contraction-rate test (see module docstring)."""
         opt, st = self.opt, self.stats
@@ -180,10 +196,7 @@ class NewtonSolver:
             return float(np.sqrt(np.mean(np.abs(v / scale) ** 2)))
 
         exact = opt.variant == "exact"
-        fresh = exact or self.stale   # a Jacobian at this step's guess
-        if fresh or self.B is None:   # B None only: new step size, the last Jacobian serves
-            self._set(make_matrix(y0, fresh))
-            self.stale = False
+        fresh = self.prepare(y0, make_matrix)
         while True:
             y, g = y0, residual(y0)
             eta = max(self._eta, EPS) ** 0.8
@@ -211,7 +224,7 @@ class NewtonSolver:
                     self._set(make_matrix(y, True))
                 g, dn_old = g_new, dn
             if ok:
-                self._eta = eta
+                self._eta, self._fresh = eta, False
                 if not exact and k + 1 > 2 and theta > RATE_REFRESH:
                     self.stale = True
                 return y, g
