@@ -14,7 +14,7 @@ tolerance. Adaptive runs stop Newton by its contraction
 rate in the error norm (``newton_stop="auto"``, :mod:`cvtfem.integrate.newton`), with tolerance
 ``kappa = max(10 eps / rtol, 1e-3)`` (option ``newton_kappa``): tighter than Radau's 0.03 because
 the trapezoidal rule does not damp stiff components (R(-inf) = -1), so a Newton error left there
-rings on (band-6+2n, rtol 1e-3, Euler predictor: kappa 0.03 gave 1870 steps, 1e-3 gave 389); fixed-step runs and
+rings on (band-6+2n 1 s, rtol 1e-3, Euler predictor: kappa 0.03 gave 2483 steps, 1e-3 389); fixed-step runs and
 ``newton_stop="source"`` use the source's line search and stopping rule (2.21)-(2.23).
 
 Error estimate (ours): the trapezoidal rule's local error ``-h^3 y'''/12`` with ``y'''``
