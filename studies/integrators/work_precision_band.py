@@ -110,6 +110,17 @@ def plot(rows, path: Path, title: str) -> None:
     plt.close(fig)
 
 
+def merge(path: Path, rows: list[dict], methods) -> list[dict]:
+    """Rows of the other methods from an earlier CSV, then the new ones (a partial re-run)."""
+    import csv
+
+    old = [r for r in csv.DictReader(open(path)) if r["method"] not in methods]
+    for r in old:
+        r.update(error=float(r["error"]), time=float(r["time"]), nfev=int(r["nfev"]))
+    order = {m: i for i, m in enumerate(list(ADAPTIVE) + ["rk4"])}
+    return sorted(old + rows, key=lambda r: order.get(r["method"], len(order)))
+
+
 def replot() -> None:
     """Redraw the PNGs from the CSVs (``--replot``)."""
     import csv
@@ -139,6 +150,8 @@ def main() -> None:
     for model in args.models:
         rows = study(model, args.until, args.repeats, args.slow, args.methods)
         stem = OUT / f"work_precision_{model}"
+        if set(args.methods) != set(ADAPTIVE) | {"rk4"} and stem.with_suffix(".csv").exists():
+            rows = merge(stem.with_suffix(".csv"), rows, args.methods)
         write_csv(rows, stem.with_suffix(".csv"))
         plot(rows, stem.with_suffix(".png"), f"{model}, {args.until} s of the stationary regime: "
              "relative error of ratio, speeds, work ratio vs cost")
