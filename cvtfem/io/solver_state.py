@@ -5,7 +5,8 @@ step-to-step memory of the methods that carry one and restores it into a freshly
 
 - cvtfem theta family (``trapezoidal``, ``implicit-euler``, ``theta``) through
   :class:`~cvtfem.integrate.CvtfemSolver`: Jacobian, ``h alpha`` of the iteration matrix and whether
-  its LU is current, previous step and slope (error estimate), ``F`` at the current point;
+  its LU is current, previous step and slope (error estimate), ``F`` at the current point, and the
+  Newton solver's memory (Jacobian marked stale, contraction estimate of the last solve);
 - scipy ``Radau``: Jacobian and whether it is current, whether the LU factors are current, the last two
   step sizes and error norms (predictive controller), the collocation increments ``Z``, ``y_old``,
   ``t_old`` (dense output = Newton start of the next step), the finite-difference factors;
@@ -33,7 +34,8 @@ BDF_ROWS = 5 + 3  # scipy.integrate BDF: MAX_ORDER + 3 rows of D
 
 def _fields(method: str, n: int, n2: int) -> tuple[tuple[str, int], ...]:
     if method in ("trapezoidal", "implicit-euler", "theta"):
-        return (("gamma", 1), ("lu_valid", 1), ("prev_h", 1), ("prev_f", n), ("J", n * n), ("f_start", n))
+        return (("gamma", 1), ("lu_valid", 1), ("prev_h", 1), ("prev_f", n), ("J", n * n), ("f_start", n),
+                ("newton_stale", 1), ("newton_eta", 1))
     if method == "Radau":
         return (("h_abs_old", 1), ("error_norm_old", 1), ("J", n * n), ("current_jac", 1), ("lu_valid", 1),
                 ("Z", 3 * n), ("y_old", n), ("t_old", 1), ("jac_factor", n), ("h_abs", 1))
@@ -84,7 +86,8 @@ def export_state(method: str, solver, n: int, n2: int = 0) -> np.ndarray:
         v = {"gamma": [math.nan if st._gamma is None else st._gamma],
              "lu_valid": [float(st.newton.B is not None)], "prev_h": [math.nan if prev is None else prev[0]],
              "prev_f": _opt(None if prev is None else prev[1], n), "J": _opt(st.J, n * n),
-             "f_start": _opt(start[2] if at_t else None, n)}
+             "f_start": _opt(start[2] if at_t else None, n), "newton_stale": [float(st.newton.stale)],
+             "newton_eta": [st.newton._eta]}
     return np.concatenate([np.asarray(v[name], dtype=float).ravel() for name, _ in f])
 
 
@@ -156,3 +159,4 @@ def _import_theta(solver, v: dict, n: int, n2: int) -> None:
     st.newton.invalidate()
     if v["lu_valid"][0] == 1.0 and st.J is not None and st._gamma is not None:
         st.newton._set(reduced_matrix(st.J, n2, st._gamma))
+    st.newton.stale, st.newton._eta = bool(v["newton_stale"][0]), float(v["newton_eta"][0])
