@@ -102,13 +102,15 @@ def plot_work_precision(rows, path: Path, title: str = "") -> Path:
     plt = _plt()
     fig, (a1, a2) = plt.subplots(1, 2, figsize=(10, 4))
     labels = list(dict.fromkeys(r["label"] for r in rows))
-    for label in labels:
+    for i, label in enumerate(labels):
         sel = [r for r in rows if r["label"] == label and np.isfinite(r["error"]) and r["error"] > 0]
         if not sel:
             continue
         err = [r["error"] for r in sel]
-        a1.loglog([r["time"] for r in sel], err, "o-", ms=3, label=label)
-        a2.loglog([r["nfev"] for r in sel], err, "o-", ms=3, label=label)
+        # 10 colours, then the next ten dashed with other markers: no two methods look alike
+        style = dict(color=f"C{i % 10}", ls=("-", "--", ":")[i // 10 % 3], marker="osv^D"[i // 10 % 5], ms=3)
+        a1.loglog([r["time"] for r in sel], err, label=label, **style)
+        a2.loglog([r["nfev"] for r in sel], err, label=label, **style)
     a1.set_xlabel("wall time, s (median)")
     a2.set_xlabel("RHS calls (incl. Jacobians)")
     for ax in (a1, a2):
