@@ -9,11 +9,13 @@ from __future__ import annotations
 
 import argparse
 import platform
+from pathlib import Path
 
 DEFAULT_STABILITY = ("euler,rk4,dopri45,dopri56,dopri78,gbs:stages=2,gbs-smooth:stages=2,"
                      "euler-extrapolation:stages=4,sw24:d=0.5,w1:d=1.0,w1-extrapolation:d=0.5:stages=4,"
-                     "trapezoidal,implicit-euler,rkc:stages=5,rock2:stages=5,rock4:stages=5")
-DEFAULT_ORDER = "euler,rk4,dopri45,dopri56,dopri78,gbs:stages=2,sw24,trapezoidal,rkc:stages=10"
+                     "trapezoidal,implicit-euler,rkc:stages=5,rock2:stages=5,rock4:stages=5,dumka3:polynomial=0")
+DEFAULT_ORDER = ("euler,rk4,dopri45,dopri56,dopri78,gbs:stages=2,sw24,trapezoidal,rkc:stages=10,"
+                 "dumka3:polynomial=6")
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
@@ -25,14 +27,14 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     a.add_argument("--log", action="store_true", help="signed-log axes (spec §2.3) instead of linear")
     a.add_argument("--extent", type=float, default=6.0, help="half-width of the linear plane")
     a.add_argument("--n", type=int, default=401, help="pixels per axis")
-    a.add_argument("--png", default="stability.png", help="output PNG")
+    a.add_argument("--png", default="out/studies/stability.png", help="output PNG")
     b = s.add_parser("order", help="effective-order test: local error vs h (spec §9.4)")
     b.add_argument("--problem", default="limit_cycle", help="problem name (cvtfem.problems.PROBLEMS)")
     _scene_args(b)
     b.add_argument("--methods", default=DEFAULT_ORDER)
     b.add_argument("--hs", default="0.4:0.0125:6", help="H_MAX:H_MIN:COUNT (log spaced)")
-    b.add_argument("--png", default="order.png")
-    b.add_argument("--csv", default="order.csv")
+    b.add_argument("--png", default="out/studies/order.png")
+    b.add_argument("--csv", default="out/studies/order.csv")
     c = s.add_parser("work", help="work-precision diagram of methods on a problem")
     c.add_argument("--problem", default="hires")
     _scene_args(c)
@@ -40,14 +42,14 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     c.add_argument("--rtols", default="1e-4,1e-5,1e-6,1e-7", help="tolerances of adaptive runs")
     c.add_argument("--steps", default="", help="fixed steps h instead of tolerances (comma separated)")
     c.add_argument("--repeats", type=int, default=3, help="wall time = median of this many runs")
-    c.add_argument("--png", default="work.png")
-    c.add_argument("--csv", default="work.csv")
+    c.add_argument("--png", default="out/studies/work.png")
+    c.add_argument("--csv", default="out/studies/work.csv")
     d = s.add_parser("heat", help="benchmark: heat equation, RHS calls and time at a target error")
     d.add_argument("--N", type=int, default=1000)
     d.add_argument("--target", type=float, default=1e-4)
     d.add_argument("--repeats", type=int, default=3)
     d.add_argument("--methods", default="", help="subset (default: the issue's list)")
-    d.add_argument("--csv", default="heat_benchmark.csv")
+    d.add_argument("--csv", default="out/studies/heat_benchmark.csv")
     p.set_defaults(func=run)
 
 
@@ -110,6 +112,9 @@ def run(args: argparse.Namespace) -> int:
     from cvtfem.post import integrators as plots
 
     methods = [parse_method(m) for m in getattr(args, "methods", "").split(",") if m.strip()]
+    for out in (getattr(args, "png", None), getattr(args, "csv", None)):
+        if out:
+            Path(out).parent.mkdir(parents=True, exist_ok=True)
     if args.study == "stability":
         out = plots.plot_stability(methods, args.png, extent=args.extent, log=args.log, n=args.n)
         print(f"wrote {out}")

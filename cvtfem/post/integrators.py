@@ -67,7 +67,7 @@ def plot_stability(methods, path: Path, extent: float = 6.0, log: bool = False, 
     for ax in list(axes.flat)[k:]:
         ax.set_visible(False)
     fig.suptitle("stability regions |R(hλ)| ≤ 1 (brute force, one step per pixel)", fontsize=10)
-    fig.tight_layout()
+    fig.tight_layout(rect=(0, 0, 1, 1 - 0.35 / fig.get_figheight()))  # keep the first row's titles clear
     fig.savefig(path, dpi=110)
     plt.close(fig)
     return Path(path)
