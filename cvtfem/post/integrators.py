@@ -8,16 +8,9 @@ from pathlib import Path
 import numpy as np
 
 from cvtfem.integrate.study import amplification, effective_order, signed_log, signed_log_inverse
+from cvtfem.post.figures import pyplot, save
 
 __all__ = ["plot_stability", "plot_effective_order", "plot_work_precision", "write_csv"]
-
-
-def _plt():
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    return plt
 
 
 def plot_stability(methods, path: Path, extent: float = 6.0, log: bool = False, n: int = 401,
@@ -27,7 +20,7 @@ def plot_stability(methods, path: Path, extent: float = 6.0, log: bool = False, 
     Linear plane ``[-extent, extent/3] x [-extent, extent]`` or, with ``log``, the signed-log
     plane (``x* = 1e-3``, up to ``+-log_extent``), grid lines at powers of ten.
     """
-    plt = _plt()
+    plt = pyplot()
     if log:
         lim = float(signed_log(log_extent, x_star))
         u = np.linspace(-lim, lim, n)
@@ -68,14 +61,12 @@ def plot_stability(methods, path: Path, extent: float = 6.0, log: bool = False, 
         ax.set_visible(False)
     fig.suptitle("stability regions |R(hλ)| ≤ 1 (brute force, one step per pixel)", fontsize=10)
     fig.tight_layout(rect=(0, 0, 1, 1 - 0.35 / fig.get_figheight()))  # keep the first row's titles clear
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return Path(path)
+    return save(fig, path)
 
 
 def plot_effective_order(curves, path: Path, title: str = "") -> Path:
     """``curves`` = [(label, hs, errs, nominal order)]: local error e(h) and p~(h) (spec (2.8))."""
-    plt = _plt()
+    plt = pyplot()
     fig, (a1, a2) = plt.subplots(1, 2, figsize=(10, 4))
     for label, hs, errs, p in curves:
         line, = a1.loglog(hs, errs, "o-", ms=3, label=label)
@@ -92,14 +83,12 @@ def plot_effective_order(curves, path: Path, title: str = "") -> Path:
         ax.xaxis.set_minor_formatter(plt.NullFormatter())  # minor labels of a short log range overlap
     fig.suptitle(title or "effective order test", fontsize=10)
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return Path(path)
+    return save(fig, path)
 
 
 def plot_work_precision(rows, path: Path, title: str = "") -> Path:
     """Error vs wall time and vs RHS calls, one line per ``label`` (rows from ``work_precision``)."""
-    plt = _plt()
+    plt = pyplot()
     fig, (a1, a2) = plt.subplots(1, 2, figsize=(10, 4))
     labels = list(dict.fromkeys(r["label"] for r in rows))
     for i, label in enumerate(labels):
@@ -119,9 +108,7 @@ def plot_work_precision(rows, path: Path, title: str = "") -> Path:
     a1.legend(fontsize=7)
     fig.suptitle(title or "work-precision", fontsize=10)
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return Path(path)
+    return save(fig, path)
 
 
 def write_csv(rows, path: Path) -> Path:
