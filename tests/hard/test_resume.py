@@ -24,8 +24,7 @@ from cvtfem.io.results import ResultsWriter, read_results
 from cvtfem.scene.loader import load_scene
 
 UNTIL = 0.05          # s simulated: 5000 rk4 steps, ~1.8 s wall per run (compiled right-hand side)
-INTERVAL = 0.005      # s simulated between checkpoints: 9 before the end, ~0.18 s wall apart, so a kill
-                      # within 0.3 s of checkpoint 1 or 2 always lands mid-run
+INTERVAL = 0.005      # s simulated between checkpoints: 9 before the end
 SCENE = f"""preset = "band-4dof"
 [solver]
 method = "rk4"
@@ -58,22 +57,26 @@ checkpoint_interval = {interval}
 
 
 def _kill_and_resume(tmp_path, cli, text: str, until: float, interval: float, rows: int):
-    """Uninterrupted reference, then a subprocess killed at a random moment after checkpoint 1 or 2 and
-    resumed with the CLI; returns (reference, resumed) results and where it was killed."""
+    """Uninterrupted reference, then a subprocess killed at a random moment between checkpoint 2 or 3 and
+    the next one, resumed with the CLI; returns (reference, resumed) results and where it was killed."""
     scene_file = tmp_path / "scene.toml"
     scene_file.write_text(text, encoding="utf-8")
     ref_path, path = tmp_path / "ref.h5", tmp_path / "killed.h5"
     run_scene(load_scene(scene_file), until=until, results=ref_path, show_progress=False)
 
     rng = random.Random()
-    after, delay = rng.randint(1, 2), rng.uniform(0.0, 0.3)  # kill after checkpoint `after` + delay s
+    after = rng.randint(2, 3)  # kill after checkpoint `after`, before the next one (the run has >= 8 more)
     proc = subprocess.Popen([sys.executable, "-m", "cvtfem.cli", "run", str(scene_file), "--until", str(until),
                              "--results", str(path), "--report-checkpoints"], stdout=subprocess.PIPE,
                             stderr=subprocess.PIPE, text=True)
     try:
+        stamps = []
         for seq in range(1, after + 1):
             line = proc.stdout.readline()
+            stamps.append(time.perf_counter())
             assert line.startswith(f"checkpoint {seq} at t = "), (line, proc.stderr.read() if not line else "")
+        # a random moment within the wall time between two checkpoints: mid-run however fast the machine
+        delay = rng.uniform(0.0, 0.9 * (stamps[1] - stamps[0]))
         time.sleep(delay)
     finally:
         proc.kill()  # SIGKILL
