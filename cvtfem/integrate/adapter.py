@@ -83,7 +83,7 @@ class CvtfemSolver(OdeSolver):
         t, x = self.t, self.y
         h_min = 16 * np.finfo(float).eps * max(abs(t), 1.0)
         while True:
-            h = min(self.h_next, self.t_bound - t)
+            h = min(self.h_next, self.t_bound - t, self.stepper.max_step() if self.adaptive else np.inf)
             if self.t_bound - (t + h) < 1e-9 * h:    # absorb round-off: land on t_bound
                 h = self.t_bound - t
             self.monitor.before()

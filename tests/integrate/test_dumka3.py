@@ -215,3 +215,24 @@ def test_adaptive_steps_capped_at_longest_polynomial(monkeypatch):
     monkeypatch.setattr(DUMKA3, "max_step", lambda self: np.inf)
     free = run()
     assert capped["nreject"] < free["nreject"] and capped["nfev"] < 0.85 * free["nfev"], (capped, free)
+
+
+
+def test_cvtfem_solver_applies_the_same_cap(monkeypatch):
+    """`cvtfem run` steps through CvtfemSolver: its adaptive DUMKA3 steps obey the same cap as `solve`
+    (heat N = 1000, rtol 3e-3: fewer RHS calls than without the cap, as in `solve`)."""
+    from scipy.integrate import solve_ivp
+
+    from cvtfem.integrate import CvtfemSolver
+
+    p = heat1d(1000, 0.1)
+
+    def nfev():
+        res = solve_ivp(p.fun, p.t_span, p.y0, method=CvtfemSolver, cvtfem_method="dumka3", rtol=3e-3,
+                        atol=3e-6)
+        assert res.success
+        return res.nfev
+
+    capped = nfev()
+    monkeypatch.setattr(DUMKA3, "max_step", lambda self: np.inf)
+    assert capped < 0.85 * nfev()
