@@ -46,7 +46,23 @@ def make_stepper(method: str, fun, t0: float, y0, t_end: float, rtol: float, ato
         options["first_step"] = h
     if jac is not None and method in ("Radau", "BDF", "LSODA"):
         options["jac"] = jac
-    return getattr(si, method)(fun, t0, np.asarray(y0, float), t_end, **options)
+    solver = getattr(si, method)(fun, t0, np.asarray(y0, float), t_end, **options)
+    if method in ("Radau", "BDF"):
+        _remember_iteration_matrices(solver)
+    return solver
+
+
+def _remember_iteration_matrices(solver) -> None:
+    """Make scipy's Radau/BDF keep a copy of the matrices they factorise last (``iteration_matrices``:
+    ``"real"``, and ``"complex"`` for Radau), so that a checkpoint can restore their LU factors exactly."""
+    factorise = solver.lu
+    solver.iteration_matrices = {}
+
+    def lu(A):
+        solver.iteration_matrices["complex" if np.iscomplexobj(A) else "real"] = A.copy()
+        return factorise(A)
+
+    solver.lu = lu
 
 
 def _unavailable_hint(method: str) -> str:

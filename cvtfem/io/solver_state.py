@@ -12,9 +12,13 @@ step-to-step memory of the methods that carry one and restores it into a freshly
   ``t_old`` (dense output = Newton start of the next step), the finite-difference factors;
 - scipy ``BDF``: the difference array ``D``, order, equal-step count, step, Jacobian, LU flag, factors.
 
-LU factors are not stored: they are recomputed from the saved matrix with the same call (LAPACK is
-deterministic for the same input), ``I h/mu - J`` (Radau) or ``I - c J`` (BDF), ``I - h alpha J``
-reduced (theta). Unknown values (``None``) are stored as NaN. Methods without memory (explicit
+LU factors are not stored: they are recomputed with the same call from the matrix that was factorised
+(LAPACK is deterministic for the same input).  For scipy's Radau and BDF that matrix is saved as it was
+(``iteration_matrices``, recorded by :func:`cvtfem.analysis.steppers.make_stepper`): rebuilding it from
+the current step is wrong, because scipy keeps a factorisation across steps whose sizes differ in the last
+bits (Radau: ``h = (t + h) - t`` is re-rounded every step; BDF keeps the LU after an error rejection), and
+that difference surfaced at 1e-9 under some OpenBLAS kernels (issue 11).  The theta family rebuilds
+``I - h alpha J`` reduced from its saved ``h alpha``. Unknown values (``None``) are stored as NaN. Methods without memory (explicit
 Runge-Kutta) have an empty state; scipy ``LSODA`` keeps its history inside Fortran work arrays that
 scipy does not expose for writing, so it restarts (agreement within the tolerance only).
 """
@@ -38,10 +42,11 @@ def _fields(method: str, n: int, n2: int) -> tuple[tuple[str, int], ...]:
                 ("newton_stale", 1), ("newton_eta", 1))
     if method == "Radau":
         return (("h_abs_old", 1), ("error_norm_old", 1), ("J", n * n), ("current_jac", 1), ("lu_valid", 1),
-                ("Z", 3 * n), ("y_old", n), ("t_old", 1), ("jac_factor", n), ("h_abs", 1))
+                ("Z", 3 * n), ("y_old", n), ("t_old", 1), ("jac_factor", n), ("h_abs", 1),
+                ("A_real", n * n), ("A_complex", 2 * n * n))
     if method == "BDF":
         return (("D", BDF_ROWS * n), ("order", 1), ("n_equal_steps", 1), ("h_abs", 1), ("J", n * n),
-                ("lu_valid", 1), ("jac_factor", n))
+                ("lu_valid", 1), ("jac_factor", n), ("A_real", n * n))
     return ()
 
 
@@ -68,13 +73,17 @@ def export_state(method: str, solver, n: int, n2: int = 0) -> np.ndarray:
         return np.zeros(0)
     if method in ("Radau", "BDF"):
         s = solver
-        v = {"J": _opt(s.J, n * n), "lu_valid": [float(getattr(s, "LU_real" if method == "Radau" else "LU") is not None)],
-             "jac_factor": _opt(s.jac_factor, n), "h_abs": [s.h_abs]}
+        valid = getattr(s, "LU_real" if method == "Radau" else "LU") is not None
+        A = s.iteration_matrices if valid else {}
+        v = {"J": _opt(s.J, n * n), "lu_valid": [float(valid)], "jac_factor": _opt(s.jac_factor, n),
+             "h_abs": [s.h_abs], "A_real": _opt(A.get("real"), n * n)}
         if method == "Radau":
             v.update(h_abs_old=[math.nan if s.h_abs_old is None else s.h_abs_old],
                      error_norm_old=[math.nan if s.error_norm_old is None else s.error_norm_old],
                      current_jac=[float(s.current_jac)], Z=_opt(s.Z, 3 * n), y_old=_opt(s.y_old, n),
-                     t_old=[math.nan if s.t_old is None else s.t_old])
+                     t_old=[math.nan if s.t_old is None else s.t_old],
+                     A_complex=_opt(None, 2 * n * n) if "complex" not in A else
+                     np.concatenate([_opt(A["complex"].real, n * n), _opt(A["complex"].imag, n * n)]))
         else:
             v.update(D=np.asarray(s.D[:BDF_ROWS], dtype=float).ravel(), order=[s.order],
                      n_equal_steps=[s.n_equal_steps])
@@ -116,15 +125,15 @@ def _matrix(fmt: str | None, dense: np.ndarray, n: int):
 
 
 def _import_scipy(method: str, s, v: dict, n: int) -> None:
-    from scipy.integrate._ivp.radau import MU_COMPLEX, MU_REAL
-
     J = _get(v["J"])
+    fmt = s.J.format if sp.issparse(s.J) else None
     if J is not None:
-        s.J = _matrix(s.J.format if sp.issparse(s.J) else None, J, n)
+        s.J = _matrix(fmt, J, n)
     jf = _get(v["jac_factor"])
     s.jac_factor = None if jf is None else jf.copy()
     s.h_abs = float(v["h_abs"][0])
-    valid = v["lu_valid"][0] == 1.0
+    A_real = _get(v["A_real"]) if v["lu_valid"][0] == 1.0 else None
+    LU_real = None if A_real is None else s.lu(_matrix(fmt, A_real.copy(), n))
     if method == "Radau":
         s.h_abs_old = None if math.isnan(v["h_abs_old"][0]) else float(v["h_abs_old"][0])
         s.error_norm_old = None if math.isnan(v["error_norm_old"][0]) else float(v["error_norm_old"][0])
@@ -133,14 +142,13 @@ def _import_scipy(method: str, s, v: dict, n: int) -> None:
         if Z is not None:
             s.Z, s.y_old, s.t_old = Z.reshape(3, n), v["y_old"].copy(), float(v["t_old"][0])
             s.sol = s._compute_dense_output()
-        h = s.h_abs * s.direction
-        s.LU_real = s.lu(MU_REAL / h * s.I - s.J) if valid else None
-        s.LU_complex = s.lu(MU_COMPLEX / h * s.I - s.J) if valid else None
+        re_im = v["A_complex"].reshape(2, n * n)
+        A_complex = None if LU_real is None else _matrix(fmt, re_im[0] + 1j * re_im[1], n)
+        s.LU_real, s.LU_complex = LU_real, None if A_complex is None else s.lu(A_complex)
     else:
         s.D[:BDF_ROWS] = v["D"].reshape(BDF_ROWS, n)
         s.order, s.n_equal_steps = int(v["order"][0]), int(v["n_equal_steps"][0])
-        c = s.h_abs * s.direction / s.alpha[s.order]
-        s.LU = s.lu(s.I - c * s.J) if valid else None
+        s.LU = LU_real
 
 
 def _import_theta(solver, v: dict, n: int, n2: int) -> None:

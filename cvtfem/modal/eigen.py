@@ -255,15 +255,20 @@ class ModalProblem:
         return lam[keep], Z[:, keep]
 
     def _stiffness_definite(self, b: int) -> bool:
-        """Whether block ``b``'s stiffness is symmetric positive definite (Cholesky succeeds), cached."""
+        """Whether block ``b``'s stiffness is symmetric positive definite to working precision, cached.
+
+        Definite means every eigenvalue of K exceeds ``n eps max|eig K|`` (the numerical-rank tolerance of
+        ``numpy.linalg.matrix_rank``).  A free rigid-body mode of a stiff model (elastic connections of
+        1e12 N m/rad) leaves an eigenvalue of round-off size, ~1e-16 max|eig K|, whose sign depends on the
+        BLAS kernel; a Cholesky test accepts it as positive and the rigid mode becomes a spurious
+        'oscillatory' mode at ~sqrt(eps) |lambda|_max (issue 11).
+        """
         if b not in self._definite:
             K = self._sub(b)[1].toarray()
             ok = np.allclose(K, K.T, rtol=0.0, atol=1e-12 * np.abs(K).max(initial=0.0))
             if ok:
-                try:
-                    sla.cho_factor(K)
-                except np.linalg.LinAlgError:
-                    ok = False
+                w = sla.eigvalsh(K, check_finite=False)
+                ok = bool(w[0] > len(w) * np.finfo(float).eps * np.abs(w).max(initial=0.0))
             self._definite[b] = ok
         return self._definite[b]
 

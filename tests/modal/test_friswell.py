@@ -1,6 +1,7 @@
 """Acceptance: Friswell et al., Dynamics of Rotating Machines, example 5.9.1 (rad/s, within 0.1 %)."""
 import numpy as np
 import pytest
+import scipy.linalg as sla
 
 from cvtfem.machines.rotor import build_model
 from cvtfem.modal import ModalProblem
@@ -60,9 +61,15 @@ def test_damped_bearings_give_positive_damping_and_log_dec():
 
 
 def test_negative_speed_mirrors_whirl(problem):
-    """Whirl is relative to the spin: reversing the spin gives the same frequencies and labels."""
+    """Whirl is relative to the spin: reversing the spin gives the same frequencies and labels.
+
+    The two spectra belong to different (mirror-similar) state matrices, so they agree to the accuracy of
+    LAPACK's ``geev``, ``|d lambda| <~ n eps |lambda|_max`` (n = 2 x DOF), not to a fixed relative 1e-12:
+    with |lambda|_max = 5.2e4 rad/s the 85 rad/s pair differs by 1.1e-10 rad/s (rel. 1.3e-12) under the
+    Sandybridge OpenBLAS kernel and 1.3e-11 under Haswell (issue 11)."""
     pos, neg = problem.solve(4000 * RPM, 6), problem.solve(-4000 * RPM, 6)
-    np.testing.assert_allclose(neg.wd, pos.wd, rtol=1e-12)
+    w_max = np.sqrt(sla.eigh(problem.K.toarray(), problem.M.toarray(), eigvals_only=True).max())
+    np.testing.assert_allclose(neg.wd, pos.wd, rtol=0, atol=2 * problem.n * np.finfo(float).eps * w_max)
     assert neg.whirl == pos.whirl
 
 
