@@ -1,0 +1,81 @@
+"""Presets give the numbers recorded before the model-protocol restructuring (issue 12).
+
+The values in ``tests/data/baseline.json`` were recorded on main at the commit that added this file
+(``python -m tests.test_baseline`` rewrites them); the structure may change, the numbers may not.
+Run summaries are compared to 1e-9 relative (they differ between OpenBLAS kernels in the last bits),
+modal results to 1e-10, harmonic-balance peaks to 1e-8 (Newton stops at a relative step below 1e-10).
+"""
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+BASELINE = Path(__file__).parent / "data" / "baseline.json"
+RUNS = {"band-4dof": ("Radau", 0.0), "band-6+2n": ("Radau", 0.0), "band-6+2n+8": ("Radau", 0.0),
+        "band-4dof/trapezoidal": ("trapezoidal", 0.0), "band-4dof/rk4": ("rk4", 2e-6)}
+
+
+def _cli(*args: str) -> None:
+    subprocess.run([sys.executable, "-m", "cvtfem.cli", *args], check=True, capture_output=True)
+
+
+def run_numbers(name: str, tmp: Path) -> dict:
+    preset = name.split("/")[0]
+    method, h = RUNS[name]
+    scene = tmp / f"{name.replace('/', '_')}.toml"
+    scene.write_text(f'preset = "{preset}"\n[solver]\nmethod = "{method}"\nh = {h}\n')
+    out = tmp / f"{scene.stem}.json"
+    _cli("run", str(scene), "--until", "0.02", "--results", "none", "--summary-json", str(out))
+    s = json.loads(out.read_text())
+    return {"ratio": s["ratio"], "efficiency": s["efficiency"], "steps": s["solver"]["steps"],
+            "nfev": s["solver"]["nfev"]}
+
+
+def campbell_numbers(tmp: Path) -> dict:
+    out = tmp / "campbell.json"
+    _cli("campbell", "friswell_5_9_1", "--speeds", "0:4000rpm:5", "--json", str(out))
+    c = json.loads(out.read_text())
+    return {"curves": c["tracked"]["wd_rad_s"]}
+
+
+def periodic_numbers(tmp: Path) -> dict:
+    out = tmp / "periodic.json"
+    _cli("periodic", "engine_gear_train", "--sweep", "12:15:3", "--json", str(out))
+    p = json.loads(out.read_text())
+    return {"peaks": [[pt[kind]["link_moment_peak"][link] for link in p["links"]]
+                      for pt in p["points"] for kind in ("backlash", "no_backlash")]}
+
+
+def record(tmp: Path) -> dict:
+    return {"run": {name: run_numbers(name, tmp) for name in RUNS}, "campbell": campbell_numbers(tmp),
+            "periodic": periodic_numbers(tmp)}
+
+
+@pytest.fixture(scope="module")
+def baseline():
+    return json.loads(BASELINE.read_text())
+
+
+@pytest.mark.parametrize("name", sorted(RUNS))
+def test_run_summary_unchanged(tmp_path, baseline, name):
+    now, then = run_numbers(name, tmp_path), baseline["run"][name]
+    assert now["steps"] == then["steps"] and now["nfev"] == then["nfev"]
+    np.testing.assert_allclose([now["ratio"], now["efficiency"]], [then["ratio"], then["efficiency"]], rtol=1e-9)
+
+
+def test_campbell_unchanged(tmp_path, baseline):
+    np.testing.assert_allclose(campbell_numbers(tmp_path)["curves"], baseline["campbell"]["curves"], rtol=1e-10)
+
+
+def test_periodic_unchanged(tmp_path, baseline):
+    np.testing.assert_allclose(periodic_numbers(tmp_path)["peaks"], baseline["periodic"]["peaks"], rtol=1e-8)
+
+
+if __name__ == "__main__":
+    import tempfile
+
+    with tempfile.TemporaryDirectory() as d:
+        BASELINE.write_text(json.dumps(record(Path(d)), indent=1) + "\n")
