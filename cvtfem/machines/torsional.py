@@ -184,8 +184,12 @@ class TorsionalModel(ModelBase):
         return {"disk.displacement": x[:S].copy(), "link.force": f, "link.moment": f * net.radius[net.i]}
 
 
-def build_model(scene: Scene, omega: float) -> TorsionalModel:
-    """The time-domain model of a torsional scene driven at base frequency ``omega`` (rad/s)."""
+def build_model(scene: Scene, omega: float | None = None) -> TorsionalModel:
+    """The time-domain model of a torsional scene: loads at base frequency ``omega`` (rad/s; default
+    ``2 pi periodic.frequency``), the backlash and gap laws unless ``periodic.backlash`` is false."""
+    cfg = periodic_settings(scene)
+    omega = 2 * np.pi * cfg.frequency if omega is None else omega
     if not (np.isfinite(omega) and omega > 0):
         raise InputError("omega", omega, "must be a positive base frequency of the loads in rad/s")
-    return TorsionalModel(build(scene), float(omega))
+    net = build(scene)
+    return TorsionalModel(net if cfg.backlash else net.linearized("contact"), float(omega))

@@ -104,5 +104,16 @@ def test_scene_model_outputs_match_specs():
     assert all(np.size(out[s.name]) == s.size for s in model.output_specs)
     net = model.net
     assert np.allclose(out["link.moment"], out["link.force"] * net.radius[net.i])
+    assert model.omega == 100.0 and build_model(scene).omega == 2 * np.pi * scene.periodic.frequency
     with pytest.raises(InputError):
         build_model(scene, 0.0)
+
+
+def test_every_machine_kind_builds_a_model():
+    from cvtfem.machines import build_model as build_any
+
+    for name in ("engine_gear_train", "friswell_5_9_1", "band-4dof"):
+        model = build_any(load_scene(name))
+        x0 = model.initial_state()
+        assert isinstance(model, Model) and x0.shape == (model.size,) == model.rhs(0.0, x0).shape
+        assert model.layout.size == model.size and model.n2 == model.layout.n2
