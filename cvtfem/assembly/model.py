@@ -87,6 +87,7 @@ class Model(Protocol):
     size: int
     output_specs: tuple[OutputSpec, ...]
     jac_sparsity: sp.csr_matrix | None
+    jac: Any  # callable (t, x) -> sparse or dense, or None (difference over jac_sparsity)
     events: Any
     switch: Any
 
@@ -94,7 +95,7 @@ class Model(Protocol):
 
     def rhs(self, t: float, x: np.ndarray) -> np.ndarray: ...
 
-    def jac(self, t: float, x: np.ndarray) -> Any: ...
+    def fd_jac(self, t: float, x: np.ndarray) -> sp.csr_matrix: ...
 
     def outputs(self, t: float, x: np.ndarray) -> dict[str, Any]: ...
 
@@ -104,10 +105,10 @@ class Model(Protocol):
 
 
 class ModelBase:
-    """Defaults of the concrete models: sizes from :attr:`layout`, no events, coloured-FD Jacobian.
+    """Defaults of the concrete models: sizes from :attr:`layout`, no events, no analytic Jacobian.
 
-    Subclasses provide ``layout``, ``rhs``, ``jac_sparsity`` and ``outputs``; they override
-    ``jac`` where their element families give analytic blocks.
+    Subclasses provide ``layout``, ``rhs``, ``jac_sparsity``, ``output_specs`` and ``outputs``; they
+    define ``jac`` where their element families give analytic blocks.
     """
 
     #: Event indicators ``g(t, x) -> (m,)`` with ``event_direction``/``event_terminal`` (None: no events).
@@ -131,11 +132,11 @@ class ModelBase:
         pattern = sp.csr_matrix(self.jac_sparsity, dtype=bool)
         return pattern.tocoo(), color_columns(pattern)
 
+    #: Analytic ``jac(t, x)`` where the families give blocks; None: analyses difference over
+    #: :attr:`jac_sparsity` with the same colouring and count the calls (:meth:`fd_jac` does it here).
+    jac = None
+
     def fd_jac(self, t: float, x: np.ndarray) -> sp.csr_matrix:
         """``d rhs / dx`` by coloured forward differences: as many RHS calls as colours, plus ``rhs(t, x)``."""
         pattern, colors = self.colouring
         return coloured_difference(self.rhs, t, x, self.rhs(t, x), pattern, colors)
-
-    def jac(self, t: float, x: np.ndarray) -> sp.csr_matrix:
-        """``d rhs / dx``: :meth:`fd_jac` unless the model's families give analytic blocks."""
-        return self.fd_jac(t, x)
