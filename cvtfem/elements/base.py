@@ -3,7 +3,8 @@
 An element family (a whole 84-pin chain, all beam elements of a shaft) is one
 object.  Besides its physics it declares how many generalized coordinates
 (``n2``, each with a velocity) and first-order states (``n1``) it owns, its
-discrete states (switched at events) and its named outputs with units.
+discrete states (switched at events) and its named outputs with units; a model's
+state is a sequence of named :class:`Block` s.
 """
 from __future__ import annotations
 
@@ -30,6 +31,28 @@ class OutputSpec:
     unit: str
     doc: str
     size: int = 1
+
+
+@dataclass(frozen=True)
+class Block:
+    """A named block of state coordinates of a model.
+
+    Attributes
+    ----------
+    name : str
+        Block name (``band.phi``, ``control.speed``).
+    size : int
+        Number of coordinates.
+    unit : str
+        SI unit of the coordinates (their velocities carry ``unit/s``).
+    order : int
+        2: coordinates ``u`` with velocities ``v`` (second-order part); 1: first-order states ``z``.
+    """
+
+    name: str
+    size: int
+    unit: str
+    order: int = 2
 
 
 @dataclass(frozen=True)
