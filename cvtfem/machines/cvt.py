@@ -10,8 +10,9 @@ from __future__ import annotations
 import importlib.util
 from typing import Any
 
-from cvtfem.elements.base import Layout, OutputSpec
+from cvtfem.elements.base import Layout
 from cvtfem.errors import InputError
+from cvtfem.outputs import OutputSpec
 from cvtfem.scene.loader import Scene
 
 #: Generalized coordinates per pin of each discrete chain model.

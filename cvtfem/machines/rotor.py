@@ -13,10 +13,11 @@ import numpy as np
 import scipy.sparse as sp
 
 from cvtfem.assembly import assemble
-from cvtfem.elements.base import Layout, OutputSpec
+from cvtfem.elements.base import Layout
 from cvtfem.elements.beam import BeamFamily, BeamOptions
 from cvtfem.elements.bearing import BearingFamily, RadialLaw
 from cvtfem.elements.disk import DiskFamily, connection_stiffness, disc_profile, sheave_profile
+from cvtfem.outputs import OutputSpec
 from cvtfem.scene.loader import Scene
 
 #: Names of the 6 DOF of a node, in order.
