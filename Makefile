@@ -12,7 +12,7 @@ $(STAMP): pyproject.toml
 	rm -f $(VENV)/.installed-*
 	touch $@
 
-.PHONY: install demo test test-slow test-all docs
+.PHONY: install demo test test-slow test-all lint docs
 install: $(STAMP)
 
 demo: $(STAMP)
@@ -26,6 +26,10 @@ test-slow: $(STAMP)
 
 test-all: $(STAMP)
 	$(BIN)/python -m pytest -q
+
+# The layers of docs/architecture.md: import-linter contracts in pyproject.toml.
+lint: $(STAMP)
+	$(BIN)/lint-imports --no-cache
 
 docs: $(STAMP)
 	$(BIN)/cvtfem docs scenes --out docs/scenes.md
