@@ -15,7 +15,7 @@ $(STAMP): pyproject.toml constraints.txt
 	rm -f $(VENV)/.installed-*
 	touch $@
 
-.PHONY: install demo test test-slow test-all test-kernels test-latest lock docs
+.PHONY: install demo test test-slow test-all test-kernels test-latest lock lint docs
 install: $(STAMP)
 
 demo: $(STAMP)
@@ -53,6 +53,10 @@ lock:
 	{ echo "# Versions the test suite last passed with (make lock, $$(date -u +%F), $$(.venv-lock/bin/python -V))."; \
 	  .venv-lock/bin/python -m pip freeze --all --exclude-editable; } > constraints.txt
 	rm -rf .venv-lock
+
+# The layers of docs/architecture.md: import-linter contracts in pyproject.toml.
+lint: $(STAMP)
+	$(BIN)/lint-imports --no-cache
 
 docs: $(STAMP)
 	$(BIN)/cvtfem docs scenes --out docs/scenes.md

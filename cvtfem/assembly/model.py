@@ -16,7 +16,8 @@ import numpy as np
 import scipy.sparse as sp
 
 from cvtfem.assembly.colouring import color_columns, coloured_difference
-from cvtfem.elements.base import Block, OutputSpec
+from cvtfem.elements.base import Block
+from cvtfem.outputs import OutputSpec
 from cvtfem.errors import InputError
 
 __all__ = ["Block", "StateLayout", "Linearization", "Model", "ModelBase"]

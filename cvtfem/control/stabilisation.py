@@ -16,7 +16,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from cvtfem.elements.base import Block, OutputSpec
+from cvtfem.elements.base import Block
+from cvtfem.outputs import OutputSpec
 
 #: Named outputs of the loops (the open loop reports them too, but records none).
 LOOP_OUTPUTS = (OutputSpec("control.ratio_estimate", "-", "Smoothed ratio estimate."),

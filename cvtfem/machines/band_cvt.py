@@ -22,7 +22,8 @@ import scipy.sparse as sp
 from cvtfem.assembly.model import Linearization, ModelBase, StateLayout
 from cvtfem.control.clamping import Clamping
 from cvtfem.control.regimes import Regime
-from cvtfem.elements.base import Block, Layout, OutputSpec
+from cvtfem.elements.base import Block, Layout
+from cvtfem.outputs import OutputSpec
 
 #: SI unit of a band-family coordinate by its name without the arc digits.
 COORDINATE_UNITS = {"phi": "rad", "sigma": "m", "z": "m", "h": "m", "U": "m", "psi": "rad"}

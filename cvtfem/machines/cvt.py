@@ -11,8 +11,9 @@ import importlib.util
 from typing import Any
 
 from cvtfem.control.stabilisation import LOOP_OUTPUTS, Stabilisation
-from cvtfem.elements.base import Layout, OutputSpec
+from cvtfem.elements.base import Layout
 from cvtfem.errors import InputError
+from cvtfem.outputs import OutputSpec
 from cvtfem.scene.loader import Scene
 
 #: Generalized coordinates per pin of each discrete chain model.

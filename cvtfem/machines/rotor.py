@@ -17,10 +17,11 @@ import scipy.sparse.linalg as spla
 
 from cvtfem.assembly import assemble
 from cvtfem.assembly.model import Linearization, ModelBase, StateLayout
-from cvtfem.elements.base import Block, Layout, OutputSpec
+from cvtfem.elements.base import Block, Layout
 from cvtfem.elements.beam import BeamFamily, BeamOptions
 from cvtfem.elements.bearing import BearingFamily, RadialLaw
 from cvtfem.elements.disk import DiskFamily, connection_stiffness, disc_profile, sheave_profile
+from cvtfem.outputs import OutputSpec
 from cvtfem.scene.loader import Scene
 
 #: Names of the 6 DOF of a node, in order.

@@ -15,9 +15,11 @@ import numpy as np
 import scipy.sparse as sp
 
 from cvtfem.assembly.model import Linearization, ModelBase, StateLayout
-from cvtfem.elements.base import Block, Layout, OutputSpec
+from cvtfem.assembly.numbering import through_numbering
+from cvtfem.elements.base import Block, Layout
 from cvtfem.elements.torsional import BACKLASH, GAP, LINEAR, TorsionalNetwork, link_energy, link_force
 from cvtfem.errors import InputError
+from cvtfem.outputs import OutputSpec
 from cvtfem.scene.loader import Scene
 from cvtfem.scene.schema.base import validate
 from cvtfem.scene.schema.torsional import PERIODIC, link_names
@@ -77,8 +79,6 @@ def build(scene: Scene) -> TorsionalNetwork:
 
 def layout(scene: Scene) -> tuple[Layout, ...]:
     """Components of a torsional network: one coordinate per disk, one link family."""
-    from cvtfem.periodic.sweep import through_numbering
-
     net = build(scene)
     topo = through_numbering(net.n_nodes, net.i, net.j)
     n_nl = int((net.law != LINEAR).sum())
