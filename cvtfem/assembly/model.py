@@ -81,7 +81,7 @@ class Linearization:
 
 @runtime_checkable
 class Model(Protocol):
-    """What every machine kind offers (attributes and methods; see ``docs/model-protocol.md``)."""
+    """What every machine kind offers (attributes and methods; see ``docs/architecture.md``)."""
 
     layout: StateLayout
     n2: int
