@@ -38,14 +38,15 @@ class RunSummary:
 
 
 def sample_outputs(loop, t: float, x) -> dict[str, Any]:
-    """Named outputs (see ``cvtfem describe``) of closed-loop state ``x`` at time ``t``."""
-    _, info = loop.evaluate(t, x)
-    q, v, _, W = loop.split(x)
-    N = np.asarray(info["N"])
+    """Named outputs (see ``cvtfem describe``) of closed-loop state ``x`` at time ``t``: one evaluation of the
+    loop (its work-integral rates are the powers) and one of the model energy."""
+    dx, info = loop.evaluate(t, x)
+    W = loop.split(x)[3]
+    P = dx[-4:]  # [M1 w1, -M2 w2, dissipation, clamping power], W
+    N = info["N"]
     w, M, F = info["w"], info["M"], info["F"]
-    P = np.array([M[0] * w[0], -M[1] * w[1], info["dissipation"], info["clamp_power"]])
-    out = {"band.span_angle": q[0], "band.slip_speed": info["slip"], "band.slip_max": info["slip_max"],
-           "band.mean_normal_force": N.mean(axis=-1) if N.ndim == 2 else N,
+    out = {"band.span_angle": x[0], "band.slip_speed": info["slip"], "band.slip_max": info["slip_max"],
+           "band.mean_normal_force": N.sum(axis=-1) / N.shape[-1] if N.ndim == 2 else N,
            "driving.speed": w[0], "driving.torque": M[0], "driving.clamping_force": F[0],
            "driven.speed": w[1], "driven.torque": M[1], "driven.clamping_force": F[1],
            "control.ratio_estimate": info["ratio_estimate"], "control.resistance": info["resistance"],

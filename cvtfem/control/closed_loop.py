@@ -226,6 +226,9 @@ class ClosedLoop:
         return Jm
 
     def energy(self, x) -> float:
-        """Kinetic plus elastic energy of the model, J."""
+        """Kinetic plus elastic energy of the model, J (one compiled call where the model has ``energies``)."""
         q, v, _, _ = self.split(x)
+        if hasattr(self.model, "energies"):
+            T, V = self.model.energies(q, v)
+            return float(T + V)
         return float(self.model.kinetic_energy(q, v) + self.model.elastic_energy(q))

@@ -10,8 +10,9 @@ Layout::
     /checkpoint/slots  full state for resuming (payload chosen by the run driver;
                      layout in :mod:`cvtfem.io.checkpoint`)
 
-Rows are appended to resizable datasets and the file is flushed every
-``flush_interval`` seconds of wall time, so a run killed half-way leaves a
+Rows are collected in memory (one float64 block, a row per sample) and
+appended to resizable datasets, one write per series, when the file is
+flushed: every ``flush_interval`` seconds of wall time, so a run killed half-way leaves a
 readable file with every row up to the last flush (``status`` then stays
 "running"): the file is in HDF5's single-writer/multiple-reader mode, which
 keeps it consistent on disk at every moment, and readers open it with
@@ -108,7 +109,14 @@ class ResultsWriter:
             self._rows = n
             f.attrs.update(_resume["attrs"])
             ckpt.write(f, self._layout, _resume["seq"], _resume["values"])
-        self._buffer: list[tuple[float, dict[str, np.ndarray]]] = []
+        self._columns: list[tuple[str, int, int]] = []  # (name, first, end) columns of each series in a row
+        for spec in outputs:
+            start = self._columns[-1][2] if self._columns else 0
+            self._columns.append((spec.name, start, start + spec.size))
+        width = self._columns[-1][2] if self._columns else 0
+        self._block = np.empty((CHUNK_ROWS, width))  # buffered rows, grown by doubling
+        self._times = np.empty(CHUNK_ROWS)
+        self._buffered = 0
         self._stats: dict[str, Any] = {}
         self._arrays: dict[str, tuple[np.ndarray, str, str]] = {}
         self._last_flush = time.monotonic()
@@ -191,29 +199,39 @@ class ResultsWriter:
         return writer, seq, values
 
     def append(self, t: float, values: Mapping[str, Any]) -> None:
-        """Record one output sample at time ``t`` (s); flushes when due."""
-        row = {name: np.asarray(values[name], dtype=float).reshape(spec.size) for name, spec in self._specs.items()}
-        self._buffer.append((float(t), row))
+        """Record one output sample at time ``t`` (s) in the in-memory block; flushes when due."""
+        i = self._buffered
+        if i == self._times.size:
+            self._block = np.concatenate([self._block, np.empty_like(self._block)])
+            self._times = np.concatenate([self._times, np.empty_like(self._times)])
+        row = self._block[i]
+        for name, a, b in self._columns:
+            value = values[name]
+            if b - a > 1 and np.size(value) != b - a:
+                raise ValueError(f"output {name!r} has {np.size(value)} values, its series {b - a}")
+            row[a:b] = value
+        self._times[i] = t
+        self._buffered = i + 1
         if time.monotonic() - self._last_flush >= self.flush_interval:
             self.flush()
 
     def flush(self) -> None:
         """Write buffered rows and make them visible to readers."""
-        if self._buffer:
-            n_new = len(self._buffer)
+        n_new = self._buffered
+        if n_new:
             series = self._file["series"]
             end = self._rows + n_new
-            for name in self._specs:
+            for name, a, b in self._columns:
                 d = series[name]
-                d.resize((end, d.shape[1]))
-                d[self._rows:end] = np.stack([row[name] for _, row in self._buffer])
+                d.resize((end, b - a))
+                d[self._rows:end] = self._block[:n_new, a:b]
                 d.flush()
             times = series["time"]
             times.resize((end,))
-            times[self._rows:end] = [t for t, _ in self._buffer]
+            times[self._rows:end] = self._times[:n_new]
             times.flush()
             self._rows = end
-            self._buffer.clear()
+            self._buffered = 0
         self._file.flush()
         self._last_flush = time.monotonic()
 
