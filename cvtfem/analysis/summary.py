@@ -5,8 +5,6 @@ import math
 from dataclasses import asdict, dataclass, field
 from typing import Any
 
-import numpy as np
-
 EFFICIENCY_WINDOW = 0.05  # s, moving average of the efficiency (section 6.1)
 
 

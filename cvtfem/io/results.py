@@ -12,9 +12,9 @@ Layout::
 
 Rows are collected in memory (one float64 block, a row per sample) and
 appended to resizable datasets, one write per series, when the file is
-flushed: every ``flush_interval`` seconds of wall time, so a run killed half-way leaves a
-readable file with every row up to the last flush (``status`` then stays
-"running"): the file is in HDF5's single-writer/multiple-reader mode, which
+flushed: every ``flush_interval`` seconds of wall time, so a run killed
+half-way leaves a readable file with every row up to the last flush
+(``status`` then stays "running"): the file is in HDF5's single-writer/multiple-reader mode, which
 keeps it consistent on disk at every moment, and readers open it with
 ``swmr=True``.  Attributes and datasets cannot be created in that mode, so
 statistics, whole arrays and the final status are written when the run
@@ -109,12 +109,9 @@ class ResultsWriter:
             self._rows = n
             f.attrs.update(_resume["attrs"])
             ckpt.write(f, self._layout, _resume["seq"], _resume["values"])
-        self._columns: list[tuple[str, int, int]] = []  # (name, first, end) columns of each series in a row
-        for spec in outputs:
-            start = self._columns[-1][2] if self._columns else 0
-            self._columns.append((spec.name, start, start + spec.size))
-        width = self._columns[-1][2] if self._columns else 0
-        self._block = np.empty((CHUNK_ROWS, width))  # buffered rows, grown by doubling
+        ends = np.cumsum([0] + [spec.size for spec in outputs]).tolist()
+        self._columns = [(spec.name, a, b) for spec, a, b in zip(outputs, ends[:-1], ends[1:])]  # columns in a row
+        self._block = np.empty((CHUNK_ROWS, ends[-1]))  # rows buffered since the last flush, grown by doubling
         self._times = np.empty(CHUNK_ROWS)
         self._buffered = 0
         self._stats: dict[str, Any] = {}
