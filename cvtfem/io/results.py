@@ -111,6 +111,9 @@ class ResultsWriter:
             ckpt.write(f, self._layout, _resume["seq"], _resume["values"])
         ends = np.cumsum([0] + [spec.size for spec in outputs]).tolist()
         self._columns = [(spec.name, a, b) for spec, a, b in zip(outputs, ends[:-1], ends[1:])]  # columns in a row
+        self._scalars = [name for name, a, b in self._columns if b - a == 1]  # one-value series, set in one go
+        self._scalar_cols = np.array([a for _, a, b in self._columns if b - a == 1], dtype=np.intp)
+        self._vectors = [(name, a, b) for name, a, b in self._columns if b - a > 1]
         self._block = np.empty((CHUNK_ROWS, ends[-1]))  # rows buffered since the last flush, grown by doubling
         self._times = np.empty(CHUNK_ROWS)
         self._buffered = 0
@@ -196,15 +199,20 @@ class ResultsWriter:
         return writer, seq, values
 
     def append(self, t: float, values: Mapping[str, Any]) -> None:
-        """Record one output sample at time ``t`` (s) in the in-memory block; flushes when due."""
+        """Record one output sample at time ``t`` (s) in the in-memory block (a scalar per one-value series,
+        an array of the series' size otherwise); flushes when due."""
         i = self._buffered
         if i == self._times.size:
             self._block = np.concatenate([self._block, np.empty_like(self._block)])
             self._times = np.concatenate([self._times, np.empty_like(self._times)])
         row = self._block[i]
-        for name, a, b in self._columns:
+        try:
+            row[self._scalar_cols] = [values[name] for name in self._scalars]
+        except (TypeError, ValueError) as err:
+            raise ValueError(f"outputs {self._scalars} must be one number each ({err})") from None
+        for name, a, b in self._vectors:
             value = values[name]
-            if b - a > 1 and np.size(value) != b - a:
+            if np.size(value) != b - a:
                 raise ValueError(f"output {name!r} has {np.size(value)} values, its series {b - a}")
             row[a:b] = value
         self._times[i] = t

@@ -101,6 +101,8 @@ def test_buffered_rows_across_flushes(tmp_path):
             w.append(1.0, {"x": 0.0, "f": [1.0, 2.0]})
         with pytest.raises(ValueError, match="'f' has 1 values"):
             w.append(1.0, {"x": 0.0, "f": 1.0})
+        with pytest.raises(ValueError, match="must be one number each"):
+            w.append(1.0, {"x": [0.0, 1.0], "f": [1.0, 2.0, 3.0]})
     res = read_results(path)
     i = np.arange(700)
     np.testing.assert_array_equal(res.time, 1e-3 * i)
