@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from cvtfem.analysis.steppers import SCIPY_STEPPERS, make_stepper
-from cvtfem.analysis.summary import EFFICIENCY_WINDOW, RunSummary, sample_outputs, summarise
+from cvtfem.analysis.summary import EFFICIENCY_WINDOW, RunSummary, summarise
 from cvtfem.errors import InputError, NumericalError
 
 #: Stall guard: a run fails when STALL_STEPS consecutive accepted steps each advance time by less than
@@ -249,7 +249,7 @@ class _Run:
             if k == self.j_window:
                 x_window = np.array(x)
             if writer is not None:
-                writer.append(t, sample_outputs(loop, t, x))
+                writer.append(t, loop.outputs(t, x))
             k += 1
 
         def save() -> None:

@@ -1,11 +1,9 @@
-"""What a time run reports: named output samples of a closed-loop state and the final :class:`RunSummary`."""
+"""What a time run reports at its end: :class:`RunSummary` (the samples are the model's ``outputs``)."""
 from __future__ import annotations
 
 import math
 from dataclasses import asdict, dataclass, field
 from typing import Any
-
-import numpy as np
 
 EFFICIENCY_WINDOW = 0.05  # s, moving average of the efficiency (section 6.1)
 
@@ -35,25 +33,6 @@ class RunSummary:
 
     def to_dict(self) -> dict[str, Any]:
         return asdict(self)
-
-
-def sample_outputs(loop, t: float, x) -> dict[str, Any]:
-    """Named outputs (see ``cvtfem describe``) of closed-loop state ``x`` at time ``t``."""
-    _, info = loop.evaluate(t, x)
-    q, v, _, W = loop.split(x)
-    N = np.asarray(info["N"])
-    w, M, F = info["w"], info["M"], info["F"]
-    P = np.array([M[0] * w[0], -M[1] * w[1], info["dissipation"], info["clamp_power"]])
-    out = {"band.span_angle": q[0], "band.slip_speed": info["slip"], "band.slip_max": info["slip_max"],
-           "band.mean_normal_force": N.mean(axis=-1) if N.ndim == 2 else N,
-           "driving.speed": w[0], "driving.torque": M[0], "driving.clamping_force": F[0],
-           "driven.speed": w[1], "driven.torque": M[1], "driven.clamping_force": F[1],
-           "control.ratio_estimate": info["ratio_estimate"], "control.resistance": info["resistance"],
-           "efficiency": P[1] / P[0] if P[0] else math.nan, "ratio": w[0] / w[1] if w[1] else math.nan,
-           "power": P, "work": W, "energy": loop.energy(x)}
-    if N.ndim == 2:
-        out["band.normal_force"] = N.ravel()
-    return out
 
 
 def summarise(scene, loop, last, window, t_end, wall, stats, status) -> RunSummary:

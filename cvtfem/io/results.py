@@ -10,10 +10,11 @@ Layout::
     /checkpoint/slots  full state for resuming (payload chosen by the run driver;
                      layout in :mod:`cvtfem.io.checkpoint`)
 
-Rows are appended to resizable datasets and the file is flushed every
-``flush_interval`` seconds of wall time, so a run killed half-way leaves a
-readable file with every row up to the last flush (``status`` then stays
-"running"): the file is in HDF5's single-writer/multiple-reader mode, which
+Rows are collected in memory (one float64 block, a row per sample) and
+appended to resizable datasets, one write per series, when the file is
+flushed: every ``flush_interval`` seconds of wall time, so a run killed
+half-way leaves a readable file with every row up to the last flush
+(``status`` then stays "running"): the file is in HDF5's single-writer/multiple-reader mode, which
 keeps it consistent on disk at every moment, and readers open it with
 ``swmr=True``.  Attributes and datasets cannot be created in that mode, so
 statistics, whole arrays and the final status are written when the run
@@ -108,7 +109,14 @@ class ResultsWriter:
             self._rows = n
             f.attrs.update(_resume["attrs"])
             ckpt.write(f, self._layout, _resume["seq"], _resume["values"])
-        self._buffer: list[tuple[float, dict[str, np.ndarray]]] = []
+        ends = np.cumsum([0] + [spec.size for spec in outputs]).tolist()
+        self._columns = [(spec.name, a, b) for spec, a, b in zip(outputs, ends[:-1], ends[1:])]  # columns in a row
+        self._scalars = [name for name, a, b in self._columns if b - a == 1]  # one-value series, set in one go
+        self._scalar_cols = np.array([a for _, a, b in self._columns if b - a == 1], dtype=np.intp)
+        self._vectors = [(name, a, b) for name, a, b in self._columns if b - a > 1]
+        self._block = np.empty((CHUNK_ROWS, ends[-1]))  # rows buffered since the last flush, grown by doubling
+        self._times = np.empty(CHUNK_ROWS)
+        self._buffered = 0
         self._stats: dict[str, Any] = {}
         self._arrays: dict[str, tuple[np.ndarray, str, str]] = {}
         self._last_flush = time.monotonic()
@@ -191,29 +199,44 @@ class ResultsWriter:
         return writer, seq, values
 
     def append(self, t: float, values: Mapping[str, Any]) -> None:
-        """Record one output sample at time ``t`` (s); flushes when due."""
-        row = {name: np.asarray(values[name], dtype=float).reshape(spec.size) for name, spec in self._specs.items()}
-        self._buffer.append((float(t), row))
+        """Record one output sample at time ``t`` (s) in the in-memory block (a scalar per one-value series,
+        an array of the series' size otherwise); flushes when due."""
+        i = self._buffered
+        if i == self._times.size:
+            self._block = np.concatenate([self._block, np.empty_like(self._block)])
+            self._times = np.concatenate([self._times, np.empty_like(self._times)])
+        row = self._block[i]
+        try:
+            row[self._scalar_cols] = [values[name] for name in self._scalars]
+        except (TypeError, ValueError) as err:
+            raise ValueError(f"outputs {self._scalars} must be one number each ({err})") from None
+        for name, a, b in self._vectors:
+            value = values[name]
+            if np.size(value) != b - a:
+                raise ValueError(f"output {name!r} has {np.size(value)} values, its series {b - a}")
+            row[a:b] = value
+        self._times[i] = t
+        self._buffered = i + 1
         if time.monotonic() - self._last_flush >= self.flush_interval:
             self.flush()
 
     def flush(self) -> None:
         """Write buffered rows and make them visible to readers."""
-        if self._buffer:
-            n_new = len(self._buffer)
+        n_new = self._buffered
+        if n_new:
             series = self._file["series"]
             end = self._rows + n_new
-            for name in self._specs:
+            for name, a, b in self._columns:
                 d = series[name]
-                d.resize((end, d.shape[1]))
-                d[self._rows:end] = np.stack([row[name] for _, row in self._buffer])
+                d.resize((end, b - a))
+                d[self._rows:end] = self._block[:n_new, a:b]
                 d.flush()
             times = series["time"]
             times.resize((end,))
-            times[self._rows:end] = [t for t, _ in self._buffer]
+            times[self._rows:end] = self._times[:n_new]
             times.flush()
             self._rows = end
-            self._buffer.clear()
+            self._buffered = 0
         self._file.flush()
         self._last_flush = time.monotonic()
 

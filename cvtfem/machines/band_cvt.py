@@ -186,19 +186,23 @@ class BandCVT(ModelBase):
         return self.rhs(t, x)[-4:]
 
     def energy(self, x) -> float:
-        """Kinetic plus elastic energy of the band family, J."""
+        """Kinetic plus elastic energy of the band family, J (one compiled call where the family has ``energies``)."""
         q, v, _, _ = self.split(x)
+        if hasattr(self.model, "energies"):
+            T, V = self.model.energies(q, v)
+            return float(T + V)
         return float(self.model.kinetic_energy(q, v) + self.model.elastic_energy(q))
 
     def outputs(self, t: float, x) -> dict[str, Any]:
-        """The named outputs of :attr:`output_specs` at ``(t, x)``."""
-        _, info = self.evaluate(t, x)
+        """The named outputs of :attr:`output_specs` at ``(t, x)``: one evaluation of the loop (its work-integral
+        rates are the powers) and one of the energy."""
+        dx, info = self.evaluate(t, x)
         q, _, _, W = self.split(x)
+        P = dx[-4:]  # [M1 w1, -M2 w2, dissipation, clamping power], W
         N = np.asarray(info["N"])
         w, M, F = info["w"], info["M"], info["F"]
-        P = np.array([M[0] * w[0], -M[1] * w[1], info["dissipation"], info["clamp_power"]])
         out = {"band.span_angle": q[0], "band.slip_speed": info["slip"], "band.slip_max": info["slip_max"],
-               "band.mean_normal_force": N.mean(axis=-1) if N.ndim == 2 else N,
+               "band.mean_normal_force": N.sum(axis=-1) / N.shape[-1] if N.ndim == 2 else N,
                "driving.speed": w[0], "driving.torque": M[0], "driving.clamping_force": F[0],
                "driven.speed": w[1], "driven.torque": M[1], "driven.clamping_force": F[1],
                "control.ratio_estimate": info["ratio_estimate"], "control.resistance": info["resistance"],

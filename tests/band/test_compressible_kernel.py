@@ -126,3 +126,17 @@ def test_without_numba_the_numpy_twin_runs(monkeypatch):
     assert dataclasses.replace(m, use_numba=False).backend == "numpy"
     q, v, F, M = next(_random_states(m, np.random.default_rng(4), 1))
     assert np.array_equal(m.accel(q, v, F, M)[0], m.accel_numpy(q, v, F, M)[0])
+    assert m.energies(q, v) == (m.kinetic_energy(q, v), m.elastic_energy(q))
+
+
+@pytest.mark.parametrize("name,profile", [c[:2] for c in CASES if c[2] == "tanh"])
+def test_compiled_energies_equal_numpy_twin(name, profile):
+    """``energies`` (compiled) against ``kinetic_energy`` and ``elastic_energy`` (numpy), each to 1e-12 relative."""
+    m = band_model(_scene(name, profile))
+    assert m.backend == "numba"
+    for q, v, F, M in _random_states(m, np.random.default_rng(6), 6):
+        T, V = m.energies(q, v)
+        T0, V0 = m.kinetic_energy(q, v), m.elastic_energy(q)
+        assert V0 > 0
+        assert abs(T - T0) <= 1e-12 * abs(T0)
+        assert abs(V - V0) <= 1e-12 * abs(V0)

@@ -33,3 +33,19 @@ def test_numba_kernel_equals_numpy_twin(profile, law, friction):
         for key in ("N", "slip", "slip_max", "dissipation", "clamp_power"):
             ref = np.asarray(i0[key], float)
             assert np.abs(np.asarray(i1[key]) - ref).max() <= 1e-12 * max(np.abs(ref).max(), 1e-300), key
+
+
+@pytest.mark.parametrize("profile", ["toroidal", "conical"])
+def test_compiled_energies_equal_numpy_twin(profile):
+    """``energies`` (compiled kinetic energy) against ``kinetic_energy`` / ``elastic_energy`` to 1e-12 relative."""
+    m = band_model(load_scene("band-4dof", {"cvt": {"geometry": {"sheave_profile": profile}}}))
+    assert m.backend == "numba"
+    rng = np.random.default_rng(8)
+    lo, hi = admissible_phi(m.p.length, m.p.L)
+    for _ in range(8):
+        q = np.array([rng.uniform(0.6 * lo, 0.6 * hi), *rng.uniform(-10, 10, 3)])
+        v = np.array([0.3, 28.0, 366.0, 152.0]) * (1 + 0.1 * rng.standard_normal(4))
+        T, V = m.energies(q, v)
+        T0 = m.kinetic_energy(q, v)
+        assert abs(T - T0) <= 1e-12 * abs(T0)
+        assert V == m.elastic_energy(q) == 0.0

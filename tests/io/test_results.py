@@ -85,3 +85,26 @@ def test_show_rejects_non_hdf5(tmp_path, cli):
     bad.write_text("not hdf5")
     res = cli("show", str(bad))
     assert res.returncode == 2 and "readable HDF5" in res.stderr and "Traceback" not in res.stderr
+
+
+def test_buffered_rows_across_flushes(tmp_path):
+    """Rows buffered in memory (beyond one block, across explicit flushes) reach the file in order and
+    unchanged; a value of the wrong size is refused."""
+    path = tmp_path / "r.h5"
+    with ResultsWriter(path, "", "run", SPECS, flush_interval=1e9) as w:
+        for i in range(700):
+            w.append(1e-3 * i, {"x": np.float64(i) / 7, "f": np.array([i, -i, 0.5 * i])})
+            if i in (10, 300):
+                w.flush()
+                assert w.rows == i + 1
+        with pytest.raises(ValueError, match="'f' has 2 values"):
+            w.append(1.0, {"x": 0.0, "f": [1.0, 2.0]})
+        with pytest.raises(ValueError, match="'f' has 1 values"):
+            w.append(1.0, {"x": 0.0, "f": 1.0})
+        with pytest.raises(ValueError, match="must be one number each"):
+            w.append(1.0, {"x": [0.0, 1.0], "f": [1.0, 2.0, 3.0]})
+    res = read_results(path)
+    i = np.arange(700)
+    np.testing.assert_array_equal(res.time, 1e-3 * i)
+    np.testing.assert_array_equal(res.series["x"][:, 0], i / 7)
+    np.testing.assert_array_equal(res.series["f"], np.column_stack([i, -i, 0.5 * i]))

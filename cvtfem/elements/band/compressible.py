@@ -301,7 +301,17 @@ class CompressibleBand:
         return a
 
     # --- energies and states -------------------------------------------------------------------
+    def energies(self, q, v) -> tuple[float, float]:
+        """Kinetic and elastic energy ``(T, V)``, J; compiled when :attr:`backend` is numba (twin:
+        :meth:`kinetic_energy`, :meth:`elastic_energy`)."""
+        if self.backend == "numpy":
+            return self.kinetic_energy(q, v), self.elastic_energy(q)
+        c = np.ascontiguousarray
+        T, V = ker.energy_kernel(c(q, float), c(v, float), *self._c["packed"])
+        return float(T), float(V)
+
     def kinetic_energy(self, q, v) -> float:
+        """Kinetic energy ``q'^T M(phi) q' / 2`` plus the shafts', J; numpy reference of :meth:`energies`."""
         p, n = self.p, self.p.n_ritz
         bi = self._band_index()
         vb = v[bi]
@@ -317,7 +327,8 @@ class CompressibleBand:
         return float(T)
 
     def elastic_energy(self, q) -> float:
-        """Band compression plus shaft springs, J (the clamping potential is not included)."""
+        """Band compression plus shaft springs, J (the clamping potential is not included); numpy reference
+        of :meth:`energies`."""
         p, n = self.p, self.p.n_ritz
         g = self.arcs(q[0])
         E = self._c["c_edge"] * np.sum(self.strain(q, g) ** 2 * g["ds"])

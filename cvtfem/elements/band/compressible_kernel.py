@@ -323,7 +323,7 @@ def jacobian_kernel(q, v, F, Mt, s, sh, sf, xidx, xi, wq, Fs, dF):
     """Forward-difference Jacobian of ``y = [a, dissipation, clamp_power]`` (n2 + 2) with respect to
     ``[q, v, F, M]`` (2 n2 + 4 columns); the rotation angles q[1:4] never enter, their columns are 0.
 
-    Increments as ``ClosedLoop.jac``: ``1e-8 max(1e-3, |q_j|)`` for coordinates, ``1e-7 max(1, |v_j|)``
+    Increments as ``BandCVT.jac``: ``1e-8 max(1e-3, |q_j|)`` for coordinates, ``1e-7 max(1, |v_j|)``
     for velocities; ``y`` is affine in F and M, so their columns are exact to rounding.
     """
     n2 = q.size
@@ -351,3 +351,53 @@ def jacobian_kernel(q, v, F, Mt, s, sh, sf, xidx, xi, wq, Fs, dF):
         Jm[n2, col] = (d1 - d0) / h
         Jm[n2 + 1, col] = (c1 - c0) / h
     return Jm
+
+
+@njit(cache=True)
+def energy_kernel(q, v, s, sh, sf, xidx, xi, wq, Fs, dF):
+    """Kinetic and elastic energy ``(T, V)``, J, as ``CompressibleBand.kinetic_energy`` and ``elastic_energy``
+    (real geometry: the complex kernels at ``phi + 0j``; strain summed as the numpy twin's, ``E^T x - z0``)."""
+    n, g = Fs.shape
+    nx = xidx.shape[1]
+    shaft = s[S_SHAFT] != 0.0
+    phic = q[0] + 0j
+    rc, drc, _, z0c, _, thc, dsc, frc, Ec, _, _ = _geometry(phic, s, sh, xi, wq, dF, nx, shaft)
+    Mb = _band_mass(phic, s, rc, drc, thc, dsc, frc, Fs).real
+    nb = 2 + 2 * n
+    vb = np.empty(nb)
+    vb[0], vb[1] = v[0], v[1]
+    for i in range(2 * n):
+        vb[2 + i] = v[6 + i]
+    T = 0.0
+    for i in range(nb):
+        acc = 0.0
+        for m in range(nb):
+            acc += Mb[i, m] * vb[m]
+        T += vb[i] * acc
+    T = 0.5 * T + 0.5 * (sf[0, 1] * v[4] ** 2 + sf[1, 1] * v[5] ** 2)
+    b = 6 + 2 * n
+    if shaft:
+        for k in range(2):
+            j = b + 4 * k
+            w_ax = v[2 + k]
+            if s[S_GYRO] != 0.0:
+                w_ax += 0.5 * (v[j + 2] * q[j + 3] - v[j + 3] * q[j + 2])
+            T += 0.5 * (sf[k, 1] * (v[j] ** 2 + v[j + 1] ** 2) + sf[k, 0] * w_ax ** 2
+                        + sf[k, 2] * (v[j + 2] ** 2 + v[j + 3] ** 2))
+    else:
+        T += 0.5 * (sf[0, 0] * v[2] ** 2 + sf[1, 0] * v[3] ** 2)
+    E, ds, z0 = Ec.real, dsc.real, z0c.real
+    V = 0.0
+    for k in range(2):
+        for j in range(g):
+            e = 0.0
+            for x in range(nx):
+                e += q[xidx[k, x]] * E[k, x, j]
+            e -= z0[k]
+            V += e * e * ds[k, j]
+    V *= s[S_CEDGE]
+    if shaft:
+        for k in range(2):
+            j = b + 4 * k
+            V += 0.5 * (sf[k, 3] * (q[j] ** 2 + q[j + 1] ** 2) + sf[k, 4] * (q[j + 2] ** 2 + q[j + 3] ** 2))
+    return T, V

@@ -13,6 +13,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from cvtfem.elements.band import compressible_kernel, fourdof_kernel
 from cvtfem.elements.band.friction import friction_gain
 from cvtfem.elements.band.geometry import radii, wrap_half_angles
 from cvtfem.elements.band.inertia import band_inertia
@@ -54,8 +55,6 @@ class FourDofBand:
     _packed: tuple = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
-        from cvtfem.elements.band import fourdof_kernel
-
         xi, wq = gauss_nodes(self.p.n_gauss)
         object.__setattr__(self, "_xi", xi)
         object.__setattr__(self, "_wq", wq)
@@ -64,9 +63,7 @@ class FourDofBand:
     @property
     def backend(self) -> str:
         """``"numba"`` (compiled right-hand side) or ``"numpy"`` (numba off or not installed)."""
-        from cvtfem.elements.band.compressible_kernel import HAVE_NUMBA
-
-        return "numba" if self.use_numba and HAVE_NUMBA else "numpy"
+        return "numba" if self.use_numba and compressible_kernel.HAVE_NUMBA else "numpy"
 
     n2 = 4
 
@@ -78,11 +75,9 @@ class FourDofBand:
         """Accelerations and diagnostics (see :meth:`accel_numpy`), compiled when :attr:`backend` is numba."""
         if self.backend == "numpy":
             return self.accel_numpy(q, v, F, M)
-        from cvtfem.elements.band.fourdof_kernel import accel4_kernel
-
         c = np.ascontiguousarray  # one compiled signature (C-contiguous float64)
-        a, N, slip, slip_max, dissipation, clamp_power = accel4_kernel(c(q, float), c(v, float), c(F, float),
-                                                                       c(M, float), *self._packed)
+        a, N, slip, slip_max, dissipation, clamp_power = fourdof_kernel.accel4_kernel(
+            c(q, float), c(v, float), c(F, float), c(M, float), *self._packed)
         return a, {"N": N, "dissipation": dissipation, "slip": slip, "slip_max": slip_max,
                    "clamp_power": clamp_power}
 
@@ -144,8 +139,16 @@ class FourDofBand:
         info["clamp_power"] = float(p.kappa * np.sum(F * tg * dr) * dphi)
         return a, info
 
+    def energies(self, q, v) -> tuple[float, float]:
+        """Kinetic and elastic energy ``(T, V)``, J; compiled when :attr:`backend` is numba (twin:
+        :meth:`kinetic_energy`, :meth:`elastic_energy`)."""
+        if self.backend == "numpy":
+            return self.kinetic_energy(q, v), self.elastic_energy(q)
+        c = np.ascontiguousarray
+        return float(fourdof_kernel.kinetic4_kernel(c(q, float), c(v, float), *self._packed[:4])), 0.0
+
     def kinetic_energy(self, q, v) -> float:
-        """``T = (Acal phi'^2 + m sigma'^2 + sum J_k phi_k'^2) / 2``, J (1.40), (1.44)."""
+        """``T = (Acal phi'^2 + m sigma'^2 + sum J_k phi_k'^2) / 2``, J (1.40), (1.44); numpy reference."""
         A = generalized_inertia(q[0], self.p)
         return 0.5 * (A * v[0] ** 2 + self.p.mass * v[1] ** 2 + np.sum(np.asarray(self.p.J) * v[2:4] ** 2))
 

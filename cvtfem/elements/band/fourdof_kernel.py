@@ -1,4 +1,5 @@
-"""Compiled right-hand side of the 4-DOF band model (numba); ``FourDofBand.accel_numpy`` is its reference twin.
+"""Compiled right-hand side and kinetic energy of the 4-DOF band model (numba); ``FourDofBand.accel_numpy`` and
+``FourDofBand.kinetic_energy`` are their reference twins.
 
 Same statements as the numpy method (complex step in phi for A and its derivative, Gauss quadrature
 of the friction along each arc, the 3x3 elimination for N_k), written as loops over the two arcs
@@ -99,3 +100,22 @@ def accel4_kernel(q, v, F, Mt, s, sh, J, msh, xi, wq):
             a[2 + k] = Mt[k] / J[k]
     clamp_power = kappa * (F[0] * tg[0] * dr[0] + F[1] * tg[1] * dr[1]) * dphi
     return a, N, slip, slip_max, dissipation, clamp_power
+
+
+@njit(cache=True)
+def kinetic4_kernel(q, v, s, sh, J, msh):
+    """Kinetic energy ``(Acal phi'^2 + m sigma'^2 + sum J_k phi_k'^2) / 2``, J, as ``FourDofBand.kinetic_energy``."""
+    length, L = s[S_LENGTH], s[S_L]
+    phi = q[0]
+    sn, cs = np.sin(phi), np.cos(phi)
+    S = (length - 2 * L * (cs + phi * sn)) / np.pi
+    r = np.empty(2)
+    A = 0.0
+    for k in range(2):
+        sg = 1.0 - 2.0 * k
+        r[k] = 0.5 * (S + sg * L * sn)
+        dr = L * cs * (0.5 * sg - phi / np.pi)
+        tg, _, _ = _face(sh[k], r[k])
+        A += msh[k] * (tg * dr) ** 2
+    A = _band_inertia(phi, r, s) + A
+    return 0.5 * (A * v[0] ** 2 + s[S_MASS] * v[1] ** 2 + (J[0] * v[2] ** 2 + J[1] * v[3] ** 2))
