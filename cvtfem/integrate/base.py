@@ -94,6 +94,18 @@ class Stepper:
     def reset(self) -> None:
         """Forget the history (after an event switch changes the state or ``phi``)."""
 
+    def memory_fields(self) -> tuple[tuple[str, int], ...]:
+        """``((name, size), ...)`` of :meth:`state` (empty: no memory besides the step size)."""
+        return ()
+
+    def state(self, t: float, x: np.ndarray) -> dict[str, np.ndarray]:
+        """The method's step-to-step memory at the accepted point ``(t, x)`` (see :meth:`memory_fields`)."""
+        return {}
+
+    def restore(self, state: dict[str, np.ndarray], t: float, x: np.ndarray) -> None:
+        """Continue from :meth:`state` in a stepper freshly built at ``(t, x)``. Without memory the method
+        restarts (W-methods, stabilized methods: their LU / spectral-radius estimates are recomputed)."""
+
     def max_step(self) -> float:
         """Largest step, s, worth attempting now (adaptive runs cap their proposals there); no cap here."""
         return np.inf
