@@ -25,7 +25,7 @@ from cvtfem.integrate.methods import METHODS, SCIPY_METHODS, check_options
 from cvtfem.integrate.stats import COUNTERS, Stats
 from cvtfem.integrate.system import OdeSystem
 
-__all__ = ["Stepping", "NativeEngine", "Candidate", "make_engine", "initial_step", "GROWTH_LIMIT",
+__all__ = ["Stepping", "NativeEngine", "Candidate", "make_engine", "initial_step", "state_fields", "GROWTH_LIMIT",
            "ZENO_GAP", "ZENO_GAP_H", "ZENO_COUNT"]
 
 ZENO_GAP = 1e-9     # events closer than this fraction of the span ...
@@ -159,13 +159,12 @@ class NativeEngine:
         self.stats.counts.update(counts)
 
     def memory_fields(self) -> tuple[tuple[str, int], ...]:
-        return (("monitor", 5),) + self.stepper.memory_fields()
+        return self.stepper.memory_fields()
 
     def state(self, t: float, x: np.ndarray) -> dict[str, np.ndarray]:
-        return {"monitor": self.monitor.snapshot(), **self.stepper.state(t, x)}
+        return self.stepper.state(t, x)
 
     def restore(self, state: dict[str, np.ndarray], t: float, x: np.ndarray) -> None:
-        self.monitor.restore(state["monitor"])
         self.stepper.restore(state, t, x)
 
     def report(self) -> dict:
@@ -222,6 +221,8 @@ class Stepping:
         self.t_events = [[] for _ in range(self.system.n_events)]
         self.y_events = [[] for _ in range(self.system.n_events)]
         self.status, self.message, self.failure = "running", "", None
+        self.t_fail = float("nan")   # where a failure was detected (a blown-up step's end), s
+        self.monitor = getattr(engine, "monitor", None)   # local-error monitor of fixed steps
         self.last: Candidate | None = None
         self.fired: np.ndarray | None = None
 
@@ -234,8 +235,9 @@ class Stepping:
         """Proposed size of the next step, s."""
         return self.engine.h
 
-    def _fail(self, message: str, failure: str = "numerical") -> bool:
+    def _fail(self, message: str, failure: str = "numerical", t: float | None = None) -> bool:
         self.status, self.message, self.failure = "failed", message, failure
+        self.t_fail = self.t if t is None else t
         return False
 
     def step(self) -> bool:
@@ -254,7 +256,7 @@ class Stepping:
         if blow_up is not None:
             kind = "adaptive" if self.engine.adaptive else "fixed"
             return self._fail(f"{blow_up} at t = {cand.t1:.6g} s with {kind} step h = {cand.h:.3g} s"
-                              f"{self.guard.hint()}")
+                              f"{self.guard.hint()}", t=cand.t1)
         counts = self.engine.counts()
         counts["nsteps"] += 1
         t1, x1 = cand.t1, cand.x1
@@ -315,10 +317,7 @@ class Stepping:
 
     def fields(self) -> tuple[tuple[str, int], ...]:
         """``((name, size), ...)`` of :meth:`state`: the loop's own memory, then the method's."""
-        n, m = len(self.x), self.system.n_events
-        return (("t", 1), ("x", n), ("h", 1), ("counts", len(COUNTERS)), ("largest", 1), ("tiny", 1),
-                ("zeno", 1), ("last_event", 1), ("events_g0", m), ("events_side", m),
-                ("events_ga", m)) + self.engine.memory_fields()
+        return loop_fields(len(self.x), self.system.n_events) + self.engine.memory_fields()
 
     def state(self) -> dict[str, np.ndarray]:
         """The full memory at the current point as named float arrays (sizes: :meth:`fields`)."""
@@ -332,6 +331,7 @@ class Stepping:
                 "counts": np.array([counts[c] for c in COUNTERS], dtype=float),
                 "largest": np.array([self.guard.largest]), "tiny": np.array([float(self.tiny)]),
                 "zeno": np.array([float(self.zeno)]), "last_event": np.array([self.last_event]),
+                "monitor": self.monitor.snapshot() if self.monitor is not None else np.zeros(5),
                 "events_g0": ev(None if loc is None else loc.g0), "events_side": ev(None if loc is None else loc.side),
                 "events_ga": ev(None if loc is None else loc._ga), **self.engine.state(self.t, self.x)}
 
@@ -346,9 +346,23 @@ class Stepping:
             self.locator.side = np.array(state["events_side"])
             ga = state["events_ga"]
             self.locator._ga = None if np.all(np.isnan(ga)) else np.array(ga)
+        if self.monitor is not None:
+            self.monitor.restore(state["monitor"])
         if memory:
             self.engine.restore(state, self.t, self.x)
         self.engine.set_counts({c: int(v) for c, v in zip(COUNTERS, state["counts"])})
+
+
+def loop_fields(n: int, n_events: int) -> tuple[tuple[str, int], ...]:
+    """The loop's own part of :meth:`Stepping.fields` (state, step size, counters, guards, events)."""
+    m = n_events
+    return (("t", 1), ("x", n), ("h", 1), ("counts", len(COUNTERS)), ("largest", 1), ("tiny", 1),
+            ("zeno", 1), ("last_event", 1), ("monitor", 5), ("events_g0", m), ("events_side", m), ("events_ga", m))
+
+
+def state_fields(method: str, n: int, n2: int = 0, n_events: int = 0, jac_sparsity=None):
+    """:meth:`Stepping.fields` of a run of ``method`` without building it (checkpoint layouts)."""
+    return loop_fields(n, n_events) + memory_fields(method, n, n2, jac_sparsity)
 
 
 def memory_fields(method: str, n: int, n2: int = 0, jac_sparsity=None) -> tuple[tuple[str, int], ...]:
@@ -358,4 +372,4 @@ def memory_fields(method: str, n: int, n2: int = 0, jac_sparsity=None) -> tuple[
 
         return scipy_fields(method, n, jac_sparsity)
     system = OdeSystem(fun=lambda t, x: x, n=n, n2=n2, jac_sparsity=jac_sparsity)
-    return (("monitor", 5),) + METHODS[method](system, Stats()).memory_fields()
+    return METHODS[method](system, Stats()).memory_fields()
