@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 
-__all__ = ["register_name", "specs", "MethodNames"]
+__all__ = ["register_name", "unregister_name", "specs", "MethodNames"]
 
 _SPECS: dict[str, object] = {
     "euler": "cvtfem.integrate.rk:Euler",
@@ -45,6 +45,13 @@ def register_name(name: str, spec: object) -> None:
     if name in _SPECS and _SPECS[name] is not spec:
         raise ValueError(f"integration method {name!r} is already registered")
     _SPECS[name] = spec
+
+
+def unregister_name(name: str) -> None:
+    """Forget a method registered at run time (built-in names stay)."""
+    if isinstance(_SPECS.get(name), str):
+        raise ValueError(f"integration method {name!r} is built in")
+    _SPECS.pop(name, None)
 
 
 def specs() -> dict[str, object]:

@@ -17,7 +17,7 @@ from cvtfem import methods_registry
 from cvtfem.errors import InputError
 from cvtfem.integrate.base import Stepper
 
-__all__ = ["METHODS", "SCIPY_METHODS", "register_method", "all_options", "check_options",
+__all__ = ["METHODS", "SCIPY_METHODS", "register_method", "unregister_method", "all_options", "check_options",
            "IgnoredOptionWarning"]
 
 _NATIVE: dict[str, type] = {}
@@ -53,6 +53,13 @@ def register_method(cls: type, name: str | None = None) -> str:
     _add(name, cls)
     methods_registry.register_name(name, cls)
     return name
+
+
+def unregister_method(name: str) -> None:
+    """Remove a method added by :func:`register_method` (a plug-in unloaded, a test's method)."""
+    methods_registry.unregister_name(name)
+    _NATIVE.pop(name, None)
+    _SCIPY.pop(name, None)
 
 
 def _resolve(spec) -> type:

@@ -12,7 +12,7 @@ EVENT = TableArray("event", "Events of a run: a named scalar output crossing a v
                    "dense output; recorded in the results file).", Table("event", "One event.", (
     Key("output", "str", "Scalar output whose crossing is the event (e.g. 'ratio'; see `cvtfem describe`).", "",
         REQUIRED),
-    Key("value", "float", "Value the output crosses, in the output's unit.", "", REQUIRED),
+    Key("value", "float", "Value the output crosses, in the output's unit.", "as output", REQUIRED),
     Key("direction", "str", "Crossings that count: the output rising through `value`, falling, or either.", "",
         "either", choices=("rising", "falling", "either")),
     Key("terminal", "bool", "End the run at the event (else it is recorded and the run goes on).", "", True),
