@@ -30,7 +30,7 @@ from cvtfem.errors import InputError
 from cvtfem.integrate.base import Attempt, Stepper
 from cvtfem.integrate.jacobian import JacobianProvider
 from cvtfem.integrate.linsolve import DENSE_MAX, LU, reduced_matrix
-from cvtfem.integrate.memory import MatrixSlot, opt_scalar, opt_vector, scalar, vector
+from cvtfem.integrate.memory import MatrixSlot, opt_scalar, scalar, vector
 from cvtfem.integrate.newton import NewtonOptions, NewtonSolver
 
 __all__ = ["Theta", "Trapezoidal", "ImplicitEuler"]
@@ -82,16 +82,15 @@ class Theta(Stepper):
         (error estimate), the Jacobian, ``F`` at the current point, and the Newton solver's memory
         (Jacobian marked stale, contraction estimate of the last solve)."""
         n = self.system.n
-        return (("gamma", 1), ("lu_valid", 1), ("prev_h", 1), ("prev_f", n)) + self._slot().fields() + (
-            ("f_start", n), ("newton_stale", 1), ("newton_eta", 1))
+        return (("gamma", 1), ("lu_valid", 1), ("prev_h", 1), ("prev_f", n)) + self._slot().fields() + \
+            super().memory_fields() + (("newton_stale", 1), ("newton_eta", 1))
 
     def state(self, t, x):
-        n, prev, start = self.system.n, self._prev, self._start
-        at_x = start is not None and start[0] == t and np.array_equal(start[1], x)
+        n, prev = self.system.n, self._prev
         return {"gamma": scalar(self._gamma), "lu_valid": scalar(self.newton.B is not None),
                 "prev_h": scalar(None if prev is None else prev[0]),
                 "prev_f": vector(None if prev is None else prev[1], n), **self._slot().pack(self.J),
-                "f_start": vector(start[2] if at_x else None, n), "newton_stale": scalar(self.newton.stale),
+                **super().state(t, x), "newton_stale": scalar(self.newton.stale),
                 "newton_eta": scalar(self.newton._eta)}
 
     def restore(self, state, t, x):
@@ -103,9 +102,7 @@ class Theta(Stepper):
         self._gamma = opt_scalar(state["gamma"])
         prev_h = opt_scalar(state["prev_h"])
         self._prev = None if prev_h is None else (prev_h, np.array(state["prev_f"]))
-        f_start = opt_vector(state["f_start"])
-        if f_start is not None:
-            self._start = (t, np.array(x), f_start)
+        super().restore(state, t, x)
         self.newton.invalidate()
         if state["lu_valid"][0] == 1.0 and self.J is not None and self._gamma is not None:
             self.newton._set(reduced_matrix(self.J, self.system.n2, self._gamma))
