@@ -43,7 +43,7 @@ def run_scene(scene, until: float | None = None, results: str | Path | None = No
         ``output.checkpoint_interval > 0`` it also receives the checkpoints (:func:`resume_run`).
     start : dict, optional
         ``ratio`` and/or ``speed_factor`` to start away from the targets
-        (:meth:`~cvtfem.control.closed_loop.ClosedLoop.initial_state`).
+        (:meth:`~cvtfem.machines.band_cvt.BandCVT.initial_state`).
     on_checkpoint : callable, optional
         ``on_checkpoint(t, seq)`` after each checkpoint is on disk.
     """
@@ -54,7 +54,6 @@ def run_scene(scene, until: float | None = None, results: str | Path | None = No
         raise InputError("--until", t_end, "must be positive (simulated seconds)")
     run = _Run(scene, t_end)
     x0 = run.x_start = run.loop.initial_state(**(start or {}))
-    run.specs = [s for s in run.specs if s.name in sample_outputs(run.loop, 0.0, x0)]
     run.check_events(x0)
     writer = None
     if results is not None:
@@ -103,12 +102,11 @@ class _Run:
     """One run of a scene: loop, output grid, checkpoint payload and the stepping loop."""
 
     def __init__(self, scene, t_end: float) -> None:
-        from cvtfem.machines import layout
         from cvtfem.machines.cvt import closed_loop
 
         self.scene, self.t_end = scene, t_end
         self.loop = closed_loop(scene)
-        self.specs = [o for part in layout(scene) for o in part.outputs]
+        self.specs = list(self.loop.output_specs)
         dt = scene.output.step
         t_out = np.arange(0.0, t_end + 0.5 * dt, dt)
         self.t_out = t_out[t_out <= t_end * (1 + 1e-12)]

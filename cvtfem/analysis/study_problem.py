@@ -59,7 +59,7 @@ def scene_problem(scene, until: float, ref_rtol: float = 1e-9, ref_method: str =
     sc = load_scene(scene) if isinstance(scene, str) else scene
     loop = closed_loop(sc)
     x0 = loop.initial_state()
-    n2 = loop.model.n2
+    n2 = loop.n2
     name = scene if isinstance(scene, str) else getattr(sc, "name", "scene")
     base = SceneProblem(name, loop.rhs, x0, (0.0, float(until)), n2=n2, jac=loop.jac, loop=loop)
     ref = solve(loop.rhs, (0.0, float(until)), x0, method=ref_method, rtol=ref_rtol,

@@ -5,7 +5,7 @@ import argparse
 from importlib import import_module
 
 #: Topic -> module with ``run(repeat=..., large=...)``.
-TOPICS = {"campbell": "cvtfem.modal.bench"}
+TOPICS = {"campbell": "cvtfem.analysis.bench_campbell"}
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:

@@ -44,7 +44,7 @@ def run(args: argparse.Namespace) -> int:
 
     from cvtfem.commands.modes import load_rotor
     from cvtfem.modal import ModalProblem, campbell
-    from cvtfem.modal.speeds import parse_speeds
+    from cvtfem.units import parse_speeds
 
     speeds = parse_speeds(args.speeds)
     scene, model = load_rotor(args.scene)

@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import argparse
 
-#: Demo parts contributed by each area: modules ``cvtfem.post.demo_<area>`` with ``run(outdir) -> list[str]``.
+#: Demo parts: modules ``cvtfem.demo.<part>`` with ``run(outdir) -> list[str]``.
 PARTS = ("foundation", "rotor", "integrators", "lowered", "periodic")
 
 
@@ -22,12 +22,7 @@ def run(args: argparse.Namespace) -> int:
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     for part in args.only or PARTS:
-        try:
-            module = import_module(f"cvtfem.post.demo_{part}")
-        except ModuleNotFoundError as err:
-            if err.name != f"cvtfem.post.demo_{part}":
-                raise
-            continue
+        module = import_module(f"cvtfem.demo.{part}")
         start = time.perf_counter()
         print(f"== {part}")
         for line in module.run(out):

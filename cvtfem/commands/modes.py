@@ -36,7 +36,7 @@ def run(args: argparse.Namespace) -> int:
 
     from cvtfem.errors import InputError
     from cvtfem.modal import ModalProblem
-    from cvtfem.modal.speeds import parse_speed
+    from cvtfem.units import parse_speed
 
     scene, model = load_rotor(args.scene)
     opts = scene.rotor

@@ -31,7 +31,7 @@ def run(args: argparse.Namespace) -> int:
         print(f"wrote {r.render_rotor(model, args.png)}")
         return 0
     from cvtfem.modal import ModalProblem
-    from cvtfem.modal.speeds import parse_speed
+    from cvtfem.units import parse_speed
 
     if args.mode < 0:
         raise InputError("--mode", args.mode, "must be >= 0")

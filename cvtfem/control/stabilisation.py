@@ -3,6 +3,12 @@
 Spec: low-order digest sections 5.2-5.5, eqs. (1.353)-(1.356).  The controller state is
 ``z = [w1s, w2s, F11, b21]`` (smoothed speeds, integral parts); modes (normal/saturation)
 are recomputed at every call, without events (section 5.5).
+
+A control family adds its first-order states (:attr:`blocks`), the clamping forces and the
+driven-shaft torque to a model that exposes its two shaft speeds: :class:`Stabilisation` (both
+loops) or :class:`OpenLoop` (prescribed forces and a fixed resistance, no states).  Both offer
+``blocks``, ``size``, ``output_specs``, ``initial_state(w1, w2)`` and
+``outputs(w, z, i_d, w2d, M1, F_appl) -> (F, M2, dz, diag)``.
 """
 from __future__ import annotations
 
@@ -10,6 +16,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from cvtfem.elements.base import Block
+from cvtfem.outputs import OutputSpec
+
+#: Named outputs of the loops (the open loop reports them too, but records none).
+LOOP_OUTPUTS = (OutputSpec("control.ratio_estimate", "-", "Smoothed ratio estimate."),
+                OutputSpec("control.resistance", "N m s", "Driven-shaft resistance b2."))
 
 def clamp(x, a, b):
     """``max(a, min(b, x))``, eq. (1.354)."""
@@ -64,9 +76,13 @@ class StabilisationParams:
 
 @dataclass(frozen=True)
 class Stabilisation:
-    """Both loops as a pure kernel: ``outputs(t, w, z, target) -> (F, M2, dz, diag)``."""
+    """Both loops as a control family: states ``z = [w1s, w2s, F11, b21]``, forces F1 and M2."""
 
     p: StabilisationParams
+    blocks = (Block("control.speed", 2, "rad/s", order=1), Block("control.F1_integral", 1, "N", order=1),
+              Block("control.b2_integral", 1, "N m s", order=1))
+    size = 4
+    output_specs = LOOP_OUTPUTS
 
     def initial_state(self, w1: float, w2: float) -> np.ndarray:
         """``z(0) = [w1, w2, 0, 0]`` (filters start at the measured speeds, integrals at zero)."""
@@ -113,3 +129,22 @@ class Stabilisation:
         dz = np.array([(w0 - w1s) / p.tau_omega, (w1 - w2s) / p.tau_omega,
                        0.0 if sat1 else f1, 0.0 if sat2 else g1])
         return F, M2, dz, {"ratio_estimate": i_t, "resistance": b2, "sat1": sat1, "sat2": sat2}
+
+
+@dataclass(frozen=True)
+class OpenLoop:
+    """No stabilisation: the prescribed clamping forces and a fixed resistance ``M2 = -b20 w2``,
+    ``b20 = M1 i_d / w2d`` (the resistance of the target operating point); no states."""
+
+    blocks = ()
+    size = 0
+    output_specs = ()
+
+    def initial_state(self, w1: float, w2: float) -> np.ndarray:
+        """No states."""
+        return np.zeros(0)
+
+    def outputs(self, w, z, i_d: float, w2d: float, M1: float, F_appl):
+        """``(F, M2, dz, diag)`` as :meth:`Stabilisation.outputs` (raw ratio estimate, b2 = b20)."""
+        b20 = M1 * i_d / w2d
+        return F_appl, -b20 * w[1], np.zeros(0), {"ratio_estimate": w[0] / w[1], "resistance": b20}

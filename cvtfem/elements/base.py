@@ -3,33 +3,36 @@
 An element family (a whole 84-pin chain, all beam elements of a shaft) is one
 object.  Besides its physics it declares how many generalized coordinates
 (``n2``, each with a velocity) and first-order states (``n1``) it owns, its
-discrete states (switched at events) and its named outputs with units.
+discrete states (switched at events) and its named outputs with units; a model's
+state is a sequence of named :class:`Block` s.
 """
 from __future__ import annotations
 
 from dataclasses import dataclass
 
+from cvtfem.outputs import OutputSpec
+
 
 @dataclass(frozen=True)
-class OutputSpec:
-    """A named output of an element family.
+class Block:
+    """A named block of state coordinates of a model.
 
     Attributes
     ----------
     name : str
-        Output name, unique within the model (``chain.link_tension``).
-    unit : str
-        SI unit.
-    doc : str
-        One-line meaning.
+        Block name (``band.phi``, ``control.speed``).
     size : int
-        Number of values per output sample (e.g. one per link).
+        Number of coordinates.
+    unit : str
+        SI unit of the coordinates (their velocities carry ``unit/s``).
+    order : int
+        2: coordinates ``u`` with velocities ``v`` (second-order part); 1: first-order states ``z``.
     """
 
     name: str
+    size: int
     unit: str
-    doc: str
-    size: int = 1
+    order: int = 2
 
 
 @dataclass(frozen=True)

@@ -40,6 +40,31 @@ def smooth_ramp(u: np.ndarray, w: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return R, dR
 
 
+def ramp_integral(u: np.ndarray, w: np.ndarray) -> np.ndarray:
+    """``P(u) = int_{-inf}^{u} R``, R of :func:`smooth_ramp`: ``0``, ``(u + w)^3 / (12 w)``, ``u^2 / 2 + w^2 / 6``.
+
+    >>> ramp_integral(np.array([-1.0, 0.0, 1.0]), np.array(0.5)).tolist()
+    [0.0, 0.020833333333333332, 0.5416666666666666]
+    """
+    ws = np.where(w > 0, w, 1.0)
+    return np.where(u > w, u ** 2 / 2 + w ** 2 / 6, np.where(np.abs(u) <= w, (u + w) ** 3 / (12 * ws), 0.0))
+
+
+def link_energy(l: np.ndarray, law: np.ndarray, k_in: np.ndarray, k_out: np.ndarray,
+                h: np.ndarray, zone: np.ndarray) -> np.ndarray:
+    """Elastic energy ``V(l)`` (J) of every link, ``V' = f`` of :func:`link_force` (same arguments), ``V(0) = 0``."""
+    shape = (-1,) + (1,) * (np.ndim(l) - 1)
+    law, k_in, k_out = law.reshape(shape), k_in.reshape(shape), k_out.reshape(shape)
+    h, w = h.reshape(shape), (zone * h / 2).reshape(shape)
+    dk = np.where(law == LINEAR, 0.0, k_out - k_in)
+    k0 = np.where(law == LINEAR, k_out, k_in)
+    centre = np.where(law == GAP, h, h / 2)
+    two_sided = law == BACKLASH
+    return k0 * l ** 2 / 2 + dk * (ramp_integral(l - centre, w) - ramp_integral(-centre, w)
+                                   + np.where(two_sided, ramp_integral(-l - centre, w) - ramp_integral(-centre, w),
+                                              0.0))
+
+
 def link_force(l: np.ndarray, law: np.ndarray, k_in: np.ndarray, k_out: np.ndarray,
                h: np.ndarray, zone: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Elastic force ``f(l)`` and stiffness ``f'(l)`` of every link.

@@ -1,39 +1,17 @@
 """Jacobian providers (spec §11.3): analytic, graph-coloured finite differences, dense FD.
 
-Columns ``i, j`` of ``dF/dx`` may share a finite-difference evaluation when no row has
-non-zeros in both (Curtis-Powell-Reid; Ypma 1987): a colouring of the column intersection
-graph ``S^T S``. Cost of one Jacobian = number of colours RHS calls (``F(x)`` is reused).
-For second-order systems the ``u' = v`` rows ``[0 I 0]`` are set analytically.
+The colouring and the coloured difference are assembly's (:mod:`cvtfem.assembly.colouring`);
+this module counts their right-hand-side calls for the stepper. For second-order systems the ``u' = v`` rows ``[0 I 0]`` are set analytically.
 """
 from __future__ import annotations
 
 import numpy as np
 import scipy.sparse as sp
 
+from cvtfem.assembly.colouring import color_columns, coloured_difference
 from cvtfem.integrate.linsolve import DENSE_MAX
 
-__all__ = ["color_columns", "JacobianProvider"]
-
-
-def color_columns(pattern: sp.spmatrix, order: str = "largest_first") -> np.ndarray:
-    """Greedy colouring of the column intersection graph of ``pattern`` (n_rows, n).
-
-    Returns ``colors`` (n,) with ``colors[j]`` the group of column ``j``; columns in one group
-    have disjoint row supports. ``order``: ``"largest_first"`` (by degree) or ``"natural"``.
-    """
-    S = sp.csc_matrix(pattern, dtype=bool).astype(np.int8)
-    G = (S.T @ S).tocsr()
-    n = G.shape[0]
-    degree = np.diff(G.indptr)
-    visit = np.argsort(-degree, kind="stable") if order == "largest_first" else np.arange(n)
-    colors = np.full(n, -1, dtype=np.int64)
-    for j in visit:
-        used = set(colors[G.indices[G.indptr[j]:G.indptr[j + 1]]].tolist())
-        c = 0
-        while c in used:
-            c += 1
-        colors[j] = c
-    return colors
+__all__ = ["JacobianProvider"]
 
 
 class JacobianProvider:
@@ -73,24 +51,16 @@ class JacobianProvider:
 
     def _fd(self, t, x):
         f = self.stepper.f
+        st = self.stepper.stats
         f0 = f(t, x)
         saved = self.stepper._cache
-        eps = np.sqrt(np.finfo(float).eps)
-        delta = eps * np.maximum(np.abs(x), 1.0)
-        delta = (x + delta) - x  # representable increments
-        rows, cols = self.pattern.row, self.pattern.col
-        vals = np.empty(len(rows), dtype=np.result_type(x, f0))
-        st = self.stepper.stats
-        for c in range(self.n_colors):
-            mask = self.colors == c
-            xp = x.copy()
-            xp[mask] += delta[mask]
+
+        def counted(t, xp):
             st.counts["nfev_jac"] += 1
-            df = f(t, xp) - f0
-            sel = mask[cols]
-            vals[sel] = df[rows[sel]] / delta[cols[sel]]
+            return f(t, xp)
+
+        J = coloured_difference(counted, t, x, f0, self.pattern, self.colors)
         self.stepper._cache = saved
-        J = sp.csr_matrix((vals, (rows, cols)), shape=(self.n, self.n))
         if self.n2:
             n2 = self.n2
             J = J + sp.csr_matrix((np.ones(n2), (np.arange(n2), np.arange(n2, 2 * n2))), shape=J.shape)

@@ -42,9 +42,9 @@ import h5py
 import numpy as np
 
 from cvtfem import __version__
-from cvtfem.elements.base import OutputSpec
 from cvtfem.errors import InputError
 from cvtfem.io import checkpoint as ckpt
+from cvtfem.outputs import OutputSpec
 
 CHUNK_ROWS = 256
 

@@ -1,4 +1,4 @@
-"""Layout of a chain-CVT model: which element families a CVT scene calls for.
+"""CVT scenes -> the band CVT model (:func:`closed_loop`) and the layout of any CVT model.
 
 Coordinate counts follow the spec: band models (low-order digest section 4),
 chain models (chain-models-2.md section 0: 2/3/5/10/21 per pin), shafts
@@ -10,16 +10,15 @@ from __future__ import annotations
 import importlib.util
 from typing import Any
 
-from cvtfem.elements.base import Layout, OutputSpec
+from cvtfem.control.stabilisation import LOOP_OUTPUTS, Stabilisation
+from cvtfem.elements.base import Layout
 from cvtfem.errors import InputError
+from cvtfem.outputs import OutputSpec
 from cvtfem.scene.loader import Scene
 
 #: Generalized coordinates per pin of each discrete chain model.
 CHAIN_COORDS_PER_PIN = {"chain-S1": 2, "chain-S2": 3, "chain-S3": 5, "chain-A1": 10, "chain-A2": 10,
                         "chain-A3": 10, "chain-A4": 10, "chain-A5": 21, "chain-A5-point": 21}
-
-#: Controller states z = [smoothed omega1, smoothed omega2, F1 integral, b2 integral] (spec 5.5).
-CONTROLLER_STATES = 4
 
 
 def _band(model: str, ritz_order: int, nodes: int) -> Layout:
@@ -82,17 +81,13 @@ def _chain(scene: Scene) -> Layout:
     return Layout("chain", model, n * per_pin, discrete=discrete, outputs=tuple(outputs), note=note)
 
 
-def layout(scene: Scene) -> tuple[Layout, ...]:
-    """Components of the CVT model the scene calls for, in DOF order."""
+def _components(scene: Scene, body: Layout) -> tuple[Layout, ...]:
+    """``body`` (band or chain), both pulleys, the loops when switched on, and the derived outputs, in DOF order."""
     cvt = scene.cvt
     model = cvt.model
-    band = model.startswith("band")
-    parts = [_band(model, cvt.ritz_order, cvt.quadrature_nodes) if band else _chain(scene),
-             _shaft("driving", scene, model), _shaft("driven", scene, model)]
+    parts = [body, _shaft("driving", scene, model), _shaft("driven", scene, model)]
     if cvt.effects.stabilisation and model != "band-1dof":
-        parts.append(Layout("stabilisation", "speed-ratio-control", 0, n1=CONTROLLER_STATES,
-                            outputs=(OutputSpec("control.ratio_estimate", "-", "Smoothed ratio estimate."),
-                                     OutputSpec("control.resistance", "N m s", "Driven-shaft resistance b2.")),
+        parts.append(Layout("stabilisation", "speed-ratio-control", 0, n1=Stabilisation.size, outputs=LOOP_OUTPUTS,
                             note="smoothed speeds, F1 integral, b2 integral"))
     parts.append(Layout("transmission", "derived", 0,
                         outputs=(OutputSpec("efficiency", "-", "Output over input power (instantaneous)."),
@@ -102,6 +97,13 @@ def layout(scene: Scene) -> tuple[Layout, ...]:
                                  OutputSpec("energy", "J", "Kinetic plus elastic energy of the model.")),
                         note="derived outputs"))
     return tuple(parts)
+
+
+def layout(scene: Scene) -> tuple[Layout, ...]:
+    """Components of the CVT model the scene calls for, in DOF order (without building its physics)."""
+    cvt = scene.cvt
+    body = _band(cvt.model, cvt.ritz_order, cvt.quadrature_nodes) if cvt.model.startswith("band") else _chain(scene)
+    return _components(scene, body)
 
 
 def band_params(scene: Scene, **overrides: Any):
@@ -166,11 +168,13 @@ def check_ratio_range(scene: Scene, p=None) -> tuple[float, float]:
 
 
 def closed_loop(scene: Scene, **overrides: Any):
-    """Scene -> :class:`~cvtfem.control.closed_loop.ClosedLoop` (model, clamping schedule, regime, loops)."""
-    from cvtfem.control.closed_loop import Clamping, ClosedLoop
+    """Scene -> :class:`~cvtfem.machines.band_cvt.BandCVT` (band family, clamping schedule, regime, control
+    family and the components with their outputs), in one pass; ``overrides`` replace band parameters."""
+    from cvtfem.control.clamping import Clamping
     from cvtfem.control.regimes import Regime
-    from cvtfem.control.stabilisation import Stabilisation, StabilisationParams
+    from cvtfem.control.stabilisation import OpenLoop, StabilisationParams
     from cvtfem.elements.band.geometry import phi_for_ratio, radii
+    from cvtfem.machines.band_cvt import BandCVT
 
     cvt = scene.cvt
     model = band_model(scene, **overrides)
@@ -179,11 +183,12 @@ def closed_loop(scene: Scene, **overrides: Any):
     check_ratio_range(scene, p)
     regime = Regime(rg.kind, rg.input_speed, rg.torque, rg.ratio, rg.end_value, rg.ramp_time)
     clamping = Clamping(p, rg.clamping_safety, rg.clamping_split, rg.min_clamping_force)
-    control = None
+    control = OpenLoop()
     if cvt.effects.stabilisation:
         c = cvt.control
         r2 = radii(phi_for_ratio(rg.ratio, p.length, p.L), p.length, p.L)[0][1]
         J_sigma = p.J[0] * rg.ratio ** 2 + p.J[1] + p.mass * r2 ** 2
         control = Stabilisation(StabilisationParams(c.tau_omega, c.eps, c.i_min, c.i_max, c.k_sat, c.c_f0, c.c_f1,
                                                     c.c_sat, c.tau, c.nu, J_sigma))
-    return ClosedLoop(model, clamping, regime, control)
+    parts = _components(scene, _band(cvt.model, p.n_ritz, p.n_gauss))
+    return BandCVT(model, clamping, regime, control, parts)

@@ -1,30 +1,41 @@
-"""Rotor scenes -> layout and linear model (sparse M, K, C, G).
+"""Rotor scenes -> layout and linear model (sparse M, K, C, G), a :class:`~cvtfem.assembly.model.Model`.
 
 Nodes are numbered from 0 at the left end of the first shaft element; each
 node has the 6 DOF ``(u1, u2, u3, theta1, theta2, phi)``.  Disks with an
 elastic connection get their own node after the shaft nodes.  Equation of
-motion (spec §12.6): ``M q'' + (C + Omega G) q' + K q = 0``.
+motion (spec §12.6): ``M q'' + (C + Omega G) q' + K q = 0``; the time-domain
+model runs at the spin speed ``Omega = speed`` (rad/s).
 """
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 import scipy.sparse as sp
+import scipy.sparse.linalg as spla
 
 from cvtfem.assembly import assemble
-from cvtfem.elements.base import Layout, OutputSpec
+from cvtfem.assembly.model import Linearization, ModelBase, StateLayout
+from cvtfem.elements.base import Block, Layout
 from cvtfem.elements.beam import BeamFamily, BeamOptions
 from cvtfem.elements.bearing import BearingFamily, RadialLaw
 from cvtfem.elements.disk import DiskFamily, connection_stiffness, disc_profile, sheave_profile
+from cvtfem.outputs import OutputSpec
 from cvtfem.scene.loader import Scene
 
 #: Names of the 6 DOF of a node, in order.
 DOF_NAMES = ("u1", "u2", "u3", "theta1", "theta2", "phi")
 
 
+def _output_specs(nodes: int, n_bearings: int) -> tuple[tuple[OutputSpec, ...], tuple[OutputSpec, ...]]:
+    """Outputs of the shaft (``nodes`` beam nodes) and of the bearings."""
+    return ((OutputSpec("shaft.displacement", "m", "Nodal displacements and rotations.", 6 * nodes),),
+            (OutputSpec("bearing.force", "N", "Bearing forces x, y.", 2 * n_bearings),) if n_bearings else ())
+
+
 @dataclass(frozen=True)
-class RotorModel:
+class RotorModel(ModelBase):
     """Linear rotor model.
 
     Attributes
@@ -37,6 +48,8 @@ class RotorModel:
         For rendering and outputs.
     profiles : tuple
         Per disk its (r, z) section polygon relative to the centre of mass (m), or None.
+    speed : float, rad/s
+        Spin speed of the time-domain model (:meth:`rhs`); modal analyses take theirs from the caller.
     """
 
     M: sp.csr_matrix
@@ -48,10 +61,71 @@ class RotorModel:
     disks: DiskFamily
     bearings: BearingFamily
     profiles: tuple = ()
+    speed: float = 0.0
 
     @property
     def n_dof(self) -> int:
         return self.M.shape[0]
+
+    @property
+    def layout(self) -> StateLayout:
+        return StateLayout((Block("nodes", self.n_dof, "m (u1, u2, u3), rad (theta1, theta2, phi) per node"),))
+
+    @property
+    def output_specs(self) -> tuple[OutputSpec, ...]:
+        shaft, bearings = _output_specs(int(self.beam.nodes.max()) + 1, len(self.bearings.nodes))
+        return shaft + bearings
+
+    @cached_property
+    def _lu(self):  # noqa: ANN202 - scipy SuperLU of M
+        return spla.splu(sp.csc_matrix(self.M))
+
+    def initial_state(self) -> np.ndarray:
+        """At rest in the undeformed position."""
+        return np.zeros(self.size)
+
+    def rhs(self, t: float, x: np.ndarray) -> np.ndarray:
+        """``[v, M^-1 (-(C + speed G) v - K u)]``."""
+        n = self.n_dof
+        u, v = x[:n], x[n:]
+        return np.concatenate([v, self._lu.solve(-(self.C @ v + self.speed * (self.G @ v)) - self.K @ u)])
+
+    def jac(self, t: float, x: np.ndarray) -> sp.csr_matrix:
+        """Constant ``[[0, I], [-M^-1 K, -M^-1 (C + speed G)]]`` (CSR; ``M^-1`` fills the lower blocks)."""
+        n = self.n_dof
+        lower = -self._lu.solve(sp.hstack([self.K, self.C + self.speed * self.G]).toarray())
+        return sp.vstack([sp.hstack([sp.csr_matrix((n, n)), sp.eye(n)]), sp.csr_matrix(lower)], format="csr")
+
+    @property
+    def jac_sparsity(self) -> sp.csr_matrix:
+        return self.jac(0.0, self.initial_state()) != 0
+
+    def linearize(self, x0: np.ndarray) -> Linearization:
+        """The model's own M, C, G, K (linear: the same at every state)."""
+        return Linearization(M=self.M, C=self.C, G=self.G, K=self.K)
+
+    def energy(self, x: np.ndarray) -> float:
+        """``v M v / 2 + u K_s u / 2`` with the symmetric part ``K_s`` of K, J."""
+        n = self.n_dof
+        u, v = x[:n], x[n:]
+        return float(v @ (self.M @ v) / 2 + u @ (self.K @ u) / 2)
+
+    def power(self, t: float, x: np.ndarray) -> dict[str, float]:
+        """Dissipated ``v C v`` and circulatory ``v K_a u`` power (K_a: skew part of K), W:
+        ``dE/dt = -dissipated - circulatory`` (G is skew: no gyroscopic power)."""
+        n = self.n_dof
+        u, v = x[:n], x[n:]
+        return {"dissipated": float(v @ (self.C @ v)), "circulatory": float(v @ ((self.K - self.K.T) @ u)) / 2}
+
+    def outputs(self, t: float, x: np.ndarray) -> dict[str, np.ndarray]:
+        """Shaft-node displacements and the x, y forces the bearings carry, ``K_b u + C_b v`` (N)."""
+        n, b = self.n_dof, self.bearings
+        u, v = x[:n], x[n:]
+        out = {"shaft.displacement": u[:6 * (int(self.beam.nodes.max()) + 1)].copy()}
+        if len(b.nodes):
+            f = np.einsum("eij,ej->ei", b.stiffness(), u[b.dofs]) + np.einsum("eij,ej->ei", b.damping(), v[b.dofs])
+            out["bearing.force"] = f[:, :2].ravel()
+        return out
 
     @property
     def dof_kind(self) -> np.ndarray:
@@ -156,7 +230,7 @@ def build_model(scene: Scene) -> RotorModel:
                      (bearings.gyroscopic(), bearings.dofs)])
     z = np.concatenate([[0.0], np.cumsum(arrays["L"]), np.zeros(len(elastic))])
     z[n_shaft:] = z[[scene.disk[i].node for i in elastic]]
-    return RotorModel(M, K, C, G, z, beam, disks, bearings, profiles)
+    return RotorModel(M, K, C, G, z, beam, disks, bearings, profiles, opts.speed if opts else 0.0)
 
 
 def layout(scene: Scene) -> tuple[Layout, ...]:
@@ -164,15 +238,13 @@ def layout(scene: Scene) -> tuple[Layout, ...]:
     n_elements = sum(s.repeat for s in scene.shaft)
     nodes = n_elements + 1
     theory = scene.rotor.theory if scene.rotor else "timoshenko"
-    parts = [Layout("shaft", f"{theory}-beam", 6 * nodes,
-                    outputs=(OutputSpec("shaft.displacement", "m", "Nodal displacements and rotations.", 6 * nodes),),
-                    note=f"{nodes} nodes x 6")]
+    shaft, bearings = _output_specs(nodes, len(scene.bearing))
+    parts = [Layout("shaft", f"{theory}-beam", 6 * nodes, outputs=shaft, note=f"{nodes} nodes x 6")]
     if scene.disk:
         extra = sum(d.connection == "elastic" for d in scene.disk)
         parts.append(Layout("disks", "rigid-disk", 6 * extra,
                             note=f"{len(scene.disk)} disks on shaft nodes, {extra} elastically connected"))
     if scene.bearing:
-        parts.append(Layout("bearings", "bearing", 0,
-                            outputs=(OutputSpec("bearing.force", "N", "Bearing forces x, y.", 2 * len(scene.bearing)),),
+        parts.append(Layout("bearings", "bearing", 0, outputs=bearings,
                             note=f"{len(scene.bearing)} bearings on shaft nodes"))
     return tuple(parts)

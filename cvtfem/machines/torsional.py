@@ -1,4 +1,5 @@
-"""Torsional network scenes -> :class:`TorsionalNetwork` and layout (spec section 8.1).
+"""Torsional network scenes -> :class:`TorsionalNetwork`, its time-domain :class:`TorsionalModel` and
+layout (spec section 8.1).
 
 Converts to circumferential coordinates at each shaft's gear radius ``r``:
 ``m = I / r^2``, ``b = b_phi / r^2``, shaft ``c = k_phi / r^2``, forces
@@ -6,12 +7,19 @@ Converts to circumferential coordinates at each shaft's gear radius ``r``:
 """
 from __future__ import annotations
 
+from dataclasses import dataclass
+from functools import cached_property
 from typing import Any
 
 import numpy as np
+import scipy.sparse as sp
 
-from cvtfem.elements.base import Layout, OutputSpec
-from cvtfem.elements.torsional import BACKLASH, GAP, LINEAR, TorsionalNetwork
+from cvtfem.assembly.model import Linearization, ModelBase, StateLayout
+from cvtfem.assembly.numbering import through_numbering
+from cvtfem.elements.base import Block, Layout
+from cvtfem.elements.torsional import BACKLASH, GAP, LINEAR, TorsionalNetwork, link_energy, link_force
+from cvtfem.errors import InputError
+from cvtfem.outputs import OutputSpec
 from cvtfem.scene.loader import Scene
 from cvtfem.scene.schema.base import validate
 from cvtfem.scene.schema.torsional import PERIODIC, link_names
@@ -71,22 +79,117 @@ def build(scene: Scene) -> TorsionalNetwork:
 
 def layout(scene: Scene) -> tuple[Layout, ...]:
     """Components of a torsional network: one coordinate per disk, one link family."""
-    from cvtfem.periodic.sweep import through_numbering
-
     net = build(scene)
     topo = through_numbering(net.n_nodes, net.i, net.j)
     n_nl = int((net.law != LINEAR).sum())
     shape = ("loop (sparse LU)" if topo is None else
              f"tree, through-numbered with {len(topo.fictitious)} fictitious nodes")
+    disks, links = _output_specs(net)
     return (
-        Layout("disks", "torsional-disk", net.n_nodes,
-               outputs=(OutputSpec("disk.displacement", "m", "Circumferential displacement x = r phi.",
-                                   net.n_nodes),),
-               note=f"{net.n_nodes} disks; {shape}"),
-        Layout("links", "torsional-link", 0, discrete=0,
-               outputs=(OutputSpec("link.force", "N", "Link force along the pitch line (shaft: torque / r).",
-                                   net.n_links),
-                        OutputSpec("link.moment", "N m", "Link moment at its first disk.", net.n_links)),
+        Layout("disks", "torsional-disk", net.n_nodes, outputs=disks, note=f"{net.n_nodes} disks; {shape}"),
+        Layout("links", "torsional-link", 0, discrete=0, outputs=links,
                note=f"{net.n_links} links ({n_nl} backlash/gap, {int((net.j < 0).sum())} "
                     f"to ground)"),
     )
+
+
+def _output_specs(net: TorsionalNetwork) -> tuple[tuple[OutputSpec, ...], tuple[OutputSpec, ...]]:
+    """Outputs of the disks and of the links."""
+    return ((OutputSpec("disk.displacement", "m", "Circumferential displacement x = r phi.", net.n_nodes),),
+            (OutputSpec("link.force", "N", "Link force along the pitch line (shaft: torque / r).", net.n_links),
+             OutputSpec("link.moment", "N m", "Link moment at its first disk.", net.n_links)))
+
+
+@dataclass(frozen=True)
+class TorsionalModel(ModelBase):
+    """Time-domain model of a torsional network: ``m x'' = q(t) - b x' - D^T (f(D x) + d D x')``.
+
+    State ``[x (S), v (S)]`` in circumferential coordinates (m, m/s); ``omega`` (rad/s) is the base
+    frequency of the loads; the backlash/gap links act through their smooth contact law.
+    """
+
+    net: TorsionalNetwork
+    omega: float
+
+    @property
+    def layout(self) -> StateLayout:
+        return StateLayout((Block("disk", self.net.n_nodes, "m"),))
+
+    @property
+    def output_specs(self) -> tuple[OutputSpec, ...]:
+        disks, links = _output_specs(self.net)
+        return disks + links
+
+    @cached_property
+    def _D(self) -> tuple[sp.csr_matrix, sp.csr_matrix]:
+        D = self.net.incidence()
+        return D, D.T.tocsr()
+
+    def initial_state(self) -> np.ndarray:
+        """At rest, undeflected."""
+        return np.zeros(self.size)
+
+    def rhs(self, t: float, x: np.ndarray) -> np.ndarray:
+        """``[v, a]``."""
+        net, (D, DT), S = self.net, self._D, self.net.n_nodes
+        u, v = x[:S], x[S:]
+        a = (net.load(t, self.omega)[:, 0] - net.b * v - DT @ net.forces(D @ u, D @ v)) / net.m
+        return np.concatenate([v, a])
+
+    def _tangent(self, u: np.ndarray) -> tuple[sp.csr_matrix, sp.csr_matrix]:
+        """Tangent stiffness ``D^T f'(D u) D`` and damping ``diag(b) + D^T diag(d) D`` (N/m, N s/m)."""
+        net, (D, DT) = self.net, self._D
+        _, df = link_force(D @ u, net.law, net.k_in, net.k_out, net.h, net.zone)
+        return (DT @ sp.diags(df) @ D).tocsr(), (sp.diags(net.b) + DT @ sp.diags(net.d) @ D).tocsr()
+
+    def jac(self, t: float, x: np.ndarray) -> sp.csr_matrix:
+        """Analytic ``[[0, I], [-M^-1 K_t, -M^-1 C]]`` (sparse)."""
+        S = self.net.n_nodes
+        K, C = self._tangent(x[:S])
+        Minv = sp.diags(1 / self.net.m)
+        return sp.bmat([[None, sp.eye(S)], [-Minv @ K, -Minv @ C]], format="csr")
+
+    @property
+    def jac_sparsity(self) -> sp.csr_matrix:
+        """Links couple their two disks: ``|D|^T |D| + I`` in both lower blocks, identity in ``u' = v``."""
+        D, DT = self._D
+        S = self.net.n_nodes
+        P = (abs(DT) @ abs(D) + sp.eye(S)).astype(bool)
+        return sp.bmat([[None, sp.eye(S, dtype=bool)], [P, P]], format="csr")
+
+    def linearize(self, x0: np.ndarray) -> Linearization:
+        """``M = diag(m)``, ``C``, ``G = 0`` and the contact stiffness ``K = D^T f'(D u0) D`` at ``x0``."""
+        S = self.net.n_nodes
+        K, C = self._tangent(x0[:S])
+        return Linearization(M=sp.diags(self.net.m).tocsr(), C=C, G=sp.csr_matrix((S, S)), K=K)
+
+    def energy(self, x: np.ndarray) -> float:
+        """Kinetic plus elastic energy, J."""
+        net, (D, _), S = self.net, self._D, self.net.n_nodes
+        u, v = x[:S], x[S:]
+        V = link_energy(D @ u, net.law, net.k_in, net.k_out, net.h, net.zone)
+        return float(net.m @ v ** 2 / 2 + V.sum())
+
+    def power(self, t: float, x: np.ndarray) -> dict[str, float]:
+        """Input power of the loads and dissipated power of dampers and links, W (``dE/dt = input - dissipated``)."""
+        net, (D, _), S = self.net, self._D, self.net.n_nodes
+        v = x[S:]
+        return {"input": float(net.load(t, self.omega)[:, 0] @ v),
+                "dissipated": float(net.b @ v ** 2 + net.d @ (D @ v) ** 2)}
+
+    def outputs(self, t: float, x: np.ndarray) -> dict[str, np.ndarray]:
+        """Displacements, link forces and moments (see :attr:`output_specs`)."""
+        net, (D, _), S = self.net, self._D, self.net.n_nodes
+        f = net.forces(D @ x[:S], D @ x[S:])
+        return {"disk.displacement": x[:S].copy(), "link.force": f, "link.moment": f * net.radius[net.i]}
+
+
+def build_model(scene: Scene, omega: float | None = None) -> TorsionalModel:
+    """The time-domain model of a torsional scene: loads at base frequency ``omega`` (rad/s; default
+    ``2 pi periodic.frequency``), the backlash and gap laws unless ``periodic.backlash`` is false."""
+    cfg = periodic_settings(scene)
+    omega = 2 * np.pi * cfg.frequency if omega is None else omega
+    if not (np.isfinite(omega) and omega > 0):
+        raise InputError("omega", omega, "must be a positive base frequency of the loads in rad/s")
+    net = build(scene)
+    return TorsionalModel(net if cfg.backlash else net.linearized("contact"), float(omega))

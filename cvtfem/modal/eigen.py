@@ -257,18 +257,21 @@ class ModalProblem:
     def _stiffness_definite(self, b: int) -> bool:
         """Whether block ``b``'s stiffness is symmetric positive definite to working precision, cached.
 
-        Definite means every eigenvalue of K exceeds ``n eps max|eig K|`` (the numerical-rank tolerance of
-        ``numpy.linalg.matrix_rank``).  A free rigid-body mode of a stiff model (elastic connections of
-        1e12 N m/rad) leaves an eigenvalue of round-off size, ~1e-16 max|eig K|, whose sign depends on the
-        BLAS kernel; a Cholesky test accepts it as positive and the rigid mode becomes a spurious
-        'oscillatory' mode at ~sqrt(eps) |lambda|_max (issue 11).
+        The test is on the Jacobi-equilibrated ``D^-1/2 K D^-1/2`` (``D = diag K``), so that penalty-like
+        terms (supports of 1e18 N/m, elastic connections of 1e12 N m/rad) do not set the scale: definite
+        means every eigenvalue of the scaled matrix exceeds ``n eps`` times its largest (the numerical-rank
+        tolerance of ``numpy.linalg.matrix_rank``).  A free rigid-body mode leaves an eigenvalue of
+        round-off size whose sign depends on the BLAS kernel; a Cholesky test of K accepted it as positive,
+        and the rigid mode became a spurious 'oscillatory' mode at ~sqrt(eps) |lambda|_max (issue 11).
         """
         if b not in self._definite:
             K = self._sub(b)[1].toarray()
-            ok = np.allclose(K, K.T, rtol=0.0, atol=1e-12 * np.abs(K).max(initial=0.0))
+            d = np.diag(K)
+            ok = bool(np.all(d > 0)) and np.allclose(K, K.T, rtol=0.0, atol=1e-12 * np.abs(K).max(initial=0.0))
             if ok:
-                w = sla.eigvalsh(K, check_finite=False)
-                ok = bool(w[0] > len(w) * np.finfo(float).eps * np.abs(w).max(initial=0.0))
+                s = 1.0 / np.sqrt(d)
+                w = sla.eigvalsh(s[:, None] * K * s[None, :], check_finite=False)
+                ok = bool(w[0] > len(w) * np.finfo(float).eps * w[-1])
             self._definite[b] = ok
         return self._definite[b]
 

@@ -16,7 +16,7 @@ from cvtfem.elements.torsional import TorsionalNetwork
 from cvtfem.errors import InputError, NumericalError
 from cvtfem.periodic.hb import (PeriodicSolution, _symmetrize, default_samples, linearize, load_harmonics,
                                 prepare, single_thread_blas, solve_periodic)
-from cvtfem.periodic.sweep import solve_blocks
+from cvtfem.periodic.blocktri import solve_blocks
 
 
 @dataclass(frozen=True)

@@ -18,9 +18,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from cvtfem.assembly.numbering import Topology, through_numbering
 from cvtfem.elements.torsional import TorsionalNetwork, link_force
 from cvtfem.errors import InputError, NumericalError
-from cvtfem.periodic.sweep import Topology, check_grounded, solve_blocks, solve_mixed, through_numbering
+from cvtfem.periodic.blocktri import check_grounded, solve_blocks, solve_mixed
 
 log = logging.getLogger(__name__)
 
@@ -183,7 +184,7 @@ def solve_linear(net: TorsionalNetwork, omega: float, N: int, stiffness: str = "
     stiffness : str
         Nonlinear links taken with their "contact" or "gap" stiffness.
     method : str
-        "auto", "sweep" or "sparse" (see :func:`cvtfem.periodic.sweep.solve_blocks`).
+        "auto", "sweep" or "sparse" (see :func:`cvtfem.periodic.blocktri.solve_blocks`).
     """
     _check(omega, N)
     lin = net.linearized(stiffness)

@@ -21,9 +21,10 @@ from pathlib import Path
 
 import numpy as np
 
+from cvtfem.assembly.numbering import through_numbering
 from cvtfem.elements.torsional import build_network
 from cvtfem.machines.torsional import build
-from cvtfem.periodic import hb, sweep, transient
+from cvtfem.periodic import blocktri, hb, transient
 from cvtfem.scene.loader import load_scene
 
 OUT = Path("out/studies/periodic")
@@ -130,10 +131,10 @@ def scaling(quick: bool) -> dict:
             L = rng.normal(size=(S, 1, K, K)) * 1e2 + np.eye(K) * 1e5
             L = (L + L.conj().transpose(0, 1, 3, 2)) / 2
             g = rng.normal(size=(S, 1, K)) + 0j
-            topo = sweep.through_numbering(S, i, j)
+            topo = through_numbering(S, i, j)
             with hb.single_thread_blas():
-                t, a = median_time(lambda: sweep.block_sweep(topo, Nb, L, i, j, g), 1 if quick and S > 1000 else 3)
-            res = np.linalg.norm(sweep.apply(Nb, L, i, j, a) - g) / np.linalg.norm(g)
+                t, a = median_time(lambda: blocktri.block_sweep(topo, Nb, L, i, j, g), 1 if quick and S > 1000 else 3)
+            res = np.linalg.norm(blocktri.apply(Nb, L, i, j, a) - g) / np.linalg.norm(g)
             print(f"block sweep {shape:5s} S={S:6d}, blocks {K}x{K}: {t:8.4f} s median, "
                   f"{t / S * 1e6:7.1f} us per mass, residual {res:.1e}")
             rows[f"{shape}_{S}"] = {"time": t, "per_mass_us": t / S * 1e6, "residual": res}

@@ -4,7 +4,7 @@
 """
 from pathlib import Path
 
-from cvtfem.modal.bench import run
+from cvtfem.analysis.bench_campbell import run
 
 OUT = Path("out/studies/rotor")
 

@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from cvtfem.control.closed_loop import Clamping
+from cvtfem.control.clamping import Clamping
 from cvtfem.elements.band.geometry import radii
 from cvtfem.machines.cvt import band_model, closed_loop
 from cvtfem.scene.loader import load_scene

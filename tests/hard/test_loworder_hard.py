@@ -169,7 +169,7 @@ def test_torque_ramp_towards_zero_finishes_or_fails_clearly(base):
     (1.13) vanish with the torque (0.37 / 0.18 N), gross slip, the step collapsed to ~1e-13 s and
     stepped in place.  With the minimum clamping force (preload) MIN_CLAMPING_FORCE = 1 kN it
     finishes with the targets held and the floor on the pulleys (equilibrium split: F1 = f_min)."""
-    from cvtfem.control.closed_loop import MIN_CLAMPING_FORCE
+    from cvtfem.control.clamping import MIN_CLAMPING_FORCE
 
     scene = _regime(base, kind="torque-ramp", torque=200.0, end_value=1e-3, ramp_time=0.05)
     s = run_scene(scene, until=0.1, show_progress=False)

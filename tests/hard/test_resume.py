@@ -18,9 +18,9 @@ import numpy as np
 import pytest
 
 from cvtfem.analysis.run import resume_run, run_scene
-from cvtfem.elements.base import OutputSpec
 from cvtfem.errors import InputError
 from cvtfem.io.results import ResultsWriter, read_results
+from cvtfem.outputs import OutputSpec
 from cvtfem.scene.loader import load_scene
 
 UNTIL = 0.05          # s simulated: 5000 rk4 steps, ~1.8 s wall per run (compiled right-hand side)

@@ -198,29 +198,38 @@ def test_heat_benchmark_row():
 
 
 
+#: Tolerances of the cap tests: one tolerance alone is a single adaptive trajectory whose rejections flip
+#: with the last bits of the spectral-radius estimate (BLAS norms): at rtol 3e-3 the cap saves 23 % of the
+#: RHS calls under the Haswell/Sandybridge/SkylakeX OpenBLAS kernels and 10 % under Prescott (issue 11).
+CAP_RTOLS = (1e-2, 5e-3, 3e-3, 2e-3, 1e-3)
+
+
 def test_adaptive_steps_capped_at_longest_polynomial(monkeypatch):
     """Adaptive steps are capped at P13's length over the spectral-radius estimate. On the heat benchmark
-    (N = 1000, rtol 3e-3, rho ~4e6 1/s) longer proposals leave every region and are rejected by the error
-    estimate: measured 7 077 RHS calls / 5 rejections without the cap, 5 432 / 3 with it, both within
-    the benchmark's 1e-4."""
+    (N = 1000, rho ~4e6 1/s) longer proposals leave every region and are rejected by the error estimate:
+    over rtol 1e-2..1e-3 (atol = 1e-3 rtol) measured 34 015 RHS calls / 24 rejections without the cap,
+    27 061 / 12 with it (Prescott kernel: 28 166 / 14), every run within the benchmark's 1e-4."""
     p = heat1d(1000, 0.1)
 
     def run():
-        res = solve(**p.solve_kwargs(), method="dumka3", rtol=3e-3, atol=3e-6)
-        err = np.max(np.abs(res.y[:, -1] - p.exact(0.1))) / np.max(np.abs(p.exact(0.1)))
-        assert res.success and err < 1e-4, err
-        return res.stats
+        total = {"nfev": 0, "nreject": 0}
+        for rtol in CAP_RTOLS:
+            res = solve(**p.solve_kwargs(), method="dumka3", rtol=rtol, atol=1e-3 * rtol)
+            err = np.max(np.abs(res.y[:, -1] - p.exact(0.1))) / np.max(np.abs(p.exact(0.1)))
+            assert res.success and err < 1e-4, (rtol, err)
+            for key in total:
+                total[key] += res.stats[key]
+        return total
 
     capped = run()
     monkeypatch.setattr(DUMKA3, "max_step", lambda self: np.inf)
     free = run()
-    assert capped["nreject"] < free["nreject"] and capped["nfev"] < 0.85 * free["nfev"], (capped, free)
-
+    assert capped["nreject"] <= 0.6 * free["nreject"] and capped["nfev"] < 0.85 * free["nfev"], (capped, free)
 
 
 def test_cvtfem_solver_applies_the_same_cap(monkeypatch):
     """`cvtfem run` steps through CvtfemSolver: its adaptive DUMKA3 steps obey the same cap as `solve`
-    (heat N = 1000, rtol 3e-3: fewer RHS calls than without the cap, as in `solve`)."""
+    (heat N = 1000, rtol 1e-2..1e-3: fewer RHS calls than without the cap, as in `solve`)."""
     from scipy.integrate import solve_ivp
 
     from cvtfem.integrate import CvtfemSolver
@@ -228,10 +237,13 @@ def test_cvtfem_solver_applies_the_same_cap(monkeypatch):
     p = heat1d(1000, 0.1)
 
     def nfev():
-        res = solve_ivp(p.fun, p.t_span, p.y0, method=CvtfemSolver, cvtfem_method="dumka3", rtol=3e-3,
-                        atol=3e-6)
-        assert res.success
-        return res.nfev
+        total = 0
+        for rtol in CAP_RTOLS:
+            res = solve_ivp(p.fun, p.t_span, p.y0, method=CvtfemSolver, cvtfem_method="dumka3", rtol=rtol,
+                            atol=1e-3 * rtol)
+            assert res.success
+            total += res.nfev
+        return total
 
     capped = nfev()
     monkeypatch.setattr(DUMKA3, "max_step", lambda self: np.inf)

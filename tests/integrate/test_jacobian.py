@@ -4,7 +4,8 @@ import pytest
 import scipy.sparse as sp
 
 from cvtfem.integrate.base import Stepper
-from cvtfem.integrate.jacobian import JacobianProvider, color_columns
+from cvtfem.assembly.colouring import color_columns
+from cvtfem.integrate.jacobian import JacobianProvider
 from cvtfem.integrate.linsolve import DENSE_MAX
 from cvtfem.integrate.system import as_system
 from cvtfem.problems import coupled_oscillators

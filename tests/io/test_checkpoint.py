@@ -5,10 +5,10 @@ import h5py
 import numpy as np
 import pytest
 
-from cvtfem.elements.base import OutputSpec
 from cvtfem.errors import InputError
 from cvtfem.io import checkpoint as ckpt
 from cvtfem.io.results import ResultsWriter, read_results
+from cvtfem.outputs import OutputSpec
 
 LAYOUT = ckpt.Layout((("t", 1), ("x", 3)))
 SPECS = (OutputSpec("x", "m", "position"),)

@@ -8,16 +8,16 @@ import time
 import numpy as np
 import pytest
 
-from cvtfem.elements.base import OutputSpec
 from cvtfem.errors import InputError
 from cvtfem.io.results import ResultsWriter, read_results
+from cvtfem.outputs import OutputSpec
 
 SPECS = (OutputSpec("x", "m", "position"), OutputSpec("f", "N", "three forces", 3))
 
 WRITER_SCRIPT = """
 import sys, time
-from cvtfem.elements.base import OutputSpec
 from cvtfem.io.results import ResultsWriter
+from cvtfem.outputs import OutputSpec
 w = ResultsWriter(sys.argv[1], "title = 'killed'\\n", "run",
                   [OutputSpec("x", "m", "position"), OutputSpec("f", "N", "forces", 3)], flush_interval=0.02)
 i = 0

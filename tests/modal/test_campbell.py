@@ -1,4 +1,4 @@
-"""Campbell: MAC tracking, excitation lines, critical speeds, speed parsing, CLI."""
+"""Campbell: MAC tracking, excitation lines, critical speeds, CLI."""
 import json
 
 import numpy as np
@@ -7,7 +7,6 @@ import pytest
 from cvtfem.errors import InputError
 from cvtfem.machines.rotor import build_model
 from cvtfem.modal import ModalProblem, campbell, chain_orders, shaft_orders
-from cvtfem.modal.speeds import parse_speed, parse_speeds
 from cvtfem.scene.loader import load_scene
 
 
@@ -44,17 +43,6 @@ def test_chain_orders():
     assert lines["3/3 f_link"] == pytest.approx(2 * np.pi * 0.05 / 0.009)
     with pytest.raises(InputError, match="link_length"):
         chain_orders(0.05, 0.8, 0.0)
-
-
-def test_speed_parsing():
-    assert parse_speed("4000rpm") == pytest.approx(4000 * np.pi / 30)
-    assert parse_speed("10 rad/s") == 10.0
-    assert parse_speeds("0:4000rpm:51")[-1] == pytest.approx(4000 * np.pi / 30)
-    for bad in ("4000", "fast", "12furlongs"):
-        with pytest.raises(InputError, match="--speed"):
-            parse_speed(bad)
-    with pytest.raises(InputError, match="--speeds"):
-        parse_speeds("100:0rpm:5")
 
 
 def test_cli_modes_and_campbell(cli, tmp_path):

@@ -7,7 +7,7 @@ from cvtfem.elements.torsional import BACKLASH
 from cvtfem.machines.torsional import build
 from cvtfem.periodic import hb
 from cvtfem.scene.loader import load_scene
-from tests.periodic.test_sweep import dense_response
+from tests.periodic.test_blocktri import dense_response
 
 
 def engine():

@@ -6,7 +6,8 @@ import pytest
 
 from cvtfem.elements.torsional import build_network
 from cvtfem.errors import InputError
-from cvtfem.periodic import hb, sweep
+from cvtfem.assembly.numbering import through_numbering
+from cvtfem.periodic import blocktri, hb
 
 
 def dense_response(net, omega, N):
@@ -76,30 +77,13 @@ def test_nonlinear_blocks_sweep_equals_sparse_lu():
     assert np.abs(d_sweep - d_lu).max() <= 1e-10 * np.abs(d_lu).max()
 
 
-def test_through_numbering_and_fictitious_nodes():
-    parents = branched_parents()
-    i = np.array([s for s in range(len(parents)) if parents[s] >= 0])
-    j = np.array([parents[s] for s in i])
-    topo = sweep.through_numbering(len(parents), i, j)
-    order = topo.order.tolist()
-    # pre-order: every parent is numbered before its children
-    pos = {s: k for k, s in enumerate(order)}
-    assert all(pos[topo.parent[s]] < pos[s] for s in order if topo.parent[s] >= 0)
-    # one fictitious node per return from the end of a side branch (3 leaves besides the chain end)
-    assert len(topo.fictitious) == 3
-    for p in topo.fictitious:
-        assert topo.parent[order[p + 1]] != order[p]
-    # the root is an end of the longest path (main chain numbered without fictitious jumps)
-    assert topo.parent[order[0]] == -1
-
-
 def test_loop_goes_to_sparse_lu():
     rng = np.random.default_rng(1)
     # ring of 6 nodes (a loop) + one ground link
     i, j = [0, 1, 2, 3, 4, 5, 0], [1, 2, 3, 4, 5, 0, -1]
     net = build_network(rng.uniform(1, 2, 6), np.full(6, 0.5), i, j, rng.uniform(1e4, 2e4, 7),
                         orders=(1,), Q=rng.normal(size=(6, 1)))
-    assert sweep.through_numbering(6, net.i, net.j) is None
+    assert through_numbering(6, net.i, net.j) is None
     got = hb.solve_linear(net, 80.0, 2)
     assert got.method == "sparse"
     ref = dense_response(net, 80.0, 2)
@@ -151,9 +135,9 @@ def test_mixed_real_basis_sweep_equals_full_complex_sweep():
     r, Nb, L = hb.linearize(net, omega, a, p, M, D)
     _, Nd, Ld, dense, Ldense = hb.linearize_mixed(net, omega, a, p, M, D)
     g = -hb._symmetrize(r)
-    for topo in (hb.prepare(net), sweep.through_numbering(net.n_nodes, net.i, net.j)):
-        ref = sweep.block_sweep(topo, Nb, L, net.i, net.j, g[:, None])[:, 0]
-        got = sweep.block_sweep_mixed(topo, Nd, Ld, dense, Ldense, net.i, net.j, g)
+    for topo in (hb.prepare(net), through_numbering(net.n_nodes, net.i, net.j)):
+        ref = blocktri.block_sweep(topo, Nb, L, net.i, net.j, g[:, None])[:, 0]
+        got = blocktri.block_sweep_mixed(topo, Nd, Ld, dense, Ldense, net.i, net.j, g)
         assert np.abs(got - ref).max() <= 1e-10 * np.abs(ref).max()
-        res = sweep.apply_mixed(Nd, Ld, dense, Ldense, net.i, net.j, got) - g
+        res = blocktri.apply_mixed(Nd, Ld, dense, Ldense, net.i, net.j, got) - g
         assert np.linalg.norm(res) <= 1e-10 * np.linalg.norm(g)

@@ -1,4 +1,4 @@
-"""Spin speeds from text with an explicit unit (CLI boundary): ``4000rpm``, ``0:4000rpm:51``."""
+"""Units at the CLI boundary: spin speeds from text with an explicit unit (``4000rpm``, ``0:4000rpm:51``)."""
 from __future__ import annotations
 
 import re

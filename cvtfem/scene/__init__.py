@@ -1,0 +1,1 @@
+"""Scene files (TOML) -> validated, read-only ``Scene`` objects; schema, presets, docs."""
