@@ -148,7 +148,7 @@ def solve(fun, t_span, y0, method: str = "dopri45", h: float | None = None, rtol
             ys.append(run.last.x1.copy())
     stats = engine.stats
     stats.times["t_total"] = time.perf_counter() - wall
-    run.counts  # noqa: B018 - syncs scipy's counters into stats
+    engine.counts()   # scipy's own counters into stats
     status = {"finished": 0, "event": 1, "failed": -1}[run.status]
     message = MESSAGES[status] if status >= 0 else run.message
     extra = engine.report()

@@ -91,6 +91,7 @@ class ScipyEngine:
         return float(getattr(s, "h_abs", None) or s.step_size or 0.0)
 
     def counts(self) -> dict[str, int]:
+        """The counters (``stats.counts``), scipy's ``nfev``, ``njev``, ``nlu`` brought up to date."""
         s, c = self.solver, self.stats.counts
         c["nfev"] = self._base["nfev"] + s.nfev
         c["njev"] = self._base["njev"] + s.njev

@@ -153,6 +153,7 @@ class NativeEngine:
         self.monitor.reset()
 
     def counts(self) -> dict[str, int]:
+        """The counters (``stats.counts``)."""
         return self.stats.counts
 
     def set_counts(self, counts: dict[str, int]) -> None:

@@ -153,7 +153,7 @@ def test_adaptive_explicit_resumes_bitwise(tmp_path, method):
 @pytest.mark.parametrize("method", ["trapezoidal", "BDF", "Radau"])
 def test_implicit_resumes_bitwise(tmp_path, method):
     """Implicit methods: the checkpoint carries their Jacobian, step history and controller state
-    (:mod:`cvtfem.io.solver_state`), so the resumed series and every counter equal the uninterrupted run's.
+    (each method's ``state()``/``restore()``), so the resumed series and every counter equal the uninterrupted run's.
     Without it (a fresh solver at the checkpoint) the series differ in the 4th digit (trapezoidal 4e-4,
     BDF 2e-3 rad/s in the driving speed)."""
     scene = load_scene("band-4dof", {"solver": {"method": method}, "output": {"checkpoint_interval": 0.01}})
