@@ -1,9 +1,10 @@
 """Time-run driver: scene -> model -> integrate -> results file (HDF5) -> summary.
 
-``run_scene`` builds the closed loop of a band-model CVT scene, integrates it with one small
-solver factory (:func:`make_stepper`: scipy's ``OdeSolver`` classes step by step, so outputs are
-sampled from the dense output, written incrementally and the progress bar advances), checks
-every accepted state for NaN/inf and returns a :class:`RunSummary`.
+``run_scene`` builds the closed loop of a band-model CVT scene and steps through the one step loop
+(:class:`~cvtfem.integrate.stepping.Stepping`, built by :func:`make_stepper`; the same object as
+``solve()``'s, so the series are bitwise ``solve()``'s): outputs are sampled from each step's dense
+output, written incrementally with checkpoints of the loop's full memory, the scene's events
+(``[[solver.event]]``) end or mark the run, and the ``solver.on_failure`` policy retries.
 """
 from __future__ import annotations
 
@@ -15,7 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
-from cvtfem.analysis.steppers import SCIPY_STEPPERS, make_stepper
+from cvtfem.analysis.steppers import make_stepper
 from cvtfem.analysis.summary import EFFICIENCY_WINDOW, RunSummary, summarise
 from cvtfem.errors import InputError, NumericalError
 
@@ -53,6 +54,7 @@ def run_scene(scene, until: float | None = None, results: str | Path | None = No
         raise InputError("--until", t_end, "must be positive (simulated seconds)")
     run = _Run(scene, t_end)
     x0 = run.x_start = run.loop.initial_state(**(start or {}))
+    run.check_events(x0)
     writer = None
     if results is not None:
         from cvtfem.io.results import ResultsWriter
@@ -68,10 +70,10 @@ def resume_run(results: str | Path, show_progress: bool = True,
 
     The scene (TOML stored in the file), end time and solver come from the file; rows after the
     checkpoint are dropped and recomputed.  Methods without step-to-step memory (explicit Runge-Kutta,
-    fixed or adaptive: the step size is restored) and those whose memory the checkpoint holds
-    (:mod:`cvtfem.io.solver_state`: trapezoidal/theta, scipy Radau and BDF, with dense Jacobians) give
-    bitwise the series of an uninterrupted run; others (W-methods, LSODA) restart their memory, so their
-    results agree within the solver tolerance.  A finished run or a file without checkpoint is refused
+    fixed or adaptive: the step size is restored) and those that export their memory (trapezoidal/theta,
+    scipy Radau and BDF; sparse Jacobians stored compressed) give bitwise the series of an uninterrupted
+    run; others (W-methods, stabilized methods, LSODA) restart their memory, so their results agree within
+    the solver tolerance.  A finished run or a file without checkpoint is refused
     with :class:`InputError`.
     """
     from cvtfem.io.results import ResultsWriter
@@ -81,6 +83,7 @@ def resume_run(results: str | Path, show_progress: bool = True,
     try:
         scene = scene_from_dict(_parse(writer.scene_toml, str(results)), source=f"{results} (resumed)")
         run = _Run(scene, float(values["t_end"][0]))
+        run.check_events(run.loop.initial_state())
         layout = run.layout()
         if dict(writer.checkpoint_layout) != {**dict(layout.fields), "rows": 1}:
             raise InputError("--resume", str(results), "must hold a checkpoint of this cvtfem version's run driver "
@@ -121,6 +124,33 @@ class _Run:
                                  "with adaptive steps), e.g. 'Radau', 'BDF', 'trapezoidal'") from None
         self.retry = 0          # retries of `solver.on_failure = "retry"` so far
         self.retry_log: list[str] = []
+        self._layout = None
+        self.events = None      # (indicators, direction, terminal) of `[[solver.event]]`, set by `check_events`
+        self.event_names: list[str] = []
+
+    def check_events(self, x0) -> None:
+        """Event indicators ``output(t, x) - value`` of the scene's ``[[solver.event]]`` (scalar outputs only)."""
+        declared = self.scene.solver.event
+        if not declared:
+            return
+        outputs = self.loop.outputs(0.0, x0)
+        for i, ev in enumerate(declared):
+            if ev.output not in outputs:
+                raise InputError(f"solver.event[{i}].output", ev.output,
+                                 f"must be an output of this model: {', '.join(sorted(outputs))}")
+            if np.size(outputs[ev.output]) != 1:
+                raise InputError(f"solver.event[{i}].output", ev.output, "must be a scalar output (it has "
+                                 f"{np.size(outputs[ev.output])} values)")
+        loop, names = self.loop, [ev.output for ev in declared]
+        values = np.array([ev.value for ev in declared])
+
+        def indicators(t, x):
+            out = loop.outputs(t, x)
+            return np.array([float(out[name]) for name in names]) - values
+
+        direction = np.array([{"rising": 1, "falling": -1, "either": 0}[ev.direction] for ev in declared])
+        self.events = (indicators, direction, np.array([ev.terminal for ev in declared]))
+        self.event_names = [ev.name or f"{ev.output} = {ev.value:g}" for ev in declared]
 
     def settings(self) -> tuple[str, float, float, float]:
         """``(method, h, rtol, atol)`` of the current attempt: the scene's, then per retry half the fixed step
@@ -130,26 +160,30 @@ class _Run:
             return sol.method, sol.h, sol.rtol, sol.atol
         if r >= sol.max_retries:
             return sol.fallback, 0.0, sol.rtol, sol.atol
-        if sol.h > 0 and sol.method not in SCIPY_STEPPERS:
+        if sol.h > 0 and _native(sol.method):
             return sol.method, sol.h / 2 ** r, sol.rtol, sol.atol
         return sol.method, sol.h, sol.rtol / 2 ** r, sol.atol / 2 ** r
 
-    def state_size(self) -> int:
-        from cvtfem.io.solver_state import state_size
-
-        sol, n, n2 = self.scene.solver, self.loop.size, self.loop.model.n2
-        methods = [sol.method] + ([sol.fallback] if sol.on_failure == "retry" else [])
-        return max(state_size(m, n, n2) for m in methods)
+    def methods(self) -> list[str]:
+        """The methods a run of this scene may step with (the scene's, and the fallback of retries)."""
+        sol = self.scene.solver
+        return list(dict.fromkeys([sol.method] + ([sol.fallback] if sol.on_failure == "retry" else [])))
 
     def layout(self):
-        from cvtfem.integrate.stats import COUNTERS
+        """Checkpoint payload: the run's own position, the step loop's memory
+        (:func:`~cvtfem.integrate.stepping.loop_fields`) and each method's (``<method>:<field>``)."""
+        from cvtfem.integrate.stepping import loop_fields, memory_fields
         from cvtfem.io.checkpoint import Layout
 
-        n = self.loop.size
-        return Layout((("t", 1), ("t_end", 1), ("x", n), ("h", 1), ("k", 1), ("steps", 1), ("tiny", 1),
-                       ("next_checkpoint", 1), ("counts", len(COUNTERS)), ("t_last", 1), ("x_last", n),
-                       ("x_window", n), ("wall", 1), ("largest", 1), ("monitor", 5), ("retry", 1),
-                       ("solver_state", self.state_size())))
+        if self._layout is None:
+            n, n2, m = self.loop.size, self.loop.model.n2, len(self.events[1]) if self.events else 0
+            sparsity = getattr(self.loop, "jac_sparsity", None)
+            fields = [("t_end", 1), ("k", 1), ("steps", 1), ("next_checkpoint", 1), ("t_last", 1), ("x_last", n),
+                      ("x_window", n), ("wall", 1), ("retry", 1)] + list(loop_fields(n, m))
+            for method in self.methods():
+                fields += [(f"{method}:{name}", size) for name, size in memory_fields(method, n, n2, sparsity)]
+            self._layout = Layout(tuple(fields))
+        return self._layout
 
     def drive_with_policy(self, writer, t0: float, x0, resumed, show_progress: bool, on_checkpoint) -> RunSummary:
         """:meth:`drive`, and on a :class:`NumericalError` the scene's ``solver.on_failure`` policy: "stop"
@@ -169,7 +203,7 @@ class _Run:
                     raise
                 self.retry += 1
                 method, h, rtol, _ = self.settings()
-                what = f"h = {h:g} s" if h > 0 and method not in SCIPY_STEPPERS else f"rtol = {rtol:g}"
+                what = f"h = {h:g} s" if h > 0 and _native(method) else f"rtol = {rtol:g}"
                 note = f"retry {self.retry} of {sol.max_retries} with {method}, {what} after: {err}"
                 if writer is not None and writer.checkpoint_layout:
                     try:
@@ -198,48 +232,34 @@ class _Run:
               fresh_solver: bool = False) -> RunSummary:
         """Step from ``(t0, x0)`` to ``t_end``; ``resumed = (seq, checkpoint payload)`` continues a run, with the
         integrator memory restored unless ``fresh_solver`` (a retry with other settings)."""
-        from cvtfem.integrate import CvtfemSolver
-        from cvtfem.integrate.driver import GROWTH_LIMIT
-        from cvtfem.integrate.guards import GrowthGuard
-        from cvtfem.integrate.stats import COUNTERS
         from cvtfem.io.progress import progress
-        from cvtfem.io.solver_state import export_state, import_state
 
         scene, loop, sol, t_end, t_out = self.scene, self.loop, self.scene.solver, self.t_end, self.t_out
         method, h_fixed, rtol, atol = self.settings()
         n, n2 = loop.size, loop.model.n2
-        k, steps, tiny, seq, wall_before = 0, 0, 0, 0, 0.0
+        k, steps, seq, wall_before = 0, 0, 0, 0.0
         last, x_window = (math.nan, np.full(n, math.nan)), np.full(n, math.nan)
         next_ck = self.interval
-        first_step = 0.0
+        first_step, memory = 0.0, None
         if resumed is not None:
             seq, v = resumed
-            k, steps, tiny = int(v["k"][0]), int(v["steps"][0]), int(v["tiny"][0])
-            next_ck, wall_before, first_step = float(v["next_checkpoint"][0]), float(v["wall"][0]), float(v["h"][0])
+            k, steps = int(v["k"][0]), int(v["steps"][0])
+            next_ck, wall_before = float(v["next_checkpoint"][0]), float(v["wall"][0])
             last, x_window = (float(v["t_last"][0]), v["x_last"]), v["x_window"]
+            memory = {name.split(":", 1)[-1]: a for name, a in v.items()
+                      if ":" not in name or name.startswith(f"{method}:")}
+            first_step = float(memory["h"][0])
         try:
-            stepper = make_stepper(method, loop.rhs, t0, x0, t_end, rtol, atol, h_fixed, loop.jac, n2,
-                                   first_step=0.0 if fresh_solver else first_step, error_check=sol.error_check)
+            run = make_stepper(method, loop.rhs, t0, x0, t_end, rtol, atol, h_fixed, loop.jac, n2,
+                               first_step=0.0 if fresh_solver else first_step, error_check=sol.error_check,
+                               events=self.events, jac_sparsity=getattr(loop, "jac_sparsity", None),
+                               stall_steps=STALL_STEPS, stall_h=STALL_FRACTION * t_end)
         except BaseException as err:
             if writer is not None:
                 writer.close("failed", str(err))
             raise
-        cvtfem_solver = isinstance(stepper, CvtfemSolver)
-        guard = stepper.guard if cvtfem_solver else GrowthGuard(GROWTH_LIMIT, x0, atol, method, adaptive=True)
-        monitor = stepper.monitor if cvtfem_solver else None
-        if resumed is not None:  # memory and counters continue from the checkpoint
-            v = resumed[1]
-            guard.largest = max(guard.largest, float(v["largest"][0]))
-            if monitor is not None:
-                monitor.restore(v["monitor"])
-            if not fresh_solver:
-                import_state(method, stepper, v["solver_state"], n, n2)
-            counts = v["counts"]
-            if cvtfem_solver:
-                stepper.stats.counts.update({c: int(counts[i]) for i, c in enumerate(COUNTERS)})
-                stepper._sync()
-            else:
-                stepper.nfev, stepper.njev, stepper.nlu = (int(c) for c in counts[:3])
+        if memory is not None:  # memory and counters continue from the checkpoint
+            run.restore(memory, memory=not fresh_solver)
 
         def emit(t: float, x) -> None:
             nonlocal k, last, x_window
@@ -255,24 +275,15 @@ class _Run:
         def save() -> None:
             nonlocal seq
             seq += 1
-            if cvtfem_solver:
-                counts = [stepper.stats.counts[c] for c in COUNTERS]
-                h = stepper.h_next
-            else:
-                counts = [stepper.nfev, getattr(stepper, "njev", 0), getattr(stepper, "nlu", 0)]
-                counts += [0] * (len(COUNTERS) - 3)
-                h = getattr(stepper, "h_abs", None) or stepper.step_size or 0.0
-            state = np.full(self.state_size(), np.nan)
-            mem = export_state(method, stepper, n, n2)
-            state[:mem.size] = mem
-            writer.checkpoint(seq, {"t": stepper.t, "t_end": t_end, "x": stepper.y, "h": h, "k": k, "steps": steps,
-                                    "tiny": tiny, "next_checkpoint": next_ck, "counts": counts, "t_last": last[0],
-                                    "x_last": last[1], "x_window": x_window,
-                                    "wall": wall_before + time.perf_counter() - wall0, "largest": guard.largest,
-                                    "monitor": monitor.snapshot() if monitor is not None else np.zeros(5),
-                                    "retry": self.retry, "solver_state": state})
+            state = run.state()
+            payload = {name: np.full(size, np.nan) for name, size in self.layout().fields}
+            payload.update({name if name in payload else f"{method}:{name}": a for name, a in state.items()})
+            payload.update({"t_end": t_end, "k": k, "steps": steps,
+                            "next_checkpoint": next_ck, "t_last": last[0], "x_last": last[1], "x_window": x_window,
+                            "wall": wall_before + time.perf_counter() - wall0, "retry": self.retry})
+            writer.checkpoint(seq, payload)
             if on_checkpoint is not None:
-                on_checkpoint(float(stepper.t), seq)
+                on_checkpoint(float(run.t), seq)
 
         checkpoints = writer is not None and self.interval > 0
         wall0 = time.perf_counter()
@@ -280,42 +291,32 @@ class _Run:
         if bar is not None and t0 > 0:
             bar.update(t0)
         status, message = "finished", ""
-        h_stall = STALL_FRACTION * t_end
         component = f"band model {scene.cvt.model}"
         retry_stats = {"retries": self.retry, "retry_log": "\n".join(self.retry_log)} if self.retry_log else {}
         try:
-            while k < len(t_out) and t_out[k] <= stepper.t:  # t = 0
-                emit(t_out[k], stepper.y)
-            while stepper.status == "running":
-                t_prev, y_prev, f_prev = stepper.t, stepper.y, getattr(stepper, "f", None)
-                msg = stepper.step()
+            while k < len(t_out) and t_out[k] <= run.t:  # t = 0
+                emit(t_out[k], run.x)
+            while run.status == "running":
+                t_prev = run.t
+                taken = run.step()
+                if run.failure == "stall":
+                    raise NumericalError(_stall_message(loop, method, run.t, run.x, run.t - t_prev,
+                                                        run.stall_h), t=run.t, component=component)
+                if not taken:
+                    raise NumericalError(f"{method} failed: {run.message}", t=run.t_fail, component=component)
                 steps += 1
-                if stepper.status == "failed" or not np.all(np.isfinite(stepper.y)):
-                    raise NumericalError(f"{method} failed: {msg or 'state became non-finite'}", t=stepper.t,
-                                         component=component)
-                if not cvtfem_solver:  # scipy steppers: the growth guard of cvtfem's adaptive runs
-                    why = guard.check(y_prev, stepper.y, stepper.t - t_prev, f_prev)
-                    if why is not None:
-                        raise NumericalError(f"{method} failed: {why} at t = {stepper.t:.6g} s with adaptive step "
-                                             f"h = {stepper.t - t_prev:.3g} s{guard.hint()}", t=stepper.t,
-                                             component=component)
-                    guard.update(stepper.y)
                 if steps > sol.max_steps:
-                    raise NumericalError(f"step budget `solver.max_steps` = {sol.max_steps} exhausted", t=stepper.t)
-                tiny = tiny + 1 if stepper.t - t_prev < h_stall else 0
-                if tiny >= STALL_STEPS:
-                    raise NumericalError(_stall_message(loop, method, stepper.t, stepper.y, stepper.t - t_prev,
-                                                        h_stall), t=stepper.t, component=component)
-                if k < len(t_out) and t_out[k] <= stepper.t:
-                    dense = stepper.dense_output()
-                    while k < len(t_out) and t_out[k] <= stepper.t:
-                        emit(t_out[k], dense(t_out[k]))
-                if checkpoints and stepper.status == "running" and stepper.t >= next_ck:
-                    while next_ck <= stepper.t:
+                    raise NumericalError(f"step budget `solver.max_steps` = {sol.max_steps} exhausted", t=run.t)
+                while k < len(t_out) and t_out[k] <= run.t:
+                    emit(t_out[k], run.dense(t_out[k]))
+                if run.status == "failed":
+                    raise NumericalError(f"{method} failed: {run.message}", t=run.t_fail, component=component)
+                if checkpoints and run.status == "running" and run.t >= next_ck:
+                    while next_ck <= run.t:
                         next_ck += self.interval
                     save()
                 if bar is not None:
-                    bar.update(stepper.t - t_prev)
+                    bar.update(run.t - t_prev)
         except BaseException as err:
             status, message = "failed", str(err)
             if writer is not None:
@@ -325,28 +326,44 @@ class _Run:
         finally:
             if bar is not None:
                 bar.close()
+        if run.status == "event" and (k == 0 or last[0] < run.t):   # the run ends at the event: its last sample
+            emit(run.t, run.x)
         wall = wall_before + time.perf_counter() - wall0
-        stats = {"name": method, "steps": steps, "nfev": int(stepper.nfev), "njev": int(getattr(stepper, "njev", 0)),
-                 "nlu": int(getattr(stepper, "nlu", 0)), "rtol": rtol, "atol": atol,
+        counts = run.counts
+        stats = {"name": method, "steps": steps, "nfev": int(counts["nfev"]), "njev": int(counts["njev"]),
+                 "nlu": int(counts["nlu"]), "rtol": rtol, "atol": atol,
                  "kernel": getattr(loop.model, "backend", "numpy")}  # compiled (numba) or numpy right-hand side
-        if monitor is not None and monitor.active:
-            stats.update(monitor.stats())
-            warning = monitor.warning()
-            if warning is not None:
-                stats["warning"] = warning
-                log.warning("%s", warning)
+        stats.update(run.engine.report())
+        warning = run.engine.warning()
+        if warning is not None:
+            stats["warning"] = warning
+            log.warning("%s", warning)
         summary = summarise(scene, loop, last, (t_out[self.j_window], x_window), t_end, wall, stats, status)
         if writer is not None:
             extra = {"checkpoints": seq} if checkpoints else {}
             if resumed is not None:
                 extra["resumed_from_t"] = float(resumed[1]["t"][0])
+            if run.status == "event":
+                fired = np.flatnonzero(run.fired & run.system.event_terminal)
+                extra.update(event_t=float(run.t), event_name=", ".join(self.event_names[i] for i in fired))
             writer.set_stats({**{f"solver_{k}": v for k, v in stats.items()}, "wall_time_s": wall, **extra,
                               **retry_stats})
+            if self.events is not None:
+                for i, name in enumerate(self.event_names):
+                    writer.add_array(f"event.{i}.times", np.array(run.t_events[i], dtype=float), "s",
+                                     f"Times of event {name!r}.")
             writer.add_array("band.node_xi", loop.model.arc_nodes(0.0)[0] / (math.pi / 2), "-",
                              "Quadrature nodes xi = theta / theta* of band.normal_force (same on both arcs).")
             writer.close(status, message)
             summary.results = str(writer.path)
         return summary
+
+
+def _native(method: str) -> bool:
+    """True for a playground method (``solver.h`` is its fixed step), False for scipy's."""
+    from cvtfem.integrate import METHODS
+
+    return method in METHODS
 
 
 def _stall_message(loop, method: str, t: float, x, h: float, h_stall: float) -> str:

@@ -6,8 +6,8 @@ is counted (:mod:`cvtfem.integrate.stats`).
 """
 from cvtfem.integrate.adapter import CvtfemSolver
 from cvtfem.integrate.driver import IgnoredOptionWarning, OdeResult, solve
-from cvtfem.integrate.methods import METHODS, SCIPY_METHODS
+from cvtfem.integrate.methods import METHODS, SCIPY_METHODS, register_method, unregister_method
 from cvtfem.integrate.system import OdeSystem, as_system
 
 __all__ = ["solve", "OdeResult", "OdeSystem", "as_system", "METHODS", "SCIPY_METHODS",
-           "IgnoredOptionWarning", "CvtfemSolver"]
+           "IgnoredOptionWarning", "CvtfemSolver", "register_method", "unregister_method"]

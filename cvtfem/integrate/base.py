@@ -94,6 +94,25 @@ class Stepper:
     def reset(self) -> None:
         """Forget the history (after an event switch changes the state or ``phi``)."""
 
+    def memory_fields(self) -> tuple[tuple[str, int], ...]:
+        """``((name, size), ...)`` of :meth:`state`: here ``F`` at the current point (``f_start``, known
+        after FSAL steps and dense output; NaN otherwise), so a resumed run makes the same RHS calls."""
+        return (("f_start", self.system.n),)
+
+    def state(self, t: float, x: np.ndarray) -> dict[str, np.ndarray]:
+        """The method's step-to-step memory at the accepted point ``(t, x)`` (see :meth:`memory_fields`)."""
+        for c in (self._start, self._cache):
+            if c is not None and c[0] == t and np.array_equal(c[1], x):
+                return {"f_start": np.array(c[2], dtype=float)}
+        return {"f_start": np.full(self.system.n, np.nan)}
+
+    def restore(self, state: dict[str, np.ndarray], t: float, x: np.ndarray) -> None:
+        """Continue from :meth:`state` in a stepper freshly built at ``(t, x)``. Methods that keep no more
+        restart the rest (W-methods: their LU; stabilized methods: the spectral-radius estimate)."""
+        f_start = state["f_start"]
+        if not np.all(np.isnan(f_start)):
+            self._start = (t, np.array(x), np.array(f_start))
+
     def max_step(self) -> float:
         """Largest step, s, worth attempting now (adaptive runs cap their proposals there); no cap here."""
         return np.inf

@@ -1,27 +1,94 @@
-"""Method registry: name -> stepper class (immutable mapping built at import)."""
+"""Method registry: name -> class, resolved from :mod:`cvtfem.methods_registry` (the one list).
+
+``METHODS`` maps the playground's names to :class:`~cvtfem.integrate.base.Stepper` classes,
+``SCIPY_METHODS`` scipy's names to ``scipy.integrate.OdeSolver`` classes (read-only live views).
+:func:`register_method` adds a method at run time: ``solve``, ``cvtfem run`` (the scene's
+``solver.method``) and resume then know it.
+"""
 from __future__ import annotations
 
+import importlib
+import warnings
 from types import MappingProxyType
 
-from cvtfem.integrate import dumka3, extrapolation, rk, rock, stabilized, theta, wmethods
+from scipy.integrate import OdeSolver
 
-__all__ = ["METHODS", "SCIPY_METHODS", "UNAVAILABLE", "all_options"]
+from cvtfem import methods_registry
+from cvtfem.errors import InputError
+from cvtfem.integrate.base import Stepper
 
-METHODS = MappingProxyType({cls.name: cls for cls in (
-    rk.Euler, rk.RK4, rk.DOPRI45, rk.DOPRI56, rk.DOPRI78,
-    extrapolation.EulerExtrapolation, extrapolation.GBS, extrapolation.GBSSmooth,
-    wmethods.SW24, wmethods.W1, wmethods.W1Extrapolation,
-    theta.Theta, theta.Trapezoidal, theta.ImplicitEuler,
-    stabilized.RKC, rock.ROCK2, rock.ROCK4, dumka3.DUMKA3)})
-SCIPY_METHODS = frozenset({"RK23", "RK45", "DOP853", "Radau", "BDF", "LSODA"})
-#: Names from the issue that are not implemented, with the reason (shown in the InputError);
-#: empty since DUMKA3 exists (kept for the driver's check).
-UNAVAILABLE: MappingProxyType = MappingProxyType({})
+__all__ = ["METHODS", "SCIPY_METHODS", "register_method", "unregister_method", "all_options", "check_options",
+           "IgnoredOptionWarning"]
+
+_NATIVE: dict[str, type] = {}
+_SCIPY: dict[str, type] = {}
+METHODS = MappingProxyType(_NATIVE)
+SCIPY_METHODS = MappingProxyType(_SCIPY)
+
+
+class IgnoredOptionWarning(UserWarning):
+    """An option was given that the chosen method does not use."""
+
+
+def _add(name: str, cls: type) -> None:
+    if isinstance(cls, type) and issubclass(cls, Stepper):
+        _NATIVE[name] = cls
+    elif isinstance(cls, type) and issubclass(cls, OdeSolver):
+        _SCIPY[name] = cls
+    else:
+        raise InputError("method", cls, "must be a cvtfem.integrate Stepper or a scipy.integrate.OdeSolver class")
+
+
+def register_method(cls: type, name: str | None = None) -> str:
+    """Make ``cls`` (a :class:`Stepper` subclass or a scipy ``OdeSolver`` class) available as
+    ``name`` (default ``cls.name``) everywhere: :func:`~cvtfem.integrate.solve`, the scene key
+    ``solver.method`` and resumed runs. Returns the name."""
+    name = getattr(cls, "name", None) if name is None else name
+    if not isinstance(name, str) or not name:
+        raise InputError("name", name, "must be a non-empty method name")
+    if name in _NATIVE or name in _SCIPY:
+        if (_NATIVE.get(name) or _SCIPY.get(name)) is cls:
+            return name
+        raise InputError("name", name, "is already a registered method")
+    _add(name, cls)
+    methods_registry.register_name(name, cls)
+    return name
+
+
+def unregister_method(name: str) -> None:
+    """Remove a method added by :func:`register_method` (a plug-in unloaded, a test's method)."""
+    methods_registry.unregister_name(name)
+    _NATIVE.pop(name, None)
+    _SCIPY.pop(name, None)
+
+
+def _resolve(spec) -> type:
+    if not isinstance(spec, str):
+        return spec
+    module, attr = spec.split(":")
+    return getattr(importlib.import_module(module), attr)
+
+
+for _name, _spec in methods_registry.specs().items():
+    _add(_name, _resolve(_spec))
 
 
 def all_options() -> frozenset[str]:
-    """Union of the options every method accepts (an unknown option is an error)."""
+    """Union of the options every native method accepts (an unknown option is an error)."""
     out = set()
     for cls in METHODS.values():
         out |= cls.OPTIONS
     return frozenset(out)
+
+
+def check_options(method: str, accepted: frozenset, options: dict) -> dict:
+    """The options ``method`` uses; unknown ones raise, ignored ones warn."""
+    known = all_options()
+    for key in options:
+        if key not in known:
+            raise InputError(key, options[key], f"is not an option of any method; known: {sorted(known)}")
+    use = {k: v for k, v in options.items() if k in accepted}
+    for key in sorted(set(options) - set(use)):
+        warnings.warn(f"option `{key}` is ignored by method {method!r} (it accepts {sorted(accepted)})",
+                      IgnoredOptionWarning, stacklevel=4)
+    return use

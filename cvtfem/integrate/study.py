@@ -158,9 +158,8 @@ def heat_benchmark(N: int = 1000, t_end: float = 0.1, target: float = 1e-4, repe
 
     Implicit methods get only ``jac_sparsity`` (coloured finite differences, also for scipy).
     RK4 runs at 98 % of its real stability limit ``2.785/rho``. Returns rows (see
-    :func:`work_precision`) with ``met`` flags; methods not available give a row with status.
+    :func:`work_precision`) with ``met`` flags.
     """
-    from cvtfem.integrate.methods import UNAVAILABLE
     from cvtfem.problems import heat1d
 
     p = heat1d(N, t_end)
@@ -182,10 +181,6 @@ def heat_benchmark(N: int = 1000, t_end: float = 0.1, target: float = 1e-4, repe
     }
     rows = []
     for method in methods or plan:
-        if method in UNAVAILABLE:
-            rows.append({"label": method, "method": method, "error": np.nan, "nfev": -1,
-                         "time": np.nan, "status": "not available", "met": None})
-            continue
         label = f"{method} (sparse)" if method == "trapezoidal" else method
         rows.append(cheapest_meeting(sparse, label, method, plan[method], target, repeats, error))
     return rows

@@ -24,11 +24,13 @@ from the divided difference of ``F`` over the last two steps; other alpha use
 from __future__ import annotations
 
 import numpy as np
+import scipy.sparse as sp
 
 from cvtfem.errors import InputError
 from cvtfem.integrate.base import Attempt, Stepper
 from cvtfem.integrate.jacobian import JacobianProvider
-from cvtfem.integrate.linsolve import LU, reduced_matrix
+from cvtfem.integrate.linsolve import DENSE_MAX, LU, reduced_matrix
+from cvtfem.integrate.memory import MatrixSlot, opt_scalar, scalar, vector
 from cvtfem.integrate.newton import NewtonOptions, NewtonSolver
 
 __all__ = ["Theta", "Trapezoidal", "ImplicitEuler"]
@@ -71,6 +73,40 @@ class Theta(Stepper):
 
     def reset(self) -> None:
         self._prev = None
+
+    def _slot(self) -> MatrixSlot:
+        return MatrixSlot.for_pattern("J", self.system.n, self.system.jac_sparsity)
+
+    def memory_fields(self):
+        """``h alpha`` of the iteration matrix and whether its LU is current, previous step and slope
+        (error estimate), the Jacobian, ``F`` at the current point, and the Newton solver's memory
+        (Jacobian marked stale, contraction estimate of the last solve)."""
+        n = self.system.n
+        return (("gamma", 1), ("lu_valid", 1), ("prev_h", 1), ("prev_f", n)) + self._slot().fields() + \
+            super().memory_fields() + (("newton_stale", 1), ("newton_eta", 1))
+
+    def state(self, t, x):
+        n, prev = self.system.n, self._prev
+        return {"gamma": scalar(self._gamma), "lu_valid": scalar(self.newton.B is not None),
+                "prev_h": scalar(None if prev is None else prev[0]),
+                "prev_f": vector(None if prev is None else prev[1], n), **self._slot().pack(self.J),
+                **super().state(t, x), "newton_stale": scalar(self.newton.stale),
+                "newton_eta": scalar(self.newton._eta)}
+
+    def restore(self, state, t, x):
+        """The LU is recomputed from the saved Jacobian and ``h alpha`` (LAPACK/SuperLU give the same
+        factors for the same matrix)."""
+        J = self._slot().unpack(state)
+        if J is not None:   # in the form JacobianProvider returns
+            self.J = sp.csr_matrix(J) if self.system.n > DENSE_MAX else (J.toarray() if sp.issparse(J) else J)
+        self._gamma = opt_scalar(state["gamma"])
+        prev_h = opt_scalar(state["prev_h"])
+        self._prev = None if prev_h is None else (prev_h, np.array(state["prev_f"]))
+        super().restore(state, t, x)
+        self.newton.invalidate()
+        if state["lu_valid"][0] == 1.0 and self.J is not None and self._gamma is not None:
+            self.newton._set(reduced_matrix(self.J, self.system.n2, self._gamma))
+        self.newton.stale, self.newton._eta = bool(state["newton_stale"][0]), float(state["newton_eta"][0])
 
     def accept(self, att: Attempt) -> None:
         super().accept(att)

@@ -153,7 +153,7 @@ def test_adaptive_explicit_resumes_bitwise(tmp_path, method):
 @pytest.mark.parametrize("method", ["trapezoidal", "BDF", "Radau"])
 def test_implicit_resumes_bitwise(tmp_path, method):
     """Implicit methods: the checkpoint carries their Jacobian, step history and controller state
-    (:mod:`cvtfem.io.solver_state`), so the resumed series and every counter equal the uninterrupted run's.
+    (each method's ``state()``/``restore()``), so the resumed series and every counter equal the uninterrupted run's.
     Without it (a fresh solver at the checkpoint) the series differ in the 4th digit (trapezoidal 4e-4,
     BDF 2e-3 rad/s in the driving speed)."""
     scene = load_scene("band-4dof", {"solver": {"method": method}, "output": {"checkpoint_interval": 0.01}})
@@ -164,11 +164,33 @@ def test_implicit_resumes_bitwise(tmp_path, method):
     assert res.solver == ref.solver and res.ratio == ref.ratio and res.efficiency == ref.efficiency
 
 
+class _Memory(dict):
+    """A method's exported memory (named arrays); ``size``: its floats."""
+
+    @property
+    def size(self) -> int:
+        return sum(v.size for v in self.values())
+
+
+def export_state(method, solver, n, n2):
+    """The memory of a :class:`CvtfemSolver`'s method (:meth:`Stepper.state`)."""
+    return _Memory(solver.stepper.state(solver.t, solver.y))
+
+
+def import_state(method, solver, mem, n, n2):
+    solver.stepper.restore(mem, solver.t, solver.y)
+
+
+def state_size(method, n, n2):
+    from cvtfem.integrate.stepping import memory_fields
+
+    return sum(size for _, size in memory_fields(method, n, n2))
+
+
 def test_solver_state_round_trip_restores_the_lu(tmp_path):
     """Export/import of the theta family rebuilds the iteration matrix from the saved Jacobian and
     h alpha: the next steps of a restored solver equal the original's bit for bit, at the same cost."""
     from cvtfem.integrate import CvtfemSolver
-    from cvtfem.io.solver_state import export_state, import_state, state_size
 
     A = np.array([[0.0, 1.0], [-1e4, -10.0]])
 
@@ -198,7 +220,6 @@ def test_theta_state_restores_newton_memory_at_every_step():
     that state: with its stale-Jacobian flag and contraction estimate reset instead, 10 of the 60
     restarts diverge from the uninterrupted run (measured)."""
     from cvtfem.integrate import CvtfemSolver
-    from cvtfem.io.solver_state import export_state, import_state
     from cvtfem.machines.cvt import closed_loop
 
     loop = closed_loop(load_scene("band-4dof"))

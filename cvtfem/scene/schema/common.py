@@ -1,14 +1,23 @@
 """Scene keys shared by every kind of machine: identity, solver, output."""
 from __future__ import annotations
 
-from cvtfem.scene.schema.base import Key, Table
+from cvtfem.methods_registry import MethodNames
+from cvtfem.scene.schema.base import REQUIRED, Key, Table, TableArray
 
-#: Method names understood by ``cvtfem.integrate.solve`` (plus scipy's).
-METHODS = (
-    "euler", "rk4", "dopri45", "dopri56", "dopri78", "gbs", "gbs-smooth", "euler-extrapolation",
-    "sw24", "w1", "w1-extrapolation", "theta", "trapezoidal", "implicit-euler", "dumka3", "rock2", "rock4", "rkc",
-    "RK23", "RK45", "DOP853", "Radau", "BDF", "LSODA",
-)
+#: Method names understood by ``cvtfem.integrate.solve`` (its own and scipy's): a live view of
+#: :mod:`cvtfem.methods_registry`, so a method registered at run time is a valid ``solver.method``.
+METHODS = MethodNames()
+
+EVENT = TableArray("event", "Events of a run: a named scalar output crossing a value (located on the step's "
+                   "dense output; recorded in the results file).", Table("event", "One event.", (
+    Key("output", "str", "Scalar output whose crossing is the event (e.g. 'ratio'; see `cvtfem describe`).", "",
+        REQUIRED),
+    Key("value", "float", "Value the output crosses, in the output's unit.", "as output", REQUIRED),
+    Key("direction", "str", "Crossings that count: the output rising through `value`, falling, or either.", "",
+        "either", choices=("rising", "falling", "either")),
+    Key("terminal", "bool", "End the run at the event (else it is recorded and the run goes on).", "", True),
+    Key("name", "str", "Name of the event in the results file (empty: '<output> = <value>').", "", ""),
+)))
 
 SOLVER = Table("solver", "Time integration settings (used by `cvtfem run`).", (
     Key("method", "str", "Integration method.", "", "Radau", choices=METHODS),
@@ -23,6 +32,7 @@ SOLVER = Table("solver", "Time integration settings (used by `cvtfem run`).", (
         "last checkpoint with half the step, then with `solver.fallback`).", "", "stop", choices=("stop", "retry")),
     Key("max_retries", "int", "Retries of `on_failure = 'retry'` before the run fails.", "-", 3, ge=1),
     Key("fallback", "str", "Method of the last retry (robust, implicit).", "", "Radau", choices=METHODS),
+    EVENT,
 ))
 
 OUTPUT = Table("output", "What a run writes and how often.", (
