@@ -53,16 +53,22 @@ def ramp_integral(u: np.ndarray, w: np.ndarray) -> np.ndarray:
 def link_energy(l: np.ndarray, law: np.ndarray, k_in: np.ndarray, k_out: np.ndarray,
                 h: np.ndarray, zone: np.ndarray) -> np.ndarray:
     """Elastic energy ``V(l)`` (J) of every link, ``V' = f`` of :func:`link_force` (same arguments), ``V(0) = 0``."""
-    shape = (-1,) + (1,) * (np.ndim(l) - 1)
-    law, k_in, k_out = law.reshape(shape), k_in.reshape(shape), k_out.reshape(shape)
-    h, w = h.reshape(shape), (zone * h / 2).reshape(shape)
-    dk = np.where(law == LINEAR, 0.0, k_out - k_in)
-    k0 = np.where(law == LINEAR, k_out, k_in)
-    centre = np.where(law == GAP, h, h / 2)
-    two_sided = law == BACKLASH
+    k0, dk, centre, w, two_sided = _law_terms(np.ndim(l), law, k_in, k_out, h, zone)
     return k0 * l ** 2 / 2 + dk * (ramp_integral(l - centre, w) - ramp_integral(-centre, w)
                                    + np.where(two_sided, ramp_integral(-l - centre, w) - ramp_integral(-centre, w),
                                               0.0))
+
+
+def _law_terms(ndim: int, law, k_in, k_out, h, zone):
+    """Per-link ``k0``, ``dk = k_out - k_in`` (0 for linear links), contact centre, half zone width ``w`` and the
+    two-sided flag, shaped ``(E, 1, ...)`` to broadcast against deflections of ``ndim`` dimensions."""
+    shape = (-1,) + (1,) * (ndim - 1)
+    law, k_in, k_out = law.reshape(shape), k_in.reshape(shape), k_out.reshape(shape)
+    h = h.reshape(shape)
+    dk = np.where(law == LINEAR, 0.0, k_out - k_in)
+    k0 = np.where(law == LINEAR, k_out, k_in)
+    centre = np.where(law == GAP, h, h / 2)
+    return k0, dk, centre, (zone.reshape(shape) * h / 2), law == BACKLASH
 
 
 def link_force(l: np.ndarray, law: np.ndarray, k_in: np.ndarray, k_out: np.ndarray,
@@ -101,15 +107,9 @@ def link_force(l: np.ndarray, law: np.ndarray, k_in: np.ndarray, k_out: np.ndarr
     >>> np.round(f, 12).tolist(), np.round(df, 12).tolist()
     ([[0.4, 1.6]], [[1.0, 11.0]])
     """
-    shape = (-1,) + (1,) * (np.ndim(l) - 1)
-    law, k_in, k_out = law.reshape(shape), k_in.reshape(shape), k_out.reshape(shape)
-    h, w = h.reshape(shape), (zone * h / 2).reshape(shape)
-    dk = np.where(law == LINEAR, 0.0, k_out - k_in)
-    k0 = np.where(law == LINEAR, k_out, k_in)
-    centre = np.where(law == GAP, h, h / 2)
+    k0, dk, centre, w, two_sided = _law_terms(np.ndim(l), law, k_in, k_out, h, zone)
     Rp, dRp = smooth_ramp(l - centre, w)
     Rm, dRm = smooth_ramp(-l - centre, w)
-    two_sided = law == BACKLASH
     f = k0 * l + dk * (Rp - np.where(two_sided, Rm, 0.0))
     df = k0 + dk * (dRp + np.where(two_sided, dRm, 0.0))
     return f, df
