@@ -1,0 +1,65 @@
+"""Issue 18, first classes: scene files the loader did not survive, and counts and spans a run cannot take.
+
+Each case ends in one line naming what is wrong (exit 2), before any work starts; each failed on the code
+before the fix (UnicodeDecodeError, RecursionError, OSError tracebacks; a raw terminal escape printed; a
+ValueError from numpy for `--until inf`; a never-ending checkpoint loop for `checkpoint_interval = 1e-300`;
+ten billion rows for `output.step = 1e-10`).
+"""
+import pytest
+
+pytestmark = pytest.mark.hard
+
+
+def _one_line_error(res, *needles):
+    assert res.returncode == 2, res.stderr
+    lines = res.stderr.strip().splitlines()
+    assert len(lines) == 1 and "Traceback" not in res.stderr, res.stderr
+    for needle in needles:
+        assert needle in lines[0], lines[0]
+    return lines[0]
+
+
+@pytest.mark.parametrize("content,needles", [
+    (b'title = "\xff"\npreset = "band-4dof"\n', ("must be UTF-8", "0xff", "line 1")),
+    (bytes(range(256)) * 2, ("must be UTF-8",)),
+    (("a = " + "[" * 3000 + "]" * 3000 + "\n").encode(), ("nested",)),
+    (b'preset = "band-4dof"\ntitle = "\\u001b[31mred"\n', ("`title`", "control characters", "\\x1b")),
+    (b'preset = "band-4dof"\ndescription = "' + b"x" * 5000 + b'"\n', ("`description`", "at most 1000")),
+])
+def test_scene_files_the_loader_did_not_survive(tmp_path, cli, content, needles):
+    path = tmp_path / "scene.toml"
+    path.write_bytes(content)
+    line = _one_line_error(cli("describe", str(path)), *needles)
+    assert "\x1b" not in line   # an escape sequence is quoted, never sent to the terminal
+
+
+def test_oversized_scene_file_is_refused_before_reading(tmp_path, cli):
+    path = tmp_path / "huge.toml"
+    path.write_bytes(b"# " + b"x" * (2 << 20) + b"\n")
+    _one_line_error(cli("describe", str(path)), "at most 1024 KiB")
+
+
+def test_a_name_too_long_for_the_file_system(cli):
+    line = _one_line_error(cli("describe", "x" * 5000), "`SCENE`", "File name too long", "5002 characters")
+    assert len(line) < 400   # the value is quoted shortened
+
+
+@pytest.mark.parametrize("args,needles", [
+    (("--until", "inf"), ("`--until`", "finite")),
+    (("--until", "nan"), ("`--until`",)),
+    (("--until", "1e300"), ("`output.step`", "samples")),
+])
+def test_run_spans_refused_up_front(cli, args, needles):
+    _one_line_error(cli("run", "band-4dof", "--results", "none", *args), *needles)
+
+
+@pytest.mark.parametrize("output,needles", [
+    ("step = 1e-10", ("`output.step`", "1e+10 samples", "GB")),
+    ("checkpoint_interval = 1e-300", ("`output.checkpoint_interval`", "checkpoints")),
+])
+def test_run_counts_bounded_up_front(tmp_path, cli, output, needles):
+    scene = tmp_path / "s.toml"
+    scene.write_text(f'preset = "band-4dof"\n[output]\n{output}\n')
+    results = tmp_path / "r.h5"
+    _one_line_error(cli("run", str(scene), "--until", "1", "--results", str(results), timeout=60), *needles)
+    assert not results.exists()   # refused before any work or file
