@@ -63,3 +63,33 @@ def test_run_counts_bounded_up_front(tmp_path, cli, output, needles):
     results = tmp_path / "r.h5"
     _one_line_error(cli("run", str(scene), "--until", "1", "--results", str(results), timeout=60), *needles)
     assert not results.exists()   # refused before any work or file
+
+
+@pytest.mark.parametrize("argv,needles", [
+    (("run", "band-4dof", "--until", "0.001", "--results", "{dir}"), ("`--results`", "not a folder")),
+    (("run", "band-4dof", "--until", "0.001", "--results", "none", "--summary-json", "{file}/s.json"),
+     ("`--summary-json`", "is a file")),
+    (("campbell", "friswell_5_9_1", "--speeds", "0:100:3", "--png", "{dir}"), ("`--png`", "not a folder")),
+    (("campbell", "friswell_5_9_1", "--speeds", "0:100:3", "--csv", "{file}/c.csv"), ("`--csv`",)),
+    (("periodic", "engine_gear_train", "--json", "{dir}"), ("`--json`",)),
+    (("modes", "friswell_5_9_1", "--json", "{long}.json"), ("`--json`", "255 bytes")),
+    (("docs", "scenes", "--out", "{file}/scenes.md"), ("`--out`",)),
+    (("demo", "--out", "{file}"), ("`--out`", "must be a folder")),
+])
+def test_output_paths_checked_before_the_work(tmp_path, cli, argv, needles):
+    """Each of these used to end in a traceback after the work was done (the work lost)."""
+    folder, file = tmp_path / "folder", tmp_path / "file"
+    folder.mkdir()
+    file.write_text("")
+    args = [a.format(dir=folder, file=file, long=tmp_path / ("y" * 300)) for a in argv]
+    _one_line_error(cli(*args, timeout=60), *needles)
+
+
+def test_default_results_name_stays_in_out_runs(tmp_path, cli):
+    """`cvtfem run ../x` (a scene file without .toml) used to write `out/runs/../x.h5`, outside out/runs."""
+    (tmp_path / "x").write_text('preset = "band-4dof"\n')
+    work = tmp_path / "work"
+    work.mkdir()
+    res = cli("run", "../x", "--until", "0.002", cwd=work)
+    assert res.returncode == 0, res.stderr
+    assert (work / "out" / "runs" / "x.h5").is_file() and not (work / "out" / "x.h5").exists()
