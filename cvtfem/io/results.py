@@ -32,6 +32,7 @@ name next to it and moved over the original once it is consistent.
 from __future__ import annotations
 
 import os
+import struct
 import time
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
@@ -156,10 +157,7 @@ class ResultsWriter:
         path = Path(path)
         if not path.is_file():
             raise InputError(where, str(path), "must be an existing results file (.h5) of a killed run")
-        try:
-            f = h5py.File(path, "r", libver="latest", swmr=True, locking=False)
-        except OSError as err:
-            raise InputError(where, str(path), f"must be a readable HDF5 file ({err})") from None
+        f = _open_for_reading(path, where)
         with f:
             attrs = dict(f.attrs)
             if attrs.get("kind") != "run" or "series" not in f:
@@ -284,16 +282,44 @@ class Results:
     units: dict[str, str] = field(repr=False)
 
 
+#: First 8 bytes of every HDF5 file.
+HDF5_SIGNATURE = b"\x89HDF\r\n\x1a\n"
+
+
+def _open_for_reading(path: Path, where: str) -> h5py.File:
+    """Open a results file read-only (SWMR), after checking that it is not cut short.
+
+    A truncated file (a partial copy, a full disk) is refused up front: HDF5's SWMR reader retries
+    metadata reads of a missing region without end, so reading one would hang.  The check reads the
+    end-of-file address of the version 2/3 superblock that the writer creates (``libver="latest"``).
+    """
+    try:
+        with open(path, "rb") as raw:
+            head = raw.read(44)
+            size = os.fstat(raw.fileno()).st_size
+    except OSError as err:
+        raise InputError(where, str(path), f"must be a readable file ({err.strerror})") from None
+    if head[:8] == HDF5_SIGNATURE and len(head) == 44 and head[8] in (2, 3) and head[9] == 8:
+        base, _, eof = struct.unpack("<QQQ", head[12:36])
+        if size < base + eof:
+            raise InputError(where, str(path), f"is truncated: HDF5 says {base + eof} bytes, the file has {size} "
+                             "(a partial copy or a full disk?)")
+    try:
+        return h5py.File(path, "r", libver="latest", swmr=True, locking=False)
+    except OSError as err:
+        raise InputError(where, str(path), f"must be a readable HDF5 file ({err})") from None
+
+
 def read_results(path: str | Path) -> Results:
     """Read a results file (also one whose run was killed: complete rows only)."""
     path = Path(path)
     if not path.is_file():
         raise InputError("RESULTS", str(path), "must be an existing results file (.h5)")
-    try:
-        f = h5py.File(path, "r", libver="latest", swmr=True, locking=False)
-    except OSError as err:
-        raise InputError("RESULTS", str(path), f"must be a readable HDF5 file ({err})") from None
+    f = _open_for_reading(path, "RESULTS")
     with f:
+        missing = [name for name in ("series", "scene", "stats") if name not in f]
+        if missing:
+            raise InputError("RESULTS", str(path), f"must be a cvtfem results file (it has no {', '.join(missing)})")
         group = f["series"]
         rows = min(d.shape[0] for d in group.values())
         series = {name: d[:rows] for name, d in group.items() if name != "time"}

@@ -93,3 +93,30 @@ def test_default_results_name_stays_in_out_runs(tmp_path, cli):
     res = cli("run", "../x", "--until", "0.002", cwd=work)
     assert res.returncode == 0, res.stderr
     assert (work / "out" / "runs" / "x.h5").is_file() and not (work / "out" / "x.h5").exists()
+
+
+@pytest.fixture(scope="module")
+def finished_run(tmp_path_factory):
+    from cvtfem.analysis.run import run_scene
+    from cvtfem.scene.loader import load_scene
+
+    path = tmp_path_factory.mktemp("run") / "r.h5"
+    run_scene(load_scene("band-4dof"), until=0.01, results=path, show_progress=False)
+    return path
+
+
+@pytest.mark.parametrize("command", [("show",), ("run", "--resume")])
+def test_truncated_results_file_is_refused_not_read(tmp_path, cli, finished_run, command):
+    """`head -c 1000 run.h5 > t.h5`: `show` and `--resume` hung in HDF5's SWMR metadata retries."""
+    cut = tmp_path / "t.h5"
+    cut.write_bytes(finished_run.read_bytes()[:1000])
+    _one_line_error(cli(*command, str(cut), timeout=30), "is truncated", "the file has 1000")
+
+
+def test_hdf5_file_that_is_not_a_results_file(tmp_path, cli):
+    import h5py
+
+    path = tmp_path / "other.h5"
+    with h5py.File(path, "w") as f:
+        f.attrs["status"] = "finished"
+    _one_line_error(cli("show", str(path)), "must be a cvtfem results file", "series")
