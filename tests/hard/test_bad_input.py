@@ -120,3 +120,35 @@ def test_hdf5_file_that_is_not_a_results_file(tmp_path, cli):
     with h5py.File(path, "w") as f:
         f.attrs["status"] = "finished"
     _one_line_error(cli("show", str(path)), "must be a cvtfem results file", "series")
+
+
+def _friswell_with(tmp_path, change):
+    import copy
+    import tomllib
+
+    import tomli_w
+
+    from cvtfem.scene.loader import preset_text
+
+    data = copy.deepcopy(tomllib.loads(preset_text("friswell_5_9_1")))
+    change(data)
+    path = tmp_path / "rotor.toml"
+    path.write_text(tomli_w.dumps(data))
+    return str(path)
+
+
+@pytest.mark.parametrize("change,needles", [
+    (lambda d: d["shaft"][0].update(repeat=10 ** 7), ("`shaft[0].repeat`", "<= 100000")),      # hung
+    (lambda d: d.update(shaft=[dict(d["shaft"][0], repeat=90_000)] * 2), ("`shaft[].repeat`", "DOF")),
+    (lambda d: d["material"][0].update(rho=1e-300), ("`material[0].rho`", ">= 1")),         # geev ValueError
+    (lambda d: d["material"][0].update(E=1e300), ("`material[0].E`", "<= 1e+13")),
+    (lambda d: d["shaft"][0].update(length=1e-300), ("`shaft[0].length`",)),
+])
+def test_rotor_sizes_and_physical_ranges(tmp_path, cli, change, needles):
+    _one_line_error(cli("modes", _friswell_with(tmp_path, change), timeout=60), *needles)
+
+
+def test_periodic_harmonics_bounded(cli):
+    """10^7 harmonics ran out of memory (or time) before saying anything."""
+    _one_line_error(cli("periodic", "engine_gear_train", "--harmonics", "10000000", timeout=60),
+                    "`--harmonics`", "1..1000", "GB")
