@@ -118,6 +118,11 @@ def _state_margins(eps, c, c1, c2, h):
     return margins, np.stack([d1, d2], axis=-1)
 
 
+def _per_plate(eps: np.ndarray, *params) -> list[np.ndarray]:
+    """The plate parameters broadcast to the plates' shape ``eps.shape[:-1]``."""
+    return [np.broadcast_to(np.asarray(p, float), eps.shape[:-1]) for p in params]
+
+
 def classify(eps: np.ndarray, c: np.ndarray, c1: np.ndarray, c2: np.ndarray, h: np.ndarray) -> np.ndarray:
     """Contact state 1..10 of every plate (A4), exactly one each; (1.175)-(1.185).
 
@@ -131,7 +136,7 @@ def classify(eps: np.ndarray, c: np.ndarray, c1: np.ndarray, c2: np.ndarray, h: 
     The state whose existence conditions hold; on a state boundary (where the
     forces of both states agree) the one nearest to holding, lower number on ties.
     """
-    margins, _ = _state_margins(eps, *np.broadcast_arrays(c, c1, c2, h))
+    margins, _ = _state_margins(eps, *_per_plate(eps, c, c1, c2, h))
     return np.argmax(margins, axis=-1) + 1
 
 
@@ -163,7 +168,7 @@ def plate_state(eps: np.ndarray, c: np.ndarray, c1: np.ndarray, c2: np.ndarray, 
     Arguments as :func:`classify`.  ``T >= 0`` and ``|M_a| <= h T / 2`` hold
     in every state; ``delta`` minimises the convex plate energy (spec section 4.3).
     """
-    c, c1, c2, h = np.broadcast_arrays(c, c1, c2, h)
+    c, c1, c2, h = _per_plate(eps, c, c1, c2, h)
     margins, candidates = _state_margins(eps, c, c1, c2, h)
     idx = np.argmax(margins, axis=-1)
     delta = np.take_along_axis(candidates, idx[..., None, None], axis=-2)[..., 0, :]
@@ -186,7 +191,7 @@ def clamped_plate_state(eps: np.ndarray, c: np.ndarray, c1: np.ndarray, c2: np.n
     is slack (state 10, no force); otherwise it stays in state 1 and ``T = c Delta``
     may be negative.  Arguments as :func:`classify`.
     """
-    c, c1, c2 = np.broadcast_arrays(c, c1, c2)
+    c, c1, c2 = _per_plate(eps, c, c1, c2)
     Delta = eps[..., 2]
     active = Delta > 0 if drop_compressed else np.ones(Delta.shape, bool)
     state = np.where(active, 1, SLACK)
