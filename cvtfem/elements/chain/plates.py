@@ -222,6 +222,43 @@ def _shape_functions(xi: np.ndarray, l: np.ndarray) -> tuple[np.ndarray, np.ndar
     return H, Hp
 
 
+def _linear_maps(xi: np.ndarray, l: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``B`` (S + (3, 20)) with ``V = U_2(xi) - U_1(xi) = B q`` and ``Tt`` (S + (2, 2, 20)) with
+    ``t_perp_a = Tt[a] q`` (1.186)-(1.187), over the local coordinates of :data:`N_LOCAL`."""
+    H, Hp = _shape_functions(xi, np.broadcast_to(l, xi.shape))
+    eye2 = np.eye(2)
+    Bperp = (H[..., None, :, None] * eye2[:, None, :]).reshape(xi.shape + (2, 8))        # d V_perp / d u_perp
+    Tp = (2.0 / np.asarray(l)[..., None, None] * Hp[..., None, :, None] * eye2[:, None, :]).reshape(xi.shape + (2, 8))
+    zero2, zero8 = np.zeros(xi.shape + (2, 2)), np.zeros(xi.shape + (2, 8))
+    par = np.stack([np.ones_like(xi), xi], axis=-1)[..., None, :]                          # d V_par / d u_par
+    B = np.concatenate([np.concatenate([-Bperp, zero2, Bperp, zero2], -1),
+                        np.concatenate([0 * Bperp[..., :1, :], -par, 0 * Bperp[..., :1, :], par], -1)], -2)
+    Tt = np.stack([np.concatenate([Tp, zero2, zero8, zero2], -1),
+                   np.concatenate([zero8, zero2, Tp, zero2], -1)], axis=-3)
+    return B, Tt
+
+
+def _local(u1perp, u1par, u2perp, u2par) -> np.ndarray:
+    """Local coordinate vector ``q`` (S + (20,)) of :data:`N_LOCAL`."""
+    S = u1par.shape[:-1]
+    return np.concatenate([u1perp.reshape(S + (8,)), u1par, u2perp.reshape(S + (8,)), u2par], axis=-1)
+
+
+def _geometry(u1perp, u1par, u2perp, u2par, xi, l, L):
+    """``q``, ``B``, ``Tt``, ``tau`` (S + (3,)), ``L~``, ``t_a`` (S + (2, 3)), ``eps``."""
+    xi = np.asarray(xi, float)
+    q = _local(u1perp, u1par, u2perp, u2par)
+    B, Tt = _linear_maps(xi, l)
+    V = np.einsum("...ij,...j->...i", B, q)
+    Lt = np.sqrt(np.sum(V * V, axis=-1))
+    tau = V / Lt[..., None]
+    tperp = np.einsum("...aij,...j->...ai", Tt, q)
+    t = np.concatenate([tperp, np.ones(tperp.shape[:-1] + (1,))], axis=-1)
+    psi = np.einsum("...ai,...i->...a", t, tau)
+    eps = np.concatenate([psi, (Lt - L)[..., None]], axis=-1)
+    return q, B, Tt, tau, Lt, t, eps
+
+
 def plate_strains(u1perp: np.ndarray, u1par: np.ndarray, u2perp: np.ndarray, u2par: np.ndarray,
                   xi: np.ndarray, l: np.ndarray, L: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Rigid-attachment strains of every plate and their gradient; (1.186)-(1.189), (1.199)-(1.202), (1.209).
@@ -240,37 +277,37 @@ def plate_strains(u1perp: np.ndarray, u1par: np.ndarray, u2perp: np.ndarray, u2p
     Returns
     -------
     eps : ndarray S + (3,)
-        ``(psi_1, psi_2, Delta)`` (rad, rad, m); ``Delta = |V| - L`` exactly.
+        ``(psi_1, psi_2, Delta)`` (rad, rad, m); ``Delta = |V| - L`` exactly, ``psi_a = tau . t_a``.
     J : ndarray S + (3, 20)
-        ``d eps / d q`` over the local coordinates ``q`` (layout :data:`N_LOCAL`).
+        ``d eps / d q`` over the local coordinates ``q`` (layout :data:`N_LOCAL`); with
+        ``1 / L~`` and ``2 h_i' / l`` as corrected in spec section 9, item 11.
     """
-    xi = np.asarray(xi, float)
-    l = np.broadcast_to(l, xi.shape)
-    H, Hp = _shape_functions(xi, l)
-    du = u2perp - u1perp
-    Vperp = np.einsum("...i,...ij->...j", H, du)
-    Vpar = u2par[..., 0] - u1par[..., 0] + xi * (u2par[..., 1] - u1par[..., 1])
-    Lt = np.sqrt(np.sum(Vperp ** 2, axis=-1) + Vpar ** 2)
-    tperp, tpar = Vperp / Lt[..., None], Vpar / Lt
-    t1 = 2.0 / l[..., None] * np.einsum("...i,...ij->...j", Hp, u1perp)
-    t2 = 2.0 / l[..., None] * np.einsum("...i,...ij->...j", Hp, u2perp)
-    psi = np.stack([np.sum(tperp * t1, -1) + tpar, np.sum(tperp * t2, -1) + tpar], axis=-1)
-    eps = np.concatenate([psi, (Lt - L)[..., None]], axis=-1)
-    # gradients w.r.t. V: dDelta/dV = tau, dpsi_a/dV = (t_a - tau psi_a) / L~ = e_a
-    gV_perp = np.stack([(t1 - tperp * psi[..., :1]) / Lt[..., None],
-                        (t2 - tperp * psi[..., 1:]) / Lt[..., None], tperp], axis=-2)      # S + (3, 2)
-    gV_par = np.stack([(1 - tpar * psi[..., 0]) / Lt, (1 - tpar * psi[..., 1]) / Lt, tpar], axis=-1)  # S + (3,)
-    dperp = H[..., None, :, None] * gV_perp[..., :, None, :]                                # S + (3, 4, 2)
-    dpar = np.stack([gV_par, gV_par * xi[..., None]], axis=-1)                               # S + (3, 2)
-    # own-end tangent: dpsi_a / du_perp_{a,i} += 2 h_i' / l tau_perp
-    own = 2.0 / l[..., None, None] * Hp[..., :, None] * tperp[..., None, :]                  # S + (4, 2)
-    zero = np.zeros_like(own)
-    own1 = np.stack([own, zero, zero], axis=-3)
-    own2 = np.stack([zero, own, zero], axis=-3)
-    shape = eps.shape[:-1] + (3, 8)
-    J = np.concatenate([(own1 - dperp).reshape(shape), -dpar,
-                        (own2 + dperp).reshape(shape), dpar], axis=-1)
-    return eps, J
+    _, B, Tt, tau, Lt, t, eps = _geometry(u1perp, u1par, u2perp, u2par, xi, l, L)
+    e = (t - tau[..., None, :] * eps[..., :2, None]) / Lt[..., None, None]          # d psi_a / d V
+    Jpsi = np.einsum("...ai,...ij->...aj", e, B) + np.einsum("...i,...aij->...aj", tau[..., :2], Tt)
+    JD = np.einsum("...i,...ij->...j", tau, B)
+    return eps, np.concatenate([Jpsi, JD[..., None, :]], axis=-2)
+
+
+def strain_hessians(u1perp: np.ndarray, u1par: np.ndarray, u2perp: np.ndarray, u2par: np.ndarray,
+                    xi: np.ndarray, l: np.ndarray, L: np.ndarray) -> np.ndarray:
+    """Second derivatives ``d^2 eps / dq^2`` (S + (3, 20, 20)) of the strains of :func:`plate_strains` (same arguments).
+
+    With ``P = E - tau tau``: ``d^2 Delta / dV^2 = P / L~``, ``d^2 psi_a / dV^2 = -(psi_a P / L~ + tau e_a + e_a tau) / L~``,
+    ``d^2 psi_a / dV dt_perp_a = P_perp / L~`` (derived from (1.186)-(1.189)).
+    """
+    _, B, Tt, tau, Lt, t, eps = _geometry(u1perp, u1par, u2perp, u2par, xi, l, L)
+    Pm = (np.eye(3) - tau[..., :, None] * tau[..., None, :]) / Lt[..., None, None]     # P / L~
+    e = (t - tau[..., None, :] * eps[..., :2, None]) / Lt[..., None, None]
+    HD = np.einsum("...ki,...kl,...lj->...ij", B, Pm, B)
+    out = []
+    for a in range(2):
+        ea = e[..., a, :]
+        G = -(eps[..., a, None, None] * Pm + tau[..., :, None] * ea[..., None, :]
+              + ea[..., :, None] * tau[..., None, :]) / Lt[..., None, None]
+        mixed = np.einsum("...ki,...kl,...lj->...ij", B, Pm[..., :, :2], Tt[..., a, :, :])
+        out.append(np.einsum("...ki,...kl,...lj->...ij", B, G, B) + mixed + np.swapaxes(mixed, -1, -2))
+    return np.stack(out + [HD], axis=-3)
 
 
 def strain_forces(st: PlateState, epsdot: np.ndarray, c: np.ndarray, c1: np.ndarray, c2: np.ndarray,
@@ -310,6 +347,30 @@ def plate_forces(st: PlateState, J: np.ndarray, qdot: np.ndarray, c: np.ndarray,
     epsdot = np.einsum("...ij,...j->...i", J, qdot)
     g = strain_forces(st, epsdot, c, c1, c2, beta_ext, beta_shear)
     return np.einsum("...ji,...j->...i", J, g)
+
+
+def force_jacobians(st: PlateState, J: np.ndarray, Heps: np.ndarray, qdot: np.ndarray, c: np.ndarray,
+                    c1: np.ndarray, c2: np.ndarray, beta_ext: float,
+                    beta_shear: float) -> tuple[np.ndarray, np.ndarray]:
+    """``dQ/dq`` and ``dQ/dqdot`` (S + (20, 20) each) of :func:`plate_forces` within the plate's current state.
+
+    ``Heps`` from :func:`strain_hessians`.  With ``K = diag(C, c)``, ``D = diag(beta_shear C, beta_ext c)``
+    and ``g`` of :func:`strain_forces`: ``dQ/dqdot = -J^T A^T D A J`` and
+    ``dQ/dq = sum_s g_s Heps_s - J^T A^T K A J - J^T A^T D A (Heps qdot)``.  ``A`` jumps across state
+    boundaries, so do these matrices (the forces do not).
+    """
+    c, c1, c2 = (np.broadcast_to(np.asarray(x, float), st.tension.shape) for x in (c, c1, c2))
+    z = np.zeros_like(c)
+    K = np.stack([np.stack([c1, c2, z], -1), np.stack([c2, c1, z], -1), np.stack([z, z, c], -1)], -2)
+    D = K * np.array([beta_shear, beta_shear, beta_ext])[:, None]
+    AJ = np.einsum("...ij,...jk->...ik", st.A, J)
+    epsdot = np.einsum("...ij,...j->...i", J, qdot)
+    g = strain_forces(st, epsdot, c, c1, c2, beta_ext, beta_shear)
+    dQ_dqdot = -np.einsum("...ji,...jk,...kl->...il", AJ, D, AJ)
+    Hq = np.einsum("...sij,...j->...si", Heps, qdot)                                   # d(J qdot)/dq
+    dQ_dq = (np.einsum("...s,...sij->...ij", g, Heps) - np.einsum("...ji,...jk,...kl->...il", AJ, K, AJ)
+             - np.einsum("...ji,...jk,...kl->...il", AJ, D, np.einsum("...ij,...jk->...ik", st.A, Hq)))
+    return dQ_dq, dQ_dqdot
 
 
 def output_specs(n_plates: int) -> tuple[OutputSpec, ...]:

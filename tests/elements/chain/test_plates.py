@@ -375,6 +375,62 @@ def test_strains_of_rigid_motions_and_a_plain_tilt(plates):
     np.testing.assert_allclose(e[0], [theta, 0.0, 0.0], atol=theta ** 2)
 
 
+def test_strain_hessians_equal_finite_differences_of_the_gradient(plates):
+    q, xi, eps, J, _ = plates
+    q, xi, J = q[:2000], xi[:2000], J[:2000]
+    n = len(q)
+    H = P.strain_hessians(q[:, :8].reshape(n, 4, 2), q[:, 8:10], q[:, 10:18].reshape(n, 4, 2), q[:, 18:20],
+                          xi, L_PIN, L_PITCH)
+    steps = coordinate_steps(q)
+    fd = np.zeros_like(H)
+    for j in range(20):
+        e = np.zeros(20)
+        e[j] = steps[j]
+        fd[..., j] = (strains(q + e, xi)[1] - strains(q - e, xi)[1]) / (2 * steps[j])
+    scale = np.abs(H).max((2, 3), keepdims=True)
+    assert (np.abs(fd - H) / scale).max() < 1e-6
+
+
+def test_force_jacobians_equal_finite_differences(plates):
+    """dQ/dq and dQ/dqdot of the elastic + damping plate forces, in every state."""
+    q, xi, eps, J, st = plates
+    pick = np.concatenate([np.flatnonzero(st.state == s)[:30] for s in range(1, 11)])
+    q, xi = q[pick], xi[pick]
+    n = len(q)
+    c, c1, c2, _ = law()
+    be, bs = 3e-6, 7e-6
+    qdot = np.random.default_rng(4).normal(size=q.shape) * 1e-1
+    split = (lambda x: (x[:, :8].reshape(n, 4, 2), x[:, 8:10], x[:, 10:18].reshape(n, 4, 2), x[:, 18:20]))
+
+    def forces(x, v):
+        e, Jx = strains(x, xi)
+        s = P.plate_state(e, *law())
+        return P.plate_forces(s, Jx, v, c, c1, c2, be, bs), s.state
+
+    e0, J0 = strains(q, xi)
+    st0 = P.plate_state(e0, *law())
+    H0 = P.strain_hessians(*split(q), xi, L_PIN, L_PITCH)
+    Kq, Kv = P.force_jacobians(st0, J0, H0, qdot, c, c1, c2, be, bs)
+    steps = coordinate_steps(q)
+    fq, fv = np.zeros_like(Kq), np.zeros_like(Kv)
+    same = np.ones(n, bool)
+    for j in range(20):
+        e = np.zeros(20)
+        e[j] = steps[j]
+        (Qp, sp_), (Qm, sm) = forces(q + e, qdot), forces(q - e, qdot)
+        same &= (sp_ == st0.state) & (sm == st0.state)
+        fq[..., j] = (Qp - Qm) / (2 * steps[j])
+        e[j] = 1e-3
+        fv[..., j] = (forces(q, qdot + e)[0] - forces(q, qdot - e)[0]) / 2e-3
+    live = same & (st0.state != P.SLACK)
+    assert live.sum() >= 260
+    assert np.all(Kq[st0.state == P.SLACK] == 0) and np.all(Kv[st0.state == P.SLACK] == 0)
+    eq = np.linalg.norm(fq - Kq, axis=(1, 2))[live] / np.linalg.norm(Kq, axis=(1, 2))[live]
+    ev = np.linalg.norm(fv - Kv, axis=(1, 2))[live] / np.linalg.norm(Kv, axis=(1, 2))[live]
+    assert eq.max() < 1e-6 and ev.max() < 1e-6
+    np.testing.assert_allclose(Kv, np.swapaxes(Kv, 1, 2), rtol=0, atol=1e-12 * np.abs(Kv).max())
+
+
 def test_forces_are_minus_the_energy_gradient_in_every_state(plates):
     """Elastic plate forces J^T A^T f equal -dPi/dq by central differences to 1e-6 relative (1.203)-(1.209)."""
     q, xi, eps, J, st = plates
