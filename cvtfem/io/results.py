@@ -31,6 +31,7 @@ name next to it and moved over the original once it is consistent.
 """
 from __future__ import annotations
 
+import fcntl
 import os
 import struct
 import time
@@ -49,6 +50,34 @@ from cvtfem.io import checkpoint as ckpt
 from cvtfem.outputs import OutputSpec
 
 CHUNK_ROWS = 256
+
+
+class RunLock:
+    """An exclusive lock on a results file while one process writes it (``flock`` on a hidden sidecar
+    ``.NAME.lock``, released by :meth:`release` or by the process's death, also by ``kill -9``)."""
+
+    def __init__(self, path: Path, where: str) -> None:
+        self.path = path.with_name(f".{path.name}.lock")
+        path.parent.mkdir(parents=True, exist_ok=True)
+        self._fh = open(self.path, "a+")
+        try:
+            fcntl.flock(self._fh, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            self._fh.seek(0)
+            owner = self._fh.read().strip() or "unknown"
+            self._fh.close()
+            raise InputError(where, str(path), f"must not be in use: a running cvtfem process (pid {owner}) is "
+                             "writing it", "wait for it to end, or stop it first") from None
+        self._fh.seek(0)
+        self._fh.truncate()
+        self._fh.write(str(os.getpid()))
+        self._fh.flush()
+
+    def release(self) -> None:
+        """Unlock and remove the sidecar (idempotent)."""
+        if not self._fh.closed:
+            self.path.unlink(missing_ok=True)
+            self._fh.close()
 
 
 class ResultsWriter:
@@ -74,12 +103,12 @@ class ResultsWriter:
 
     def __init__(self, path: str | Path, scene_toml: str, kind: str, outputs: Sequence[OutputSpec],
                  flush_interval: float = 2.0, overwrite: bool = False, checkpoint: ckpt.Layout | None = None,
-                 _resume: dict[str, Any] | None = None) -> None:
+                 _resume: dict[str, Any] | None = None, _lock: RunLock | None = None) -> None:
         self.path = Path(path)
         if self.path.exists() and not overwrite:
             raise InputError("results file", str(self.path), "must not exist already (results are never overwritten)",
                              "choose another name or delete it")
-        self.path.parent.mkdir(parents=True, exist_ok=True)
+        self._lock = _lock or RunLock(self.path, "results file")
         self.flush_interval = flush_interval
         self.scene_toml = scene_toml
         self._file = h5py.File(self.path, "w", libver="latest")
@@ -157,6 +186,16 @@ class ResultsWriter:
         path = Path(path)
         if not path.is_file():
             raise InputError(where, str(path), "must be an existing results file (.h5) of a killed run")
+        lock = RunLock(path, where)
+        try:
+            return cls._resume(path, flush_interval, where, lock)
+        except BaseException:
+            lock.release()
+            raise
+
+    @classmethod
+    def _resume(cls, path: Path, flush_interval: float, where: str,
+                lock: RunLock) -> tuple[ResultsWriter, int, dict[str, np.ndarray]]:
         f = _open_for_reading(path, where)
         with f:
             attrs = dict(f.attrs)
@@ -191,7 +230,7 @@ class ResultsWriter:
         fields = tuple(fd for fd in layout.fields if fd[0] != "rows")
         tmp = path.with_name(path.name + ".resume-tmp")
         writer = cls(tmp, scene_toml, "run", specs, flush_interval, overwrite=True, checkpoint=ckpt.Layout(fields),
-                     _resume=resume)
+                     _resume=resume, _lock=lock)
         os.replace(tmp, path)  # the open file follows the rename
         writer.path = path
         return writer, seq, values
@@ -250,14 +289,17 @@ class ResultsWriter:
         """Flush, then record statistics, arrays and the final status ("finished" or "failed")."""
         if not self._file.id.valid:
             return
-        self.flush()
-        self._file.close()
-        with h5py.File(self.path, "r+", libver="latest") as f:
-            f.attrs.update(status=status, message=message)
-            f["stats"].attrs.update(self._stats)
-            for name, (data, unit, doc) in self._arrays.items():
-                d = f.create_dataset(name, data=data)
-                d.attrs.update(unit=unit, doc=doc)
+        try:
+            self.flush()
+            self._file.close()
+            with h5py.File(self.path, "r+", libver="latest") as f:
+                f.attrs.update(status=status, message=message)
+                f["stats"].attrs.update(self._stats)
+                for name, (data, unit, doc) in self._arrays.items():
+                    d = f.create_dataset(name, data=data)
+                    d.attrs.update(unit=unit, doc=doc)
+        finally:
+            self._lock.release()
 
     def __enter__(self) -> ResultsWriter:
         return self

@@ -152,3 +152,29 @@ def test_periodic_harmonics_bounded(cli):
     """10^7 harmonics ran out of memory (or time) before saying anything."""
     _one_line_error(cli("periodic", "engine_gear_train", "--harmonics", "10000000", timeout=60),
                     "`--harmonics`", "1..1000", "GB")
+
+
+def test_resume_of_a_running_run_is_refused_and_works_after_a_kill(tmp_path, cli):
+    """`--resume` on a file another process is writing was accepted and the original died with a traceback;
+    the writer now holds a lock (flock on a sidecar), which a kill -9 releases."""
+    import os
+    import signal
+    import subprocess
+    import sys
+
+    scene = tmp_path / "s.toml"
+    scene.write_text('preset = "band-4dof"\n[solver]\nmethod = "rk4"\nh = 2e-6\n'
+                     '[output]\ncheckpoint_interval = 0.002\n')
+    results = tmp_path / "r.h5"
+    proc = subprocess.Popen([sys.executable, "-m", "cvtfem.cli", "run", str(scene), "--until", "1", "--results",
+                             str(results), "--report-checkpoints"], stdout=subprocess.PIPE, text=True)
+    try:
+        assert proc.stdout.readline().startswith("checkpoint 1")
+        _one_line_error(cli("run", "--resume", str(results)), "must not be in use", f"pid {proc.pid}")
+        _one_line_error(cli("run", str(scene), "--results", str(results), "--overwrite"), "must not be in use")
+    finally:
+        os.kill(proc.pid, signal.SIGKILL)
+        proc.wait()
+    from cvtfem.io.results import RunLock
+
+    RunLock(results, "--resume").release()   # the killed writer's lock is gone with it
