@@ -34,14 +34,14 @@ def impact_impulse(v_r, normal, A, f):
 
     ``v_r`` ``(n, 3)`` relative velocity pin minus sheave before impact (m/s), ``normal``
     ``(n, 3)`` unit outward sheave normals, ``A`` ``(n, 3, 3)`` from :func:`impact_compliance`,
-    ``f`` friction coefficient. Stick (``v_r+ = 0``) when the stick impulse satisfies (1.301)
+    ``f`` friction coefficients (scalar or (n,)). Stick (``v_r+ = 0``) when the stick impulse satisfies (1.301)
     (``|tau| <= 1``, ``tau . tau- >= 0``), else sliding with (1.305) and ``alpha = E_t``.
     Where ``n . v_r >= 0`` (separating) ``P = 0`` and the state is ``FREE``; where the sliding
     denominator of (1.305) is not positive, stick (digest §3, edge cases).
     Returns ``(P (n, 3), state (n,) in {FREE, SLIDING, STUCK})``.
     """
     v_r, normal = np.asarray(v_r, dtype=float), np.asarray(normal, dtype=float)
-    A = np.asarray(A, dtype=float)
+    A, f = np.asarray(A, dtype=float), np.asarray(f, dtype=float)
     proj = np.eye(3) - _outer(normal, normal)
     vn = np.sum(normal * v_r, axis=-1)
     vt = np.einsum("...ij,...j->...i", proj, v_r)
@@ -55,7 +55,7 @@ def impact_impulse(v_r, normal, A, f):
     stick = (Pn_st > 0.0) & (np.linalg.norm(Pt_st, axis=-1) <= f * Pn_st) \
         & (np.sum(Pt_st * tau_minus, axis=-1) <= 0.0)
 
-    d = normal - f * tau_minus
+    d = normal - f[..., None] * tau_minus
     denom = np.sum(normal * np.einsum("...ij,...j->...i", A, d), axis=-1)
     stick |= denom <= 0.0
     Pn = -vn / np.where(denom > 0.0, denom, 1.0)
