@@ -1,0 +1,213 @@
+"""H2 refined biconvex kinematics (contact-models digest §5, §10.4 items 8 and 9)."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from scipy.optimize import minimize
+
+from cvtfem.elements.contact.hertz import hertz_force, hertz_potential
+from cvtfem.elements.contact.pin_axis import pin_axis_contact, pin_axis_forces
+from cvtfem.elements.contact.refined import (pin_coefficients, pin_loads, refined_contact, refined_force,
+                                             refined_slip, sheave_coefficients)
+from cvtfem.elements.contact.sheave import rotation
+from cvtfem.errors import NumericalError
+
+C = 2.0e10
+K = np.array([0.0, 0.0, 1.0])
+
+
+def _quad(c0, c1, C2, x):
+    return c0 + np.sum(c1 * x, -1) + 0.5 * np.einsum("...i,...ij,...j->...", x, C2, x)
+
+
+def _poses(profile, n, seed, tilt=5e-3):
+    """Crowned pin faces (R_tau 0.1-1 m, R_n 10-40 mm) at the pin-axis end near a tilted sheave."""
+    rng = np.random.default_rng(seed)
+    R_c = rng.normal(size=(n, 3)) * 1e-4
+    gamma = rng.normal(size=(n, 2)) * tilt
+    r, phi = rng.uniform(0.036, 0.088, n), rng.uniform(0, 2 * np.pi, n)
+    x0 = R_c[:, :2] + np.stack([r * np.cos(phi), r * np.sin(phi)], -1)
+    z_pin = R_c[:, 2] + profile(r)[0] + rng.uniform(-3e-5, 3e-5, n)
+    slope = rng.normal(size=(n, 2)) * tilt
+    psi = phi + np.pi / 2 + rng.normal(size=n) * 0.05       # pin along the circumference
+    tau = np.stack([np.cos(psi), np.sin(psi)], -1)
+    Bcal = np.zeros((n, 2, 2))
+    Bcal[:, 0, 0] = 1 / rng.uniform(0.1, 1.0, n)
+    Bcal[:, 1, 1] = 1 / rng.uniform(0.01, 0.04, n)
+    return dict(R_c=R_c, gamma=gamma, x0=x0, z_pin=z_pin, slope=slope, tau=tau, Bcal=Bcal,
+                beta0=np.zeros(n), beta=np.zeros((n, 2)))
+
+
+def _coefficients(profile, p):
+    sh = sheave_coefficients(p["x0"], p["R_c"], p["gamma"], profile)
+    pin = pin_coefficients(p["z_pin"], p["slope"], p["tau"], p["beta0"], p["beta"], p["Bcal"])
+    return (*sh, *pin)
+
+
+def test_closed_form_is_the_maximum_of_the_height_difference(profile):
+    """Delta = max_x (z_pul - z_pin) and x_* its argmax, against scipy's BFGS on 100 random poses;
+    the normals of both quadratics are antiparallel at x_* (digest §5.3)."""
+    p = _poses(profile, 100, 1)
+    coef = _coefficients(profile, p)
+    sh, pin = coef[:3], coef[3:]
+    con = refined_contact(p["x0"], *coef)
+    for i in range(100):
+        args = [tuple(c[i] for c in sh), tuple(c[i] for c in pin)]
+        gap = lambda x: _quad(*args[1], x * 1e-3) - _quad(*args[0], x * 1e-3)     # noqa: E731
+        res = minimize(gap, np.zeros(2), method="BFGS", options=dict(gtol=1e-14))
+        assert -res.fun == pytest.approx(con.delta[i], abs=1e-12)
+        assert np.allclose(res.x * 1e-3, con.offset[i], atol=1e-7)
+    g_pul = sh[1] + np.einsum("nij,nj->ni", sh[2], con.offset)
+    g_pin = pin[1] + np.einsum("nij,nj->ni", pin[2], con.offset)
+    assert np.allclose(g_pul, g_pin, atol=1e-14)
+    assert np.allclose(con.normal, np.concatenate([-g_pul, np.ones((100, 1))], 1)
+                       / np.sqrt(1 + np.sum(g_pul ** 2, 1))[:, None], atol=1e-15)
+
+
+def _exact_sheave_height(profile, R_c, gamma, x):
+    """Height of the tilted sheave surface above the in-plane point x, by a 1-D solve along k."""
+    theta = np.concatenate([np.stack([-gamma[:, 1], gamma[:, 0]], -1), np.zeros((len(x), 1))], 1)  # gamma = theta x k
+    P = rotation(theta)
+    z = np.zeros(len(x))
+    for _ in range(50):      # fixed point on the body-frame height
+        d = np.einsum("nji,nj->ni", P, np.concatenate([x - R_c[:, :2], (z - R_c[:, 2])[:, None]], 1))
+        f, fp, _ = profile(np.hypot(d[:, 0], d[:, 1]))
+        z = z - (d[:, 2] - f) / (P[:, 2, 2] - fp * (P[:, 2, 0] * d[:, 0] + P[:, 2, 1] * d[:, 1])
+                                 / np.hypot(d[:, 0], d[:, 1]))
+    return z
+
+
+def test_sheave_coefficients_approximate_the_tilted_surface_to_second_order(profile):
+    """(1.343) drops O(|gamma|^2, |x|^3): halving the tilt and the offset divides the height error by >= 4."""
+    errs = []
+    for s in (1.0, 0.5, 0.25):
+        p = _poses(profile, 200, 2, tilt=2e-2 * s)
+        rng = np.random.default_rng(3)
+        x = rng.normal(size=(200, 2)) * 2e-3 * s
+        sh = sheave_coefficients(p["x0"], p["R_c"], p["gamma"], profile)
+        exact = _exact_sheave_height(profile, p["R_c"], p["gamma"], p["x0"] + x)
+        errs.append(np.max(np.abs(_quad(*sh, x) - exact)))
+    assert errs[0] / errs[1] > 3.5 and errs[1] / errs[2] > 3.5, errs
+
+
+def test_forces_are_minus_the_gradient_of_the_potential_for_translations(profile):
+    """-dPi/d(translation) of pin and sheave = +-N (k - g_*) (envelope theorem, digest §10.2), by
+    central differences to 1e-6 relative on 100 random poses: translating a graph
+    z = q(x) by t gives z = q(x - t_perp) + t_3, so the coefficients shift exactly."""
+    n = 100
+    p = _poses(profile, n, 4)
+    coef = _coefficients(profile, p)
+    sh, pin = coef[:3], coef[3:]
+
+    def shifted(c, t):
+        c0, c1, C2 = c
+        Ct = np.einsum("nij,nj->ni", C2, t[:, :2])
+        return (c0 + t[:, 2] - np.sum(c1 * t[:, :2], 1) + 0.5 * np.sum(t[:, :2] * Ct, 1), c1 - Ct, C2)
+
+    def potential(t_pul, t_pin):
+        return hertz_potential(refined_contact(p["x0"], *shifted(sh, t_pul), *shifted(pin, t_pin)).delta, C)
+
+    con = refined_contact(p["x0"], *sh, *pin)
+    N = hertz_force(con.delta, C)[0]
+    F = refined_force(con, N)
+    on = con.delta > 2e-6
+    assert on.sum() > 30
+    h, zero = 1e-9, np.zeros((n, 3))
+    for j in range(3):
+        e = np.zeros((n, 3))
+        e[:, j] = h
+        fd_pin = -(potential(zero, e) - potential(zero, -e)) / (2 * h)
+        fd_pul = -(potential(e, zero) - potential(-e, zero)) / (2 * h)
+        scale = np.linalg.norm(F, axis=1)
+        assert np.all(np.abs(F[on, j] - fd_pin[on]) <= 1e-6 * scale[on])
+        assert np.all(np.abs(-F[on, j] - fd_pul[on]) <= 1e-6 * scale[on])
+    assert np.allclose(F, (N * np.linalg.norm(np.concatenate([con.slope, np.ones((n, 1))], 1), axis=1))[:, None]
+                       * con.normal, atol=1e-12 * np.max(N))
+
+
+def test_matching_slopes_reduce_to_the_pin_axis_point_model(profile):
+    """a_vec = b_vec (a face with the sheave's slope, untilted): x_* = 0 and Delta, normal and
+    force are those of H1 at the pin-axis point (digest §10.4 item 8)."""
+    n = 50
+    p = _poses(profile, n, 5, tilt=0.0)
+    r = np.linalg.norm(p["x0"] - p["R_c"][:, :2], axis=1)
+    e = (p["x0"] - p["R_c"][:, :2]) / r[:, None]
+    c, s = p["tau"][:, 0], p["tau"][:, 1]
+    p["beta"] = np.einsum("nji,nj->ni", np.stack([np.stack([c, -s], -1), np.stack([s, c], -1)], -2),
+                          profile(r)[1][:, None] * e)            # P_phi^T (f' e_r)
+    con = refined_contact(p["x0"], *_coefficients(profile, p))
+    # round-off of a_vec - b_vec (1e-17) over the smallest eigenvalue of B - A (about 1 1/m)
+    assert np.allclose(con.offset, 0.0, atol=1e-16)
+    R_pin = np.concatenate([p["x0"], p["z_pin"][:, None]], 1)
+    h1 = pin_axis_contact(R_pin, p["R_c"], np.zeros((n, 3)), profile)
+    # the torus meridian is w - Rt with Rt = 0.6 m: its round-off is ulp(0.6) = 1.1e-16 m
+    assert np.allclose(con.delta, h1.delta, rtol=0, atol=4.5e-16)
+    assert np.allclose(con.normal, h1.normal, atol=1e-15)
+    N = hertz_force(con.delta, C)[0]
+    assert np.allclose(refined_force(con, N), pin_axis_forces(h1, N), rtol=0, atol=1e-12 * max(N.max(), 1.0))
+
+
+def test_very_curved_face_tends_to_the_pin_axis_point():
+    """As the face curvature B grows past the sheave's |A| (<= 5 1/m) the contact point tends to
+    the axis end, |x_*| ~ |a_vec - b_vec| / B, and Delta to the H1 penetration."""
+    from tests.elements.contact.conftest import cone
+    n = 20
+    p = _poses(cone, n, 6, tilt=0.0)
+    R_pin = np.concatenate([p["x0"], p["z_pin"][:, None]], 1)
+    h1 = pin_axis_contact(R_pin, p["R_c"], np.zeros((n, 3)), cone)
+    offs, gaps = [], []
+    for scale in (1e2, 1e3, 1e4):
+        con = refined_contact(p["x0"], *_coefficients(cone, dict(p, Bcal=p["Bcal"] * scale)))
+        offs.append(np.linalg.norm(con.offset, axis=1))
+        gaps.append(np.max(np.abs(con.delta - h1.delta)))
+    assert np.allclose(offs[0] / offs[1], 10.0, rtol=0.06) and np.allclose(offs[1] / offs[2], 10.0, rtol=0.006)
+    assert gaps[0] / gaps[1] == pytest.approx(10.0, rel=0.06) and gaps[1] / gaps[2] == pytest.approx(10.0, rel=0.006)
+
+
+def test_recentred_face_off_the_axis_end():
+    """beta0 != 0: the re-centred b_vec matches the gradient of the rotated face (digest §5.4, reviewed):
+    error 5e-6 (not 1.6e-4) for beta0 = 0.5 mm, R_n = 20 mm, slope 0.02."""
+    beta0, Rn, sl = 0.5e-3, 0.02, 0.02
+    Bcal = np.diag([0.0, 1 / Rn])[None]
+    tau = np.array([[1.0, 0.0]])
+    slope = np.array([[0.0, sl]])
+    b, bv, _ = pin_coefficients(np.zeros(1), slope, tau, np.array([beta0]), np.zeros((1, 2)), Bcal)
+    # exact: face z = beta0 + y^2/(2 Rn) in the pin frame, rotated so that its axis k gets slope (0, sl)
+    th = np.array([[sl, 0.0, 0.0]])            # rotation about x: k -> (0, -sin, cos) ... choose sign below
+    P = rotation(-th)                          # k -> (0, sin sl, cos sl): slope +sl in y
+    assert P[0, 1, 2] / P[0, 2, 2] == pytest.approx(np.tan(sl))
+    y = np.linspace(-3e-3, 3e-3, 20001)
+    face = np.stack([0 * y, y, beta0 + y ** 2 / (2 * Rn)], -1) @ P[0].T
+    i = np.argmin(np.abs(face[:, 1]))
+    grad = np.gradient(face[:, 2], face[:, 1])[i]
+    assert abs(bv[0, 1] - grad) < 2e-5
+
+
+def test_point_loads_and_slip_power():
+    """Q_p, Q'_p and Q_phi do the virtual work F . dR_* of (1.350), and with the slip at R_* the
+    friction power is F . v_r (digest §5.5–5.6)."""
+    rng = np.random.default_rng(8)
+    n = 50
+    F = rng.normal(size=(n, 3))
+    rho = rng.normal(size=(n, 3)) * 1e-3
+    u1 = np.concatenate([rng.normal(size=(n, 2)) * 1e-2, np.zeros((n, 1))], 1)
+    H = rng.uniform(-3e-3, 3e-3, n)
+    n_perp = np.concatenate([rng.normal(size=(n, 2)), np.zeros((n, 1))], 1)
+    n_perp /= np.linalg.norm(n_perp, axis=1, keepdims=True)
+    du, du1, dphi = rng.normal(size=(n, 3)), np.concatenate([rng.normal(size=(n, 2)), np.zeros((n, 1))], 1), \
+        rng.normal(size=n)
+    Qp, Q1, Qphi = pin_loads(F, rho, u1, H, n_perp)
+    dR = du + np.cross(np.cross(K, du1), rho) + (np.cross(K + u1, rho) + H[:, None] * n_perp) * dphi[:, None]
+    assert np.allclose(np.sum(Qp * du + Q1 * du1, 1) + Qphi * dphi, np.sum(F * dR, 1), rtol=1e-12, atol=1e-15)
+    with pytest.raises(NumericalError):
+        refined_contact(np.zeros((1, 2)), np.zeros(1), np.zeros((1, 2)), np.eye(2)[None], np.zeros(1),
+                        np.zeros((1, 2)), 0.5 * np.eye(2)[None])
+    # slip: rigid motion shared by both bodies gives zero slip
+    from cvtfem.elements.contact.refined import RefinedContact
+    R_s = rng.normal(size=(n, 3)) * 0.05
+    nrm = np.tile(K, (n, 1))
+    con = RefinedContact(np.zeros(n), np.zeros((n, 2)), R_s, np.zeros((n, 2)), nrm)
+    R_pin, R_c = R_s - rho, rng.normal(size=(n, 3)) * 1e-3
+    w, v0 = rng.normal(size=(n, 3)), rng.normal(size=(n, 3))
+    slip = refined_slip(con, R_pin, v0 + np.cross(w, R_pin - R_c), w, R_c, v0, w)
+    assert np.allclose(slip, 0.0, atol=1e-15)
