@@ -164,6 +164,33 @@ def test_very_curved_face_tends_to_the_pin_axis_point():
     assert gaps[0] / gaps[1] == pytest.approx(10.0, rel=0.06) and gaps[1] / gaps[2] == pytest.approx(10.0, rel=0.006)
 
 
+def test_pin_tilted_about_tau_gets_a_restoring_moment():
+    """Digest §6 item 2, §10.4 item 8: a pin whose axis tilts radially by s (rotation about tau) on a
+    cone moves its contact point by (f' + s) R_n radially; at fixed N the bending moment
+    Q'_p = (rho x F) x k changes by -R_n N s (1 + tan^2 gamma / 2) e_r (restoring; the tan^2 term
+    is the lever of the axial contact-point height rho_z, whose odd part is -s tan gamma R_n / 2)."""
+    from tests.elements.contact.conftest import TAN_GAMMA, cone
+    n, N, Rn = 8, 1e3, 0.02
+    phi = np.linspace(0, 2 * np.pi, n, endpoint=False)
+    e_r = np.stack([np.cos(phi), np.sin(phi)], -1)
+    x0 = 0.06 * e_r
+    tau = np.stack([-np.sin(phi), np.cos(phi)], -1)
+    Bcal = np.broadcast_to(np.diag([0.0, 1 / Rn]), (n, 2, 2))     # cylindrical face, curved along n_perp
+    z_pin = cone(0.06)[0] - 1e-5
+    Q = []
+    for s in (-1e-3, 1e-3):
+        pin = pin_coefficients(np.full(n, z_pin), s * e_r, tau, np.zeros(n), np.zeros((n, 2)), Bcal)
+        con = refined_contact(x0, *sheave_coefficients(x0, np.zeros((n, 3)), np.zeros((n, 2)), cone), *pin)
+        assert np.allclose(np.sum(con.offset * e_r, 1), (s - TAN_GAMMA) * Rn, rtol=1e-12)
+        R_pin = np.concatenate([x0, np.full((n, 1), z_pin)], 1)
+        slope3 = np.concatenate([s * e_r, np.zeros((n, 1))], 1)
+        n_perp = np.concatenate([np.stack([-tau[:, 1], tau[:, 0]], -1), np.zeros((n, 1))], 1)
+        Q.append(pin_loads(refined_force(con, np.full(n, N)), con.point - R_pin, slope3, np.zeros(n), n_perp)[1])
+    dQ = (Q[1] - Q[0])[:, :2]
+    assert np.allclose(np.sum(dQ * e_r, 1), -Rn * N * 2e-3 * (1 + TAN_GAMMA ** 2 / 2), rtol=1e-9)
+    assert np.allclose(np.sum(dQ * tau, 1), 0.0, atol=1e-14)   # round-off of moments N |x_*| ~ 4 N m
+
+
 def test_recentred_face_off_the_axis_end():
     """beta0 != 0: the re-centred b_vec matches the gradient of the rotated face (digest §5.4, reviewed):
     error 5e-6 (not 1.6e-4) for beta0 = 0.5 mm, R_n = 20 mm, slope 0.02."""
