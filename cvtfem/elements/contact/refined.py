@@ -3,8 +3,10 @@
 Both surfaces are local graphs over the plane normal to ``k``, quadratic about the in-plane pin
 point ``x0`` (1.331): sheave ``z = a + a.x + x.A x/2``, pin face ``z = b + b.x + x.B x/2`` with
 ``B - A`` positive definite. The contact point, penetration (along ``k``) and normal are the
-closed form of §5.3. Written for a sheave below the pin (side ``+1``); the other side is the
-mirror image. Vectorised over contacts: in-plane vectors ``(n, 2)``, tensors ``(n, 2, 2)``.
+closed form of §5.3. The coefficients live in the frame of a sheave below the pin: for a sheave
+on the other side (``side = -1``, its material on the ``+k`` side) the functions mirror ``z -> -z``
+on the way in and back on the way out. Vectorised over contacts: in-plane vectors ``(n, 2)``,
+tensors ``(n, 2, 2)``.
 """
 from __future__ import annotations
 
@@ -22,8 +24,8 @@ class RefinedContact:
     delta: np.ndarray    # (n,) penetration max(z_pul - z_pin) along k (m)
     offset: np.ndarray   # (n, 2) contact point relative to x0, x_hat_* (m)
     point: np.ndarray    # (n, 3) contact point R_* (m), mid-way between the surfaces
-    slope: np.ndarray    # (n, 2) common surface gradient g_* (-)
-    normal: np.ndarray   # (n, 3) outward unit sheave normal (k - g_*)/|k - g_*|
+    grad: np.ndarray     # (n, 3) dDelta/d(pin translation) = -side (k - g_*) (-), g_* the common slope
+    normal: np.ndarray   # (n, 3) outward unit sheave normal -grad/|grad|
 
 
 def _rot2(tau):
@@ -40,13 +42,15 @@ def _tilted(c0, c1, C2, gamma):
     return c0, lin, quad
 
 
-def sheave_coefficients(x0, R_c, gamma, profile):
+def sheave_coefficients(x0, R_c, gamma, profile, side=1.0):
     """Sheave quadratic ``(a, a_vec, A)`` (m, -, 1/m) about in-plane points ``x0`` (n, 2) (m); (1.339)–(1.343).
 
     ``R_c`` (n, 3) sheave centre (m), ``gamma = theta x k`` (n, 2) its tilt (rad), ``profile(r) ->
-    (f, f', f'')`` its meridian ``z - z_c = f(r)``. One pass ``xi0 = x0 - x_c - f(|x0 - x_c|) gamma``.
+    (f, f', f'')`` its meridian ``z - z_c = side f(r)``. One pass ``xi0 = x0 - x_c - f(|x0 - x_c|) gamma``.
     """
-    R_c, gamma = np.asarray(R_c, dtype=float), np.asarray(gamma, dtype=float)
+    s = np.asarray(side, dtype=float)
+    R_c = np.asarray(R_c, dtype=float) * np.stack([np.ones_like(s), np.ones_like(s), s], -1)
+    gamma = s[..., None] * np.asarray(gamma, dtype=float)
     xt = np.asarray(x0, dtype=float) - R_c[..., :2]
     xi = xt - profile(np.linalg.norm(xt, axis=-1))[0][..., None] * gamma
     r = np.linalg.norm(xi, axis=-1)
@@ -60,16 +64,18 @@ def sheave_coefficients(x0, R_c, gamma, profile):
     return _tilted(a, alpha, Acal, gamma)
 
 
-def pin_coefficients(z_pin, slope, tau, beta0, beta, Bcal):
+def pin_coefficients(z_pin, slope, tau, beta0, beta, Bcal, side=1.0):
     """Pin-face quadratic ``(b, b_vec, B)`` (m, -, 1/m) at the pin-axis end; (1.344)–(1.345).
 
     ``z_pin`` (n,) axial position of the axis end (m), ``slope = u'_p`` (n, 2) axis slope there
     (-), ``tau`` (n, 2) unit in-plane pin direction ``P_phi e_1``; face ``z = beta0 + beta.xi +
     xi.Bcal xi/2`` in the pin frame (m, -, 1/m; ``Bcal`` (n, 2, 2), crowned: ``diag(1/R_tau,
     1/R_n)``). A face not through the axis end (``beta0 != 0``) is re-centred at
-    ``xi0 = -beta0 P_phi^T gamma`` first (digest §5.4, reviewed).
+    ``xi0 = -beta0 P_phi^T gamma`` first (digest §5.4, reviewed). ``side`` as for the sheave it touches;
+    the face is given in the end's own frame (its outward axis towards that sheave).
     """
-    gamma = np.asarray(slope, dtype=float)
+    s = np.asarray(side, dtype=float)
+    gamma = s[..., None] * np.asarray(slope, dtype=float)
     Pp = _rot2(np.asarray(tau, dtype=float))
     beta0, beta, Bcal = (np.asarray(x, dtype=float) for x in (beta0, beta, Bcal))
     xi0 = -beta0[..., None] * np.einsum("...ji,...j->...i", Pp, gamma)
@@ -77,11 +83,14 @@ def pin_coefficients(z_pin, slope, tau, beta0, beta, Bcal):
     beta = beta + np.einsum("...ij,...j->...i", Bcal, xi0)
     beta_p = np.einsum("...ij,...j->...i", Pp, beta)
     B_p = Pp @ Bcal @ np.swapaxes(Pp, -1, -2)
-    return _tilted(np.asarray(z_pin, dtype=float) + beta0, beta_p, B_p, gamma)
+    return _tilted(s * np.asarray(z_pin, dtype=float) + beta0, beta_p, B_p, gamma)
 
 
-def refined_contact(x0, a, a_vec, A, b, b_vec, B) -> RefinedContact:
+def refined_contact(x0, a, a_vec, A, b, b_vec, B, side=1.0) -> RefinedContact:
     """Closed-form contact point and penetration of §5.3 for quadratics about ``x0`` (n, 2) (m).
+
+    The coefficients come from :func:`sheave_coefficients` and :func:`pin_coefficients` with the
+    same ``side``; the results are in world coordinates.
 
     ``x_* = (B - A)^-1 (a_vec - b_vec)``, ``Delta = a - b + (a_vec - b_vec) . x_*/2``
     ``= max_x (z_pul - z_pin)``. Raises :class:`~cvtfem.errors.NumericalError` where ``B - A``
@@ -101,20 +110,19 @@ def refined_contact(x0, a, a_vec, A, b, b_vec, B) -> RefinedContact:
     Bx = np.einsum("...ij,...j->...i", B, x)
     z_pul = a + np.sum(a_vec * x, axis=-1) + 0.5 * np.sum(x * Ax, axis=-1)
     z_pin = b + np.sum(b_vec * x, axis=-1) + 0.5 * np.sum(x * Bx, axis=-1)
-    g = a_vec + Ax
-    point = np.concatenate([np.asarray(x0, dtype=float) + x, (0.5 * (z_pul + z_pin))[..., None]], -1)
-    kg = np.concatenate([-g, np.ones(g.shape[:-1] + (1,))], -1)
-    return RefinedContact(delta, x, point, g, kg / np.linalg.norm(kg, axis=-1, keepdims=True))
+    s = np.asarray(side, dtype=float) * np.ones(delta.shape)
+    point = np.concatenate([np.asarray(x0, dtype=float) + x, (0.5 * s * (z_pul + z_pin))[..., None]], -1)
+    grad = np.concatenate([a_vec + Ax, -s[..., None]], -1)          # S (g_*, -1): mirrored back
+    return RefinedContact(delta, x, point, grad, -grad / np.linalg.norm(grad, axis=-1, keepdims=True))
 
 
 def refined_force(contact: RefinedContact, N):
-    """Normal force on the pin at ``R_*`` (N): ``N (k - g_*)`` = ``-N dDelta/d(pin translation)``.
+    """Normal force on the pin at ``R_*`` (N): ``-N dDelta/d(pin translation) = side N (k - g_*)``.
 
     Minus the gradient of ``2/5 c Delta^{5/2}`` for translations of either body (envelope theorem,
     digest §10.2); the source's ``N n`` is ``1/|k - g_*|`` of it (docs/chain.md).
     """
-    g = contact.slope
-    return np.asarray(N, dtype=float)[..., None] * np.concatenate([-g, np.ones(g.shape[:-1] + (1,))], -1)
+    return -np.asarray(N, dtype=float)[..., None] * contact.grad
 
 
 def pin_loads(force, rho, slope, H, n_perp, k=(0.0, 0.0, 1.0)):

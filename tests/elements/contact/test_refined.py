@@ -20,14 +20,14 @@ def _quad(c0, c1, C2, x):
     return c0 + np.sum(c1 * x, -1) + 0.5 * np.einsum("...i,...ij,...j->...", x, C2, x)
 
 
-def _poses(profile, n, seed, tilt=5e-3):
+def _poses(profile, n, seed, tilt=5e-3, side=1.0):
     """Crowned pin faces (R_tau 0.1-1 m, R_n 10-40 mm) at the pin-axis end near a tilted sheave."""
     rng = np.random.default_rng(seed)
     R_c = rng.normal(size=(n, 3)) * 1e-4
     gamma = rng.normal(size=(n, 2)) * tilt
     r, phi = rng.uniform(0.036, 0.088, n), rng.uniform(0, 2 * np.pi, n)
     x0 = R_c[:, :2] + np.stack([r * np.cos(phi), r * np.sin(phi)], -1)
-    z_pin = R_c[:, 2] + profile(r)[0] + rng.uniform(-3e-5, 3e-5, n)
+    z_pin = R_c[:, 2] + side * (profile(r)[0] + rng.uniform(-3e-5, 3e-5, n))
     slope = rng.normal(size=(n, 2)) * tilt
     psi = phi + np.pi / 2 + rng.normal(size=n) * 0.05       # pin along the circumference
     tau = np.stack([np.cos(psi), np.sin(psi)], -1)
@@ -35,12 +35,12 @@ def _poses(profile, n, seed, tilt=5e-3):
     Bcal[:, 0, 0] = 1 / rng.uniform(0.1, 1.0, n)
     Bcal[:, 1, 1] = 1 / rng.uniform(0.01, 0.04, n)
     return dict(R_c=R_c, gamma=gamma, x0=x0, z_pin=z_pin, slope=slope, tau=tau, Bcal=Bcal,
-                beta0=np.zeros(n), beta=np.zeros((n, 2)))
+                beta0=np.zeros(n), beta=np.zeros((n, 2)), side=side)
 
 
 def _coefficients(profile, p):
-    sh = sheave_coefficients(p["x0"], p["R_c"], p["gamma"], profile)
-    pin = pin_coefficients(p["z_pin"], p["slope"], p["tau"], p["beta0"], p["beta"], p["Bcal"])
+    sh = sheave_coefficients(p["x0"], p["R_c"], p["gamma"], profile, p["side"])
+    pin = pin_coefficients(p["z_pin"], p["slope"], p["tau"], p["beta0"], p["beta"], p["Bcal"], p["side"])
     return (*sh, *pin)
 
 
@@ -90,12 +90,15 @@ def test_sheave_coefficients_approximate_the_tilted_surface_to_second_order(prof
     assert errs[0] / errs[1] > 3.5 and errs[1] / errs[2] > 3.5, errs
 
 
-def test_forces_are_minus_the_gradient_of_the_potential_for_translations(profile):
+@pytest.mark.parametrize("side", [1.0, -1.0])
+def test_forces_are_minus_the_gradient_of_the_potential_for_translations(profile, side):
     """-dPi/d(translation) of pin and sheave = +-N (k - g_*) (envelope theorem, digest §10.2), by
     central differences to 1e-6 relative on 100 random poses: translating a graph
-    z = q(x) by t gives z = q(x - t_perp) + t_3, so the coefficients shift exactly."""
+    z = q(x) by t gives z = q(x - t_perp) + t_3, so the coefficients shift exactly (by the
+    mirrored t for side -1)."""
     n = 100
-    p = _poses(profile, n, 4)
+    p = _poses(profile, n, 4, side=side)
+    mirror = np.array([1.0, 1.0, side])
     coef = _coefficients(profile, p)
     sh, pin = coef[:3], coef[3:]
 
@@ -105,9 +108,10 @@ def test_forces_are_minus_the_gradient_of_the_potential_for_translations(profile
         return (c0 + t[:, 2] - np.sum(c1 * t[:, :2], 1) + 0.5 * np.sum(t[:, :2] * Ct, 1), c1 - Ct, C2)
 
     def potential(t_pul, t_pin):
-        return hertz_potential(refined_contact(p["x0"], *shifted(sh, t_pul), *shifted(pin, t_pin)).delta, C)
+        con = refined_contact(p["x0"], *shifted(sh, t_pul * mirror), *shifted(pin, t_pin * mirror), side)
+        return hertz_potential(con.delta, C)
 
-    con = refined_contact(p["x0"], *sh, *pin)
+    con = refined_contact(p["x0"], *sh, *pin, side)
     N = hertz_force(con.delta, C)[0]
     F = refined_force(con, N)
     on = con.delta > 2e-6
@@ -121,30 +125,47 @@ def test_forces_are_minus_the_gradient_of_the_potential_for_translations(profile
         scale = np.linalg.norm(F, axis=1)
         assert np.all(np.abs(F[on, j] - fd_pin[on]) <= 1e-6 * scale[on])
         assert np.all(np.abs(-F[on, j] - fd_pul[on]) <= 1e-6 * scale[on])
-    assert np.allclose(F, (N * np.linalg.norm(np.concatenate([con.slope, np.ones((n, 1))], 1), axis=1))[:, None]
-                       * con.normal, atol=1e-12 * np.max(N))
+    assert np.allclose(F, (N * np.linalg.norm(con.grad, axis=1))[:, None] * con.normal, atol=1e-12 * np.max(N))
+    assert np.all(side * con.normal[:, 2] > 0.9)
 
 
-def test_matching_slopes_reduce_to_the_pin_axis_point_model(profile):
+@pytest.mark.parametrize("side", [1.0, -1.0])
+def test_matching_slopes_reduce_to_the_pin_axis_point_model(profile, side):
     """a_vec = b_vec (a face with the sheave's slope, untilted): x_* = 0 and Delta, normal and
     force are those of H1 at the pin-axis point (digest §10.4 item 8)."""
     n = 50
-    p = _poses(profile, n, 5, tilt=0.0)
+    p = _poses(profile, n, 5, tilt=0.0, side=side)
     r = np.linalg.norm(p["x0"] - p["R_c"][:, :2], axis=1)
     e = (p["x0"] - p["R_c"][:, :2]) / r[:, None]
     c, s = p["tau"][:, 0], p["tau"][:, 1]
     p["beta"] = np.einsum("nji,nj->ni", np.stack([np.stack([c, -s], -1), np.stack([s, c], -1)], -2),
                           profile(r)[1][:, None] * e)            # P_phi^T (f' e_r)
-    con = refined_contact(p["x0"], *_coefficients(profile, p))
+    con = refined_contact(p["x0"], *_coefficients(profile, p), side)
     # round-off of a_vec - b_vec (1e-17) over the smallest eigenvalue of B - A (about 1 1/m)
     assert np.allclose(con.offset, 0.0, atol=1e-16)
     R_pin = np.concatenate([p["x0"], p["z_pin"][:, None]], 1)
-    h1 = pin_axis_contact(R_pin, p["R_c"], np.zeros((n, 3)), profile)
+    h1 = pin_axis_contact(R_pin, p["R_c"], np.zeros((n, 3)), profile, side)
     # the torus meridian is w - Rt with Rt = 0.6 m: its round-off is ulp(0.6) = 1.1e-16 m
     assert np.allclose(con.delta, h1.delta, rtol=0, atol=4.5e-16)
     assert np.allclose(con.normal, h1.normal, atol=1e-15)
     N = hertz_force(con.delta, C)[0]
     assert np.allclose(refined_force(con, N), pin_axis_forces(h1, N), rtol=0, atol=1e-12 * max(N.max(), 1.0))
+
+
+def test_opposite_side_is_the_mirror_image(profile):
+    """A configuration and its mirror z -> -z (sheave side -1, tilts and slopes reversed) have the
+    same penetration and offset, mirrored contact point, normal and force."""
+    n = 50
+    p = _poses(profile, n, 9)
+    q = dict(p, R_c=p["R_c"] * [1.0, 1.0, -1.0], gamma=-p["gamma"], z_pin=-p["z_pin"], slope=-p["slope"],
+             side=-1.0)
+    a = refined_contact(p["x0"], *_coefficients(profile, p))
+    b = refined_contact(q["x0"], *_coefficients(profile, q), -1.0)
+    mirror = np.array([1.0, 1.0, -1.0])
+    assert np.array_equal(a.delta, b.delta) and np.array_equal(a.offset, b.offset)
+    assert np.array_equal(a.point * mirror, b.point) and np.array_equal(a.normal * mirror, b.normal)
+    N = hertz_force(a.delta, C)[0]
+    assert np.array_equal(refined_force(a, N) * mirror, refined_force(b, N))
 
 
 def test_very_curved_face_tends_to_the_pin_axis_point():
