@@ -32,6 +32,19 @@ def hertz_potential(delta, c):
     return 0.4 * c * d * d * np.sqrt(d)
 
 
+def normal_force(grad, N):
+    """Normal force on the pin ``-N dDelta/dR_pin`` (n, 3) (N): minus the gradient of the potential
+    (1.311)–(1.312) for the contact's ``grad = dDelta/dR_pin`` (H1 or H2); the sheave gets its negative."""
+    return -np.asarray(N, dtype=float)[..., None] * grad
+
+
+def normal_stiffness(grad, hessian, N, dN):
+    """``d(normal_force)/dR_pin = -(dN/dDelta grad grad + N d2Delta/dR_pin^2)`` (n, 3, 3) (N/m);
+    minus it for the sheave's translation. ``N, dN`` from :func:`hertz_force`."""
+    return -(np.asarray(dN, dtype=float)[..., None, None] * grad[..., :, None] * grad[..., None, :]
+             + np.asarray(N, dtype=float)[..., None, None] * hessian)
+
+
 def _omega_of(p):
     """``Omega`` (1.325) at ``m = 1 - p`` through ``kappa = B/A`` of Johnson's gap coefficients."""
     K, E = ellipkm1(p), ellipe(1.0 - p)

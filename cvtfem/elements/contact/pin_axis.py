@@ -3,8 +3,9 @@
 Penetration (1.321) ``Delta = f(r) - s (z_pin - z_c)`` in the tilted sheave frame (1.317)–(1.318),
 ``s = +-1`` the side of the sheave (its material on the ``-s k`` side). Normal forces are the
 exact gradient of the potential ``2/5 c Delta^{5/2}`` (1.311)–(1.313): on the pin ``-N dDelta/dR``
-``= N sqrt(1 + f'^2) n`` (digest §4.2 [D]), so energy balances hold to round-off; the source's
-``N n`` (1.322) is ``1/sqrt(1 + f'^2)`` of it (docs/chain.md). Vectorised over contacts.
+``= N sqrt(1 + f'^2) n`` (digest §4.2 [D]; :func:`cvtfem.elements.contact.hertz.normal_force` with
+``grad``), so energy balances hold to round-off; the source's ``N n`` (1.322) is
+``1/sqrt(1 + f'^2)`` of it (docs/chain.md). Vectorised over contacts.
 """
 from __future__ import annotations
 
@@ -24,6 +25,7 @@ class PinAxisContact:
     delta: np.ndarray    # (n,) penetration along the sheave axis (m), > 0 in contact
     normal: np.ndarray   # (n, 3) outward unit sheave normal n at the pin-axis point
     grad: np.ndarray     # (n, 3) dDelta/dR_pin (-); dDelta/dR_c = -grad
+    hessian: np.ndarray  # (n, 3, 3) d2 Delta/dR_pin^2 (1/m)
     arm: np.ndarray      # (n, 3) R_pin - R_c (m)
     radius: np.ndarray   # (n,) contact radius r (m), (1.317)
 
@@ -34,7 +36,8 @@ def pin_axis_contact(R_pin, R_c, theta, profile, side=1.0) -> PinAxisContact:
     ``R_c`` ``(n, 3)`` sheave centres (m), ``theta`` ``(n, 3)`` sheave tilts (rad), ``profile(r)
     -> (f, f', f'')`` the sheave surface ``z - z_c = s f(r)`` (m, -, 1/m), vectorised; ``side``
     ``s`` (n,) or scalar. The exact derivative with respect to tilt is ``(grad x arm)`` through
-    :func:`cvtfem.elements.contact.sheave.tangent_operator`, as :func:`pin_axis_forces` uses.
+    :func:`cvtfem.elements.contact.sheave.tangent_operator`, which
+    :func:`cvtfem.elements.contact.sheave.sheave_generalized` uses.
     """
     R_pin, R_c = np.asarray(R_pin, dtype=float), np.asarray(R_c, dtype=float)
     s = np.asarray(side, dtype=float)
@@ -42,22 +45,16 @@ def pin_axis_contact(R_pin, R_c, theta, profile, side=1.0) -> PinAxisContact:
     P = rotation(theta)
     d = np.einsum("...ji,...j->...i", P, arm)          # P^T (R - R_c), sheave frame
     r = np.hypot(d[..., 0], d[..., 1])
-    f, fp, _ = profile(r)
+    f, fp, fpp = profile(r)
     e_xi = np.stack([d[..., 0], d[..., 1], np.zeros_like(r)], -1) / np.where(r > 0, r, 1.0)[..., None]
     g = fp[..., None] * e_xi - s[..., None] * K            # dDelta/dd in the sheave frame
     grad = np.einsum("...ij,...j->...i", P, g)
     normal = -grad / np.linalg.norm(grad, axis=-1, keepdims=True)
-    return PinAxisContact(f - s * d[..., 2], normal, grad, arm, r)
-
-
-def pin_axis_forces(contact: PinAxisContact, N):
-    """Normal contact force on the pin ``-N dDelta/dR_pin`` ``(n, 3)`` (N) for normal forces ``N`` (n,).
-
-    Acts at the pin-axis point; the sheave's share follows from
-    :func:`cvtfem.elements.contact.sheave.sheave_generalized` with ``contact.arm``. Together they
-    are minus the gradient of ``2/5 c Delta^{5/2}`` when ``N = c Delta^{3/2}``.
-    """
-    return -np.asarray(N, dtype=float)[..., None] * contact.grad
+    plane = np.diag([1.0, 1.0, 0.0]) - e_xi[..., :, None] * e_xi[..., None, :]    # in-plane, normal to e_xi
+    H = fpp[..., None, None] * e_xi[..., :, None] * e_xi[..., None, :] \
+        + (fp / np.where(r > 0, r, 1.0))[..., None, None] * plane                   # d2 f(|d_perp|)/dd^2
+    hessian = P @ H @ np.swapaxes(P, -1, -2)
+    return PinAxisContact(f - s * d[..., 2], normal, grad, hessian, arm, r)
 
 
 def pin_axis_slip(contact: PinAxisContact, v_pin, v_c, omega):

@@ -3,7 +3,9 @@
 Both surfaces are local graphs over the plane normal to ``k``, quadratic about the in-plane pin
 point ``x0`` (1.331): sheave ``z = a + a.x + x.A x/2``, pin face ``z = b + b.x + x.B x/2`` with
 ``B - A`` positive definite. The contact point, penetration (along ``k``) and normal are the
-closed form of §5.3. The coefficients live in the frame of a sheave below the pin: for a sheave
+closed form of §5.3; the normal force on the pin, ``side N (k - g_*)`` at ``R_*``, and its stiffness
+for translations are :func:`cvtfem.elements.contact.hertz.normal_force` and ``normal_stiffness``
+with ``grad`` and ``hessian`` (envelope theorem, digest §10.2). The coefficients live in the frame of a sheave below the pin: for a sheave
 on the other side (``side = -1``, its material on the ``+k`` side) the functions mirror ``z -> -z``
 on the way in and back on the way out. Vectorised over contacts: in-plane vectors ``(n, 2)``,
 tensors ``(n, 2, 2)``.
@@ -25,6 +27,7 @@ class RefinedContact:
     offset: np.ndarray   # (n, 2) contact point relative to x0, x_hat_* (m)
     point: np.ndarray    # (n, 3) contact point R_* (m), mid-way between the surfaces
     grad: np.ndarray     # (n, 3) dDelta/d(pin translation) = -side (k - g_*) (-), g_* the common slope
+    hessian: np.ndarray  # (n, 3, 3) d2 Delta/d(pin translation)^2 (1/m): in-plane A (B - A)^-1 B
     normal: np.ndarray   # (n, 3) outward unit sheave normal -grad/|grad|
 
 
@@ -111,18 +114,14 @@ def refined_contact(x0, a, a_vec, A, b, b_vec, B, side=1.0) -> RefinedContact:
     z_pul = a + np.sum(a_vec * x, axis=-1) + 0.5 * np.sum(x * Ax, axis=-1)
     z_pin = b + np.sum(b_vec * x, axis=-1) + 0.5 * np.sum(x * Bx, axis=-1)
     s = np.asarray(side, dtype=float) * np.ones(delta.shape)
+    AMB = np.einsum("...ij,...jk->...ik", A, np.stack([np.stack([M[..., 1, 1], -M[..., 0, 1]], -1),
+                                                       np.stack([-M[..., 1, 0], M[..., 0, 0]], -1)], -2)
+                    / det[..., None, None]) @ B
+    hessian = np.zeros(delta.shape + (3, 3))
+    hessian[..., :2, :2] = AMB
     point = np.concatenate([np.asarray(x0, dtype=float) + x, (0.5 * s * (z_pul + z_pin))[..., None]], -1)
     grad = np.concatenate([a_vec + Ax, -s[..., None]], -1)          # S (g_*, -1): mirrored back
-    return RefinedContact(delta, x, point, grad, -grad / np.linalg.norm(grad, axis=-1, keepdims=True))
-
-
-def refined_force(contact: RefinedContact, N):
-    """Normal force on the pin at ``R_*`` (N): ``-N dDelta/d(pin translation) = side N (k - g_*)``.
-
-    Minus the gradient of ``2/5 c Delta^{5/2}`` for translations of either body (envelope theorem,
-    digest §10.2); the source's ``N n`` is ``1/|k - g_*|`` of it (docs/chain.md).
-    """
-    return -np.asarray(N, dtype=float)[..., None] * contact.grad
+    return RefinedContact(delta, x, point, grad, hessian, -grad / np.linalg.norm(grad, axis=-1, keepdims=True))
 
 
 def pin_loads(force, rho, slope, H, n_perp, k=(0.0, 0.0, 1.0)):

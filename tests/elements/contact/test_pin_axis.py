@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 from cvtfem.elements.contact.friction import friction_force
-from cvtfem.elements.contact.hertz import hertz_force, hertz_potential
-from cvtfem.elements.contact.pin_axis import pin_axis_contact, pin_axis_forces, pin_axis_slip
+from cvtfem.elements.contact.hertz import hertz_force, hertz_potential, normal_force, normal_stiffness
+from cvtfem.elements.contact.pin_axis import pin_axis_contact, pin_axis_slip
 from cvtfem.elements.contact.sheave import rotation, sheave_generalized, tangent_operator
 
 C = 2.0e10      # N/m^1.5
@@ -53,7 +53,7 @@ def test_normal_forces_are_minus_the_gradient_of_the_potential(profile, side):
 
     con = pin_axis_contact(R_pin, R_c, theta, profile, side)
     N = hertz_force(con.delta, C)[0]
-    F = pin_axis_forces(con, N)
+    F = normal_force(con.grad, N)
     F_c, Q_theta, Q_phi = sheave_generalized(F, con.arm, theta)
     on = con.delta > 2e-6     # away from the C1 point at onset
     assert on.sum() > 50
@@ -73,6 +73,34 @@ def test_normal_forces_are_minus_the_gradient_of_the_potential(profile, side):
     fp = profile(con.radius)[1]
     assert np.allclose(F, (N * np.sqrt(1 + fp ** 2))[:, None] * con.normal, rtol=0, atol=1e-12 * scale.max())
     assert np.all(side * con.normal[:, 2] > 0.9)
+
+
+@pytest.mark.parametrize("side", [1.0, -1.0])
+def test_translational_stiffness_equals_differences_of_the_force(profile, side):
+    """normal_stiffness = dF/dR_pin = -dF/dR_c by central differences (1e-6 of |dN| |grad|^2)."""
+    n = 200
+    R_pin, R_c, theta = _states(profile, n, 7, side)
+
+    def force(Rp, Rc):
+        con = pin_axis_contact(Rp, Rc, theta, profile, side)
+        return normal_force(con.grad, hertz_force(con.delta, C)[0])
+
+    con = pin_axis_contact(R_pin, R_c, theta, profile, side)
+    Kpp = normal_stiffness(con.grad, con.hessian, *hertz_force(con.delta, C))
+    on = con.delta > 2e-6
+    scale = hertz_force(con.delta, C)[1][on]
+    h = 1e-10
+    for j in range(3):
+        e = np.zeros((n, 3))
+        e[:, j] = h
+        fd_p = (force(R_pin + e, R_c) - force(R_pin - e, R_c)) / (2 * h)
+        fd_c = (force(R_pin, R_c + e) - force(R_pin, R_c - e)) / (2 * h)
+        assert np.all(np.abs(Kpp[on, :, j] - fd_p[on]) <= 1e-6 * scale[:, None])
+        assert np.all(np.abs(-Kpp[on, :, j] - fd_c[on]) <= 1e-6 * scale[:, None])
+        # the curvature term N d2Delta/dR^2 is 1e-4 of dN grad grad here: check the Hessian itself
+        dg = (pin_axis_contact(R_pin + e * 1e3, R_c, theta, profile, side).grad
+              - pin_axis_contact(R_pin - e * 1e3, R_c, theta, profile, side).grad) / (2e3 * h)
+        assert np.all(np.abs(con.hessian[:, :, j] - dg) <= 1e-6 * np.abs(con.hessian).max(axis=(1, 2))[:, None])
 
 
 def test_penetration_of_an_untilted_sheave_is_1_321(profile):
@@ -112,6 +140,6 @@ def test_grazing_is_finite():
     with np.errstate(divide="raise", invalid="raise", over="raise"):
         con = pin_axis_contact(R_pin, np.zeros((3, 3)), np.zeros((3, 3)), f)
         N, dN = hertz_force(con.delta, C)
-        F = pin_axis_forces(con, N)
+        F = normal_force(con.grad, N)
     assert np.allclose(con.delta, [1e-9, 0.0, -1e-9], rtol=1e-6, atol=1e-20)
     assert np.all(np.isfinite(F)) and N[1] == N[2] == dN[1] == dN[2] == 0.0

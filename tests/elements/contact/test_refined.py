@@ -5,10 +5,10 @@ import numpy as np
 import pytest
 from scipy.optimize import minimize
 
-from cvtfem.elements.contact.hertz import hertz_force, hertz_potential
-from cvtfem.elements.contact.pin_axis import pin_axis_contact, pin_axis_forces
-from cvtfem.elements.contact.refined import (pin_coefficients, pin_loads, refined_contact, refined_force,
-                                             refined_slip, sheave_coefficients)
+from cvtfem.elements.contact.hertz import hertz_force, hertz_potential, normal_force, normal_stiffness
+from cvtfem.elements.contact.pin_axis import pin_axis_contact
+from cvtfem.elements.contact.refined import (pin_coefficients, pin_loads, refined_contact, refined_slip,
+                                             sheave_coefficients)
 from cvtfem.elements.contact.sheave import rotation
 from cvtfem.errors import NumericalError
 
@@ -113,7 +113,7 @@ def test_forces_are_minus_the_gradient_of_the_potential_for_translations(profile
 
     con = refined_contact(p["x0"], *sh, *pin, side)
     N = hertz_force(con.delta, C)[0]
-    F = refined_force(con, N)
+    F = normal_force(con.grad, N)
     on = con.delta > 2e-6
     assert on.sum() > 30
     h, zero = 1e-9, np.zeros((n, 3))
@@ -127,6 +127,24 @@ def test_forces_are_minus_the_gradient_of_the_potential_for_translations(profile
         assert np.all(np.abs(-F[on, j] - fd_pul[on]) <= 1e-6 * scale[on])
     assert np.allclose(F, (N * np.linalg.norm(con.grad, axis=1))[:, None] * con.normal, atol=1e-12 * np.max(N))
     assert np.all(side * con.normal[:, 2] > 0.9)
+    # translational stiffness: the moving contact point, dx_* = (B - A)^-1 B dt
+    def force(t_pul, t_pin):
+        c = refined_contact(p["x0"], *shifted(sh, t_pul * mirror), *shifted(pin, t_pin * mirror), side)
+        return normal_force(c.grad, hertz_force(c.delta, C)[0])
+
+    Kpp = normal_stiffness(con.grad, con.hessian, *hertz_force(con.delta, C))
+    dN = hertz_force(con.delta, C)[1]
+    h = 1e-10
+    for j in range(3):
+        e = np.zeros((n, 3))
+        e[:, j] = h
+        fd_pin = (force(zero, e) - force(zero, -e)) / (2 * h)
+        fd_pul = (force(e, zero) - force(-e, zero)) / (2 * h)
+        assert np.all(np.abs(Kpp[on, :, j] - fd_pin[on]) <= 1e-6 * dN[on, None])
+        assert np.all(np.abs(-Kpp[on, :, j] - fd_pul[on]) <= 1e-6 * dN[on, None])
+        grad = lambda t: refined_contact(p["x0"], *sh, *shifted(pin, t * mirror), side).grad   # noqa: E731
+        dg = (grad(e * 1e3) - grad(-e * 1e3)) / (2e3 * h)
+        assert np.all(np.abs(con.hessian[:, :, j] - dg) <= 1e-6 * np.abs(con.hessian).max(axis=(1, 2))[:, None])
 
 
 @pytest.mark.parametrize("side", [1.0, -1.0])
@@ -149,7 +167,7 @@ def test_matching_slopes_reduce_to_the_pin_axis_point_model(profile, side):
     assert np.allclose(con.delta, h1.delta, rtol=0, atol=4.5e-16)
     assert np.allclose(con.normal, h1.normal, atol=1e-15)
     N = hertz_force(con.delta, C)[0]
-    assert np.allclose(refined_force(con, N), pin_axis_forces(h1, N), rtol=0, atol=1e-12 * max(N.max(), 1.0))
+    assert np.allclose(normal_force(con.grad, N), normal_force(h1.grad, N), rtol=0, atol=1e-12 * max(N.max(), 1.0))
 
 
 def test_opposite_side_is_the_mirror_image(profile):
@@ -165,7 +183,7 @@ def test_opposite_side_is_the_mirror_image(profile):
     assert np.array_equal(a.delta, b.delta) and np.array_equal(a.offset, b.offset)
     assert np.array_equal(a.point * mirror, b.point) and np.array_equal(a.normal * mirror, b.normal)
     N = hertz_force(a.delta, C)[0]
-    assert np.array_equal(refined_force(a, N) * mirror, refined_force(b, N))
+    assert np.array_equal(normal_force(a.grad, N) * mirror, normal_force(b.grad, N))
 
 
 def test_very_curved_face_tends_to_the_pin_axis_point():
@@ -206,7 +224,7 @@ def test_pin_tilted_about_tau_gets_a_restoring_moment():
         R_pin = np.concatenate([x0, np.full((n, 1), z_pin)], 1)
         slope3 = np.concatenate([s * e_r, np.zeros((n, 1))], 1)
         n_perp = np.concatenate([np.stack([-tau[:, 1], tau[:, 0]], -1), np.zeros((n, 1))], 1)
-        Q.append(pin_loads(refined_force(con, np.full(n, N)), con.point - R_pin, slope3, np.zeros(n), n_perp)[1])
+        Q.append(pin_loads(normal_force(con.grad, np.full(n, N)), con.point - R_pin, slope3, np.zeros(n), n_perp)[1])
     dQ = (Q[1] - Q[0])[:, :2]
     assert np.allclose(np.sum(dQ * e_r, 1), -Rn * N * 2e-3 * (1 + TAN_GAMMA ** 2 / 2), rtol=1e-9)
     assert np.allclose(np.sum(dQ * tau, 1), 0.0, atol=1e-14)   # round-off of moments N |x_*| ~ 4 N m
@@ -254,7 +272,7 @@ def test_point_loads_and_slip_power():
     from cvtfem.elements.contact.refined import RefinedContact
     R_s = rng.normal(size=(n, 3)) * 0.05
     nrm = np.tile(K, (n, 1))
-    con = RefinedContact(np.zeros(n), np.zeros((n, 2)), R_s, np.zeros((n, 2)), nrm)
+    con = RefinedContact(np.zeros(n), np.zeros((n, 2)), R_s, -nrm, np.zeros((n, 3, 3)), nrm)
     R_pin, R_c = R_s - rho, rng.normal(size=(n, 3)) * 1e-3
     w, v0 = rng.normal(size=(n, 3)), rng.normal(size=(n, 3))
     slip = refined_slip(con, R_pin, v0 + np.cross(w, R_pin - R_c), w, R_c, v0, w)
