@@ -13,7 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from cvtfem.elements.contact.sheave import rotation
+from cvtfem.elements.contact.sheave import rotate
 
 K = np.array([0.0, 0.0, 1.0])
 
@@ -36,24 +36,22 @@ def pin_axis_contact(R_pin, R_c, theta, profile, side=1.0) -> PinAxisContact:
     ``R_c`` ``(n, 3)`` sheave centres (m), ``theta`` ``(n, 3)`` sheave tilts (rad), ``profile(r)
     -> (f, f', f'')`` the sheave surface ``z - z_c = s f(r)`` (m, -, 1/m), vectorised; ``side``
     ``s`` (n,) or scalar. The exact derivative with respect to tilt is ``(grad x arm)`` through
-    :func:`cvtfem.elements.contact.sheave.tangent_operator`, which
+    :func:`cvtfem.elements.contact.sheave.tilt_forces`, which
     :func:`cvtfem.elements.contact.sheave.sheave_generalized` uses.
     """
     R_pin, R_c = np.asarray(R_pin, dtype=float), np.asarray(R_c, dtype=float)
     s = np.asarray(side, dtype=float)
     arm = R_pin - R_c
-    P = rotation(theta)
-    d = np.einsum("...ji,...j->...i", P, arm)          # P^T (R - R_c), sheave frame
+    d = rotate(theta, arm, inverse=True)                    # P^T (R - R_c), sheave frame
     r = np.hypot(d[..., 0], d[..., 1])
     f, fp, fpp = profile(r)
     e_xi = np.stack([d[..., 0], d[..., 1], np.zeros_like(r)], -1) / np.where(r > 0, r, 1.0)[..., None]
     g = fp[..., None] * e_xi - s[..., None] * K            # dDelta/dd in the sheave frame
-    grad = np.einsum("...ij,...j->...i", P, g)
+    grad = rotate(theta, g)
     normal = -grad / np.linalg.norm(grad, axis=-1, keepdims=True)
-    plane = np.diag([1.0, 1.0, 0.0]) - e_xi[..., :, None] * e_xi[..., None, :]    # in-plane, normal to e_xi
-    H = fpp[..., None, None] * e_xi[..., :, None] * e_xi[..., None, :] \
-        + (fp / np.where(r > 0, r, 1.0))[..., None, None] * plane                   # d2 f(|d_perp|)/dd^2
-    hessian = P @ H @ np.swapaxes(P, -1, -2)
+    e, k = rotate(theta, e_xi), rotate(theta, np.broadcast_to(K, e_xi.shape))
+    ee, kk = e[..., :, None] * e[..., None, :], k[..., :, None] * k[..., None, :]
+    hessian = fpp[..., None, None] * ee + (fp / np.where(r > 0, r, 1.0))[..., None, None] * (np.eye(3) - kk - ee)
     return PinAxisContact(f - s * d[..., 2], normal, grad, hessian, arm, r)
 
 

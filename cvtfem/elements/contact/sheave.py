@@ -9,13 +9,6 @@ from __future__ import annotations
 import numpy as np
 
 
-def _skew(w):
-    z = np.zeros(w.shape[:-1])
-    return np.stack([np.stack([z, -w[..., 2], w[..., 1]], -1),
-                     np.stack([w[..., 2], z, -w[..., 0]], -1),
-                     np.stack([-w[..., 1], w[..., 0], z], -1)], -2)
-
-
 def _coefficients(t2):
     """``(sin t / t, (1 - cos t)/t^2, (t - sin t)/t^3)`` at ``t^2``, series below ``t^2 = 1e-6``."""
     t = np.sqrt(t2)
@@ -27,20 +20,23 @@ def _coefficients(t2):
     return s1, s2, s3
 
 
-def rotation(theta):
-    """Rotation tensors ``P(theta)`` ``(n, 3, 3)`` of rotation vectors ``theta`` ``(n, 3)`` (rad), Rodrigues."""
-    theta = np.asarray(theta, dtype=float)
-    W = _skew(theta)
+def rotate(theta, v, inverse=False):
+    """``P(theta) v`` (or ``P(theta)^T v``) for rotation vectors ``theta`` and vectors ``v`` (n, 3), Rodrigues."""
+    theta, v = np.asarray(theta, dtype=float), np.asarray(v, dtype=float)
     s1, s2, _ = _coefficients(np.sum(theta * theta, axis=-1))
-    return np.eye(3) + s1[..., None, None] * W + s2[..., None, None] * (W @ W)
+    tv = np.cross(theta, v)
+    sign = -1.0 if inverse else 1.0
+    return v + sign * s1[..., None] * tv + s2[..., None] * np.cross(theta, tv)
 
 
-def tangent_operator(theta):
-    """``T(theta)`` ``(n, 3, 3)`` with ``delta o = T delta theta`` for ``delta P(theta) = delta o x P``."""
-    theta = np.asarray(theta, dtype=float)
-    W = _skew(theta)
+def tilt_forces(theta, moment):
+    """``T(theta)^T M`` (n, 3): generalized forces on the rotation vector ``theta`` of moments ``M``
+    (n, 3) (N m), with ``delta o = T delta theta`` for ``delta P(theta) = delta o x P`` (tangent operator
+    ``T = E + (1 - cos t)/t^2 Theta + (t - sin t)/t^3 Theta^2``, ``Theta = theta x``)."""
+    theta, moment = np.asarray(theta, dtype=float), np.asarray(moment, dtype=float)
     _, s2, s3 = _coefficients(np.sum(theta * theta, axis=-1))
-    return np.eye(3) + s2[..., None, None] * W + s3[..., None, None] * (W @ W)
+    tm = np.cross(theta, moment)
+    return moment - s2[..., None] * tm + s3[..., None] * np.cross(theta, tm)
 
 
 def sheave_generalized(force, arm, theta, k=(0.0, 0.0, 1.0)):
@@ -54,6 +50,5 @@ def sheave_generalized(force, arm, theta, k=(0.0, 0.0, 1.0)):
     """
     force, arm, theta = (np.asarray(x, dtype=float) for x in (force, arm, theta))
     M = -np.cross(arm, force)
-    Q_theta = np.einsum("...ji,...j->...i", tangent_operator(theta), M)
-    axis = np.einsum("...ij,j->...i", rotation(theta), np.asarray(k, dtype=float))
-    return -force, Q_theta, np.sum(axis * M, axis=-1)
+    axis = rotate(theta, np.broadcast_to(np.asarray(k, dtype=float), M.shape))
+    return -force, tilt_forces(theta, M), np.sum(axis * M, axis=-1)

@@ -8,7 +8,9 @@ import pytest
 from cvtfem.elements.contact.friction import friction_force
 from cvtfem.elements.contact.hertz import hertz_force, hertz_potential, normal_force, normal_stiffness
 from cvtfem.elements.contact.pin_axis import pin_axis_contact, pin_axis_slip
-from cvtfem.elements.contact.sheave import rotation, sheave_generalized, tangent_operator
+from scipy.spatial.transform import Rotation
+
+from cvtfem.elements.contact.sheave import rotate, sheave_generalized, tilt_forces
 
 C = 2.0e10      # N/m^1.5
 
@@ -24,21 +26,37 @@ def _states(profile, n, seed, side=1.0):
     return R_c + np.einsum("nij,nj->ni", rotation(theta), local), R_c, theta
 
 
-def test_rotation_and_tangent_operator():
+def rotation(theta):
+    return Rotation.from_rotvec(theta).as_matrix()
+
+
+def tangent_operator(theta):
+    """T = E + (1 - cos t)/t^2 Theta + (t - sin t)/t^3 Theta^2 (t = |theta| > 0)."""
+    t = np.linalg.norm(theta, axis=-1)[:, None, None]
+    W = np.cross(theta[:, None, :], -np.eye(3)[None])        # Theta = theta x: W v = theta x v
+    return np.eye(3) + (1 - np.cos(t)) / t ** 2 * W + (t - np.sin(t)) / t ** 3 * (W @ W)
+
+
+def test_rotation_and_tilt_forces_against_scipy():
+    """rotate = scipy's rotation-vector matrix (also transposed); tilt_forces(M) . e_j = M . o_j with
+    (o_j x) = dP/dtheta_j P^T from central differences of scipy's matrices, |theta| 1e-9 ... 2."""
     rng = np.random.default_rng(0)
     theta = rng.normal(size=(20, 3)) * np.geomspace(1e-9, 2.0, 20)[:, None]
+    v = rng.normal(size=(20, 3))
     P = rotation(theta)
-    assert np.allclose(P @ np.swapaxes(P, 1, 2), np.eye(3), atol=1e-15)
-    assert np.allclose(np.linalg.det(P), 1.0, atol=1e-15)
-    T = tangent_operator(theta)
-    h = 1e-7
+    assert np.allclose(rotate(theta, v), np.einsum("nij,nj->ni", P, v), rtol=0, atol=1e-15 * 4)
+    assert np.allclose(rotate(theta, v, inverse=True), np.einsum("nji,nj->ni", P, v), rtol=0, atol=1e-15 * 4)
+    M = rng.normal(size=(20, 3))
+    Q = tilt_forces(theta, M)
+    h = 1e-6
     for j in range(3):
         d = np.zeros(3)
         d[j] = h
-        dP = (rotation(theta + d) - rotation(theta - d)) / (2 * h)
-        W = dP @ np.swapaxes(P, 1, 2)                   # (delta o x) for delta theta = e_j
+        W = (rotation(theta + d) - rotation(theta - d)) / (2 * h) @ np.swapaxes(P, 1, 2)
         o = np.stack([W[:, 2, 1], W[:, 0, 2], W[:, 1, 0]], -1)
-        assert np.allclose(o, T[:, :, j], atol=1e-8)
+        assert np.allclose(Q[:, j], np.sum(M * o, axis=1), rtol=0, atol=1e-9)
+    big = np.linalg.norm(theta, axis=1) > 1e-3
+    assert np.allclose(Q[big], np.einsum("nji,nj->ni", tangent_operator(theta[big]), M[big]), atol=1e-14)
 
 
 @pytest.mark.parametrize("side", [1.0, -1.0])

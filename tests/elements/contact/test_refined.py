@@ -4,12 +4,12 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from scipy.optimize import minimize
+from scipy.spatial.transform import Rotation
 
 from cvtfem.elements.contact.hertz import hertz_force, hertz_potential, normal_force, normal_stiffness
 from cvtfem.elements.contact.pin_axis import pin_axis_contact
 from cvtfem.elements.contact.refined import (pin_coefficients, pin_loads, refined_contact, refined_slip,
                                              sheave_coefficients)
-from cvtfem.elements.contact.sheave import rotation
 from cvtfem.errors import NumericalError
 
 C = 2.0e10
@@ -67,7 +67,7 @@ def test_closed_form_is_the_maximum_of_the_height_difference(profile):
 def _exact_sheave_height(profile, R_c, gamma, x):
     """Height of the tilted sheave surface above the in-plane point x, by a 1-D solve along k."""
     theta = np.concatenate([np.stack([-gamma[:, 1], gamma[:, 0]], -1), np.zeros((len(x), 1))], 1)  # gamma = theta x k
-    P = rotation(theta)
+    P = Rotation.from_rotvec(theta).as_matrix()
     z = np.zeros(len(x))
     for _ in range(50):      # fixed point on the body-frame height
         d = np.einsum("nji,nj->ni", P, np.concatenate([x - R_c[:, :2], (z - R_c[:, 2])[:, None]], 1))
@@ -240,7 +240,7 @@ def test_recentred_face_off_the_axis_end():
     b, bv, _ = pin_coefficients(np.zeros(1), slope, tau, np.array([beta0]), np.zeros((1, 2)), Bcal)
     # exact: face z = beta0 + y^2/(2 Rn) in the pin frame, rotated so that its axis k gets slope (0, sl)
     th = np.array([[sl, 0.0, 0.0]])            # rotation about x: k -> (0, -sin, cos) ... choose sign below
-    P = rotation(-th)                          # k -> (0, sin sl, cos sl): slope +sl in y
+    P = Rotation.from_rotvec(-th).as_matrix()                          # k -> (0, sin sl, cos sl): slope +sl in y
     assert P[0, 1, 2] / P[0, 2, 2] == pytest.approx(np.tan(sl))
     y = np.linspace(-3e-3, 3e-3, 20001)
     face = np.stack([0 * y, y, beta0 + y ** 2 / (2 * Rn)], -1) @ P[0].T
