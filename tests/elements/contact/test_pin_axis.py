@@ -161,3 +161,33 @@ def test_grazing_is_finite():
         F = normal_force(con.grad, N)
     assert np.allclose(con.delta, [1e-9, 0.0, -1e-9], rtol=1e-6, atol=1e-20)
     assert np.all(np.isfinite(F)) and N[1] == N[2] == dN[1] == dN[2] == 0.0
+
+
+def test_high_speed_entry_frictionless_is_elastic():
+    """Digest §10.4 item 4: a 5 g pin end entering a 10-degree cone at 55 m/s along the normal,
+    frictionless H1: the penetration peaks at (5 m v^2 / (4 c))^{2/5} (energy: the forces are the
+    exact gradient of 2/5 c Delta^{5/2}), no tunnelling, and it leaves with its entry speed."""
+    from scipy.integrate import solve_ivp
+
+    from tests.elements.contact.conftest import cone
+    m, v, c = 5e-3, 55.0, 5e10
+    R0 = np.array([[0.06, 0.0, cone(0.06)[0] + 1e-6]])
+    n0 = pin_axis_contact(R0, np.zeros((1, 3)), np.zeros((1, 3)), cone).normal[0]
+    zero = np.zeros((1, 3))
+
+    def rhs(t, y):
+        con = pin_axis_contact(y[None, :3], zero, zero, cone)
+        return np.concatenate([y[3:], normal_force(con.grad, hertz_force(con.delta, c)[0])[0] / m])
+
+    def deepest(t, y):
+        return np.dot(pin_axis_contact(y[None, :3], zero, zero, cone).grad[0], y[3:])
+    deepest.direction = -1
+
+    y0 = np.concatenate([R0[0], -v * n0])
+    sol = solve_ivp(rhs, (0.0, 2e-5), y0, method="DOP853", rtol=1e-12, atol=1e-15, events=deepest)
+    assert sol.status == 0 and len(sol.t_events[0]) == 1
+    d_max = pin_axis_contact(sol.y_events[0][:, :3], zero, zero, cone).delta[0]
+    assert d_max == pytest.approx((5 * m * v ** 2 / (4 * c)) ** 0.4, rel=1e-7)
+    v_out = sol.y[3:, -1]
+    assert np.dot(v_out, n0) == pytest.approx(v, rel=1e-8)
+    assert np.linalg.norm(v_out - np.dot(v_out, n0) * n0) < 1e-8 * v

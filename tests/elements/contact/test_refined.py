@@ -277,3 +277,21 @@ def test_point_loads_and_slip_power():
     w, v0 = rng.normal(size=(n, 3)), rng.normal(size=(n, 3))
     slip = refined_slip(con, R_pin, v0 + np.cross(w, R_pin - R_c), w, R_c, v0, w)
     assert np.allclose(slip, 0.0, atol=1e-15)
+
+
+def test_batched_equals_one_contact_at_a_time(profile):
+    """Digest §10.4 item 10: H1 and H2 over 30 contacts equal the same contacts one by one."""
+    n = 30
+    p = _poses(profile, n, 12)
+    con = refined_contact(p["x0"], *_coefficients(profile, p))
+    R_pin = np.concatenate([p["x0"], p["z_pin"][:, None]], 1)
+    theta = np.concatenate([p["gamma"][:, ::-1] * [-1.0, 1.0], np.zeros((n, 1))], 1)
+    h1 = pin_axis_contact(R_pin, p["R_c"], theta, profile)
+    for i in range(0, n, 7):
+        q = {k: (v[i:i + 1] if isinstance(v, np.ndarray) else v) for k, v in p.items()}
+        one = refined_contact(q["x0"], *_coefficients(profile, q))
+        for a, b in zip((con.delta, con.point, con.grad, con.hessian), (one.delta, one.point, one.grad, one.hessian)):
+            assert np.allclose(a[i], b[0], rtol=1e-15, atol=0)
+        h1_one = pin_axis_contact(R_pin[i:i + 1], p["R_c"][i:i + 1], theta[i:i + 1], profile)
+        for a, b in zip((h1.delta, h1.grad, h1.hessian), (h1_one.delta, h1_one.grad, h1_one.hessian)):
+            assert np.allclose(a[i], b[0], rtol=1e-15, atol=0)
