@@ -3,12 +3,12 @@
 Both surfaces are local graphs over the plane normal to ``k``, quadratic about the in-plane pin
 point ``x0`` (1.331): sheave ``z = a + a.x + x.A x/2``, pin face ``z = b + b.x + x.B x/2`` with
 ``B - A`` positive definite. The contact point, penetration (along ``k``) and normal are the
-closed form of §5.3; the normal force on the pin, ``side N (k - g_*)`` at ``R_*``, and its stiffness
-for translations are :func:`cvtfem.elements.contact.hertz.normal_force` and ``normal_stiffness``
-with ``grad`` and ``hessian`` (envelope theorem, digest §10.2). The coefficients live in the frame of a sheave below the pin: for a sheave
-on the other side (``side = -1``, its material on the ``+k`` side) the functions mirror ``z -> -z``
-on the way in and back on the way out. Vectorised over contacts: in-plane vectors ``(n, 2)``,
-tensors ``(n, 2, 2)``.
+closed form of §5.3; the normal force on the pin, ``side N (k - g_*)`` at ``R_*``, and its
+stiffness for translations are :func:`cvtfem.elements.contact.hertz.normal_force` and
+``normal_stiffness`` with ``grad`` and ``hessian`` (envelope theorem, digest §10.2). The
+coefficients live in the frame of a sheave below the pin: for a sheave on the other side
+(``side = -1``, its material on the ``+k`` side) the functions mirror ``z -> -z`` on the way in
+and back on the way out. Vectorised over contacts: in-plane vectors ``(n, 2)``, tensors ``(n, 2, 2)``.
 """
 from __future__ import annotations
 
@@ -92,12 +92,11 @@ def pin_coefficients(z_pin, slope, tau, beta0, beta, Bcal, side=1.0):
 def refined_contact(x0, a, a_vec, A, b, b_vec, B, side=1.0) -> RefinedContact:
     """Closed-form contact point and penetration of §5.3 for quadratics about ``x0`` (n, 2) (m).
 
-    The coefficients come from :func:`sheave_coefficients` and :func:`pin_coefficients` with the
-    same ``side``; the results are in world coordinates.
-
     ``x_* = (B - A)^-1 (a_vec - b_vec)``, ``Delta = a - b + (a_vec - b_vec) . x_*/2``
-    ``= max_x (z_pul - z_pin)``. Raises :class:`~cvtfem.errors.NumericalError` where ``B - A``
-    is not positive definite (the surfaces are not locally biconvex).
+    ``= max_x (z_pul - z_pin)``. The coefficients come from :func:`sheave_coefficients` and
+    :func:`pin_coefficients` with the same ``side``; the results are in world coordinates.
+    Raises :class:`~cvtfem.errors.NumericalError` where ``B - A`` is not positive definite (the
+    surfaces are not locally biconvex).
     """
     M = np.asarray(B, dtype=float) - A
     det = M[..., 0, 0] * M[..., 1, 1] - M[..., 0, 1] * M[..., 1, 0]
