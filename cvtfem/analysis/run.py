@@ -352,6 +352,9 @@ class _Run:
             stats["warning"] = warning
             log.warning("%s", warning)
         summary = summarise(scene, loop, last, (t_out[self.j_window], x_window), t_end, wall, stats, status)
+        diverged = self._diverged(summary, method, h_fixed)
+        if diverged:
+            status, message = "failed", diverged
         if writer is not None:
             extra = {"checkpoints": seq} if checkpoints else {}
             if resumed is not None:
@@ -369,7 +372,22 @@ class _Run:
                              "Quadrature nodes xi = theta / theta* of band.normal_force (same on both arcs).")
             writer.close(status, message)
             summary.results = str(writer.path)
+        if diverged:
+            raise NumericalError(diverged, t=summary.simulated_time_s, component=component)
         return summary
+
+    def _diverged(self, summary: RunSummary, method: str, h: float) -> str:
+        """Why a run that stepped to its end has diverged (empty if it has not): a final speed ratio beyond
+        half / twice the ratios the sheaves admit, or a driving shaft turning backwards."""
+        from cvtfem.machines.cvt import check_ratio_range
+
+        lo, hi = check_ratio_range(self.scene)
+        if lo / 2 <= summary.ratio <= 2 * hi and summary.input_speed_rpm > 0:
+            return ""
+        how = f"{method} at h = {h:g} s" if h > 0 and _native(method) else method
+        return (f"the run diverged: final ratio {summary.ratio:.3g} (admissible {lo:.3g}..{hi:.3g}), input speed "
+                f"{summary.input_speed_rpm:.4g} rpm; {how} may be unstable for this model: try a smaller "
+                "`solver.h` or an implicit method")
 
 
 def _native(method: str) -> bool:

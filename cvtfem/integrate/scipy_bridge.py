@@ -25,7 +25,7 @@ import scipy.sparse as sp
 from cvtfem.integrate.memory import MatrixSlot, opt_scalar, opt_vector, scalar, vector
 from cvtfem.integrate.methods import SCIPY_METHODS
 from cvtfem.integrate.stats import Stats
-from cvtfem.integrate.stepping import Candidate
+from cvtfem.integrate.stepping import MODEL_FAILURES, Candidate
 
 __all__ = ["ScipyEngine", "scipy_fields", "SCIPY_OPTIONS"]
 
@@ -107,8 +107,11 @@ class ScipyEngine:
     def advance(self, t: float, x: np.ndarray, tf: float) -> tuple[Candidate | None, str | None]:
         s = self.solver
         f0 = getattr(s, "f", None)
-        with np.errstate(over="ignore", invalid="ignore"):
-            message = s.step()
+        try:
+            with np.errstate(over="ignore", invalid="ignore"):
+                message = s.step()
+        except MODEL_FAILURES as err:   # the right-hand side met a state it cannot evaluate
+            return None, f"the right-hand side failed ({type(err).__name__}: {err})"
         if s.status == "failed":
             return None, str(message)
         if not np.all(np.isfinite(s.y)):

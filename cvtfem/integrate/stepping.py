@@ -16,7 +16,7 @@ from typing import Callable
 
 import numpy as np
 
-from cvtfem.errors import InputError
+from cvtfem.errors import InputError, NumericalError
 from cvtfem.integrate.base import Attempt, StepFailure, hermite
 from cvtfem.integrate.controller import FixedStep, SimpleController, error_norm
 from cvtfem.integrate.events import EVENT_SAMPLES, EventLocator
@@ -32,6 +32,9 @@ ZENO_GAP = 1e-9     # events closer than this fraction of the span ...
 ZENO_GAP_H = 1e-6   # ... or of the step count towards Zeno accumulation
 ZENO_COUNT = 3      # that many in a row stop the run
 GROWTH_LIMIT = 1e8  # default growth guard (see :mod:`cvtfem.integrate.guards`)
+#: Exceptions of a right-hand side at a state it cannot evaluate (a blown-up state reaching a linear solve):
+#: a failed attempt with the reason, not a traceback.
+MODEL_FAILURES = (np.linalg.LinAlgError, FloatingPointError, ZeroDivisionError, OverflowError)
 
 
 @dataclass
@@ -112,6 +115,8 @@ class NativeEngine:
                 failure = None if np.all(np.isfinite(att.x1)) else "non-finite state"
             except StepFailure as err:
                 att, failure = None, str(err)
+            except MODEL_FAILURES as err:   # the right-hand side met a state it cannot evaluate
+                att, failure = None, f"the right-hand side failed ({type(err).__name__}: {err})"
             if not adaptive:
                 if failure is not None:
                     nonfin = [] if att is None else np.flatnonzero(~np.isfinite(att.x1))
@@ -311,8 +316,17 @@ class Stepping:
         return True
 
     def dense(self, t: float) -> np.ndarray:
-        """The last step's interpolant at one time ``t`` in ``[last.t0, t]``, s."""
-        return self.last.dense(t)
+        """The last step's interpolant at one time ``t`` in ``[last.t0, t]``, s.
+
+        :class:`NumericalError` when the interpolant needs the right-hand side at a state it cannot evaluate
+        (a diverging fixed-step run: the step's end is finite, its slope is not).
+        """
+        try:
+            return self.last.dense(t)
+        except MODEL_FAILURES as err:
+            raise NumericalError(f"{self.engine.name}: the right-hand side failed at the end of the last step "
+                                 f"({type(err).__name__}: {err}); the run is diverging", t=self.last.t1,
+                                 component="dense output") from None
 
     # --- memory -------------------------------------------------------------------------------
 

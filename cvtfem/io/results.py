@@ -45,7 +45,7 @@ import h5py
 import numpy as np
 
 from cvtfem import __version__
-from cvtfem.errors import InputError
+from cvtfem.errors import InputError, NumericalError
 from cvtfem.io import checkpoint as ckpt
 from cvtfem.outputs import OutputSpec
 
@@ -258,8 +258,16 @@ class ResultsWriter:
             self.flush()
 
     def flush(self) -> None:
-        """Write buffered rows and make them visible to readers."""
+        """Write buffered rows and make them visible to readers.
+
+        A row holding a non-finite value is not written, nor any after it: :class:`NumericalError` names the
+        first such output and its time (the rows before it are on disk).
+        """
         n_new = self._buffered
+        finite = np.isfinite(self._block[:n_new]).all(axis=1) & np.isfinite(self._times[:n_new])
+        bad = None if finite.all() else int(np.argmin(finite))
+        if bad is not None:
+            n_new = bad
         if n_new:
             series = self._file["series"]
             end = self._rows + n_new
@@ -273,9 +281,14 @@ class ResultsWriter:
             times[self._rows:end] = self._times[:n_new]
             times.flush()
             self._rows = end
-            self._buffered = 0
+        self._buffered = 0
         self._file.flush()
         self._last_flush = time.monotonic()
+        if bad is not None:
+            row, t = self._block[bad], float(self._times[bad])
+            name = next((name for name, a, b in self._columns if not np.isfinite(row[a:b]).all()), "time")
+            raise NumericalError(f"output `{name}` became non-finite (that row and later ones are not written)",
+                                 t=t, component="results file")
 
     def set_stats(self, stats: Mapping[str, Any]) -> None:
         """Solver statistics (numbers or strings), stored as ``/stats`` attributes at close."""
@@ -289,8 +302,12 @@ class ResultsWriter:
         """Flush, then record statistics, arrays and the final status ("finished" or "failed")."""
         if not self._file.id.valid:
             return
+        failure = None
         try:
-            self.flush()
+            try:
+                self.flush()
+            except NumericalError as err:
+                failure, status, message = err, "failed", str(err)
             self._file.close()
             with h5py.File(self.path, "r+", libver="latest") as f:
                 f.attrs.update(status=status, message=message)
@@ -300,6 +317,8 @@ class ResultsWriter:
                     d.attrs.update(unit=unit, doc=doc)
         finally:
             self._lock.release()
+        if failure is not None:
+            raise failure
 
     def __enter__(self) -> ResultsWriter:
         return self

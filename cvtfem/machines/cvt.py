@@ -90,7 +90,7 @@ def _components(scene: Scene, body: Layout) -> tuple[Layout, ...]:
         parts.append(Layout("stabilisation", "speed-ratio-control", 0, n1=Stabilisation.size, outputs=LOOP_OUTPUTS,
                             note="smoothed speeds, F1 integral, b2 integral"))
     parts.append(Layout("transmission", "derived", 0,
-                        outputs=(OutputSpec("efficiency", "-", "Output over input power (instantaneous)."),
+                        outputs=(OutputSpec("efficiency", "-", "Output over input power (instantaneous; 0 while no power is put in)."),
                                  OutputSpec("ratio", "-", "Speed ratio omega1 / omega2."),
                                  OutputSpec("power", "W", "Input, output, dissipated and clamping power.", 4),
                                  OutputSpec("work", "J", "Input, output, dissipated and clamping work since t = 0.", 4),

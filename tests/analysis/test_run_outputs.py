@@ -23,7 +23,7 @@ def reference_outputs(loop, t, x):
            "driving.speed": w[0], "driving.torque": M[0], "driving.clamping_force": F[0],
            "driven.speed": w[1], "driven.torque": M[1], "driven.clamping_force": F[1],
            "control.ratio_estimate": info["ratio_estimate"], "control.resistance": info["resistance"],
-           "efficiency": P[1] / P[0] if P[0] else math.nan, "ratio": w[0] / w[1] if w[1] else math.nan,
+           "efficiency": P[1] / P[0] if P[0] else 0.0, "ratio": w[0] / w[1] if w[1] else math.nan,
            "power": P, "work": W, "energy": loop.model.kinetic_energy(q, v) + loop.model.elastic_energy(q)}
     if N.ndim == 2:
         out["band.normal_force"] = N.ravel()

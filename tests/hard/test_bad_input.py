@@ -178,3 +178,53 @@ def test_resume_of_a_running_run_is_refused_and_works_after_a_kill(tmp_path, cli
     from cvtfem.io.results import RunLock
 
     RunLock(results, "--resume").release()   # the killed writer's lock is gone with it
+
+
+def test_results_writer_never_stores_a_non_finite_value(tmp_path):
+    """A NaN in an output ends the run as failed, naming the output and its time; the rows before stay."""
+    import numpy as np
+
+    from cvtfem.errors import NumericalError
+    from cvtfem.io.results import ResultsWriter, read_results
+    from cvtfem.outputs import OutputSpec
+
+    path = tmp_path / "r.h5"
+    w = ResultsWriter(path, "", "run", [OutputSpec("a", "-", "a"), OutputSpec("b", "-", "b", 2)])
+    for i in range(5):
+        w.append(0.1 * i, {"a": float(i), "b": [i, np.nan if i == 3 else i]})
+    with pytest.raises(NumericalError, match=r"output `b` became non-finite.*t = 0.3 s"):
+        w.close()
+    res = read_results(path)
+    assert res.attrs["status"] == "failed" and res.time.tolist() == [0.0, 0.1, 0.2]
+    assert np.isfinite(res.series["b"]).all()
+
+
+def test_zero_torque_run_writes_only_finite_values(tmp_path, cli):
+    """band-4dof at 0 N m wrote NaN efficiency and exited 0; the instantaneous efficiency is now 0 while no
+    power is put in (the summary still calls the efficiency undefined)."""
+    import numpy as np
+
+    from cvtfem.io.results import read_results
+
+    scene = tmp_path / "s.toml"
+    scene.write_text('preset = "band-4dof"\n[cvt.regime]\ntorque = 0.0\n')
+    res = cli("run", str(scene), "--until", "0.01", "--results", str(tmp_path / "r.h5"))
+    assert res.returncode == 0 and "efficiency undefined" in res.stdout
+    series = read_results(tmp_path / "r.h5").series
+    assert all(np.isfinite(v).all() for v in series.values()) and np.all(series["efficiency"] == 0.0)
+
+
+@pytest.mark.parametrize("until,needles", [
+    ("0.005", ("the run diverged", "final ratio", "euler at h = 0.001 s")),   # exited 0 at -3.65e9 rpm
+    ("0.05", ("right-hand side failed", "diverging")),                        # LinAlgError traceback
+])
+def test_diverged_fixed_step_run_fails_loudly(tmp_path, cli, until, needles):
+    scene = tmp_path / "s.toml"
+    scene.write_text('preset = "band-6+2n+8"\n[solver]\nmethod = "euler"\nh = 1e-3\n')
+    res = cli("run", str(scene), "--until", until, "--results", str(tmp_path / "r.h5"))
+    assert res.returncode == 3 and "Traceback" not in res.stderr, res.stderr
+    line = res.stderr.strip()
+    assert len(line.splitlines()) == 1 and all(n in line for n in needles), line
+    from cvtfem.io.results import read_results
+
+    assert read_results(tmp_path / "r.h5").attrs["status"] == "failed"
