@@ -10,6 +10,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
+from scipy.optimize import brentq
 
 from cvtfem.elements.link_pattern import link_lengths
 from cvtfem.errors import InputError
@@ -191,3 +192,17 @@ def reference_geometry(randomised: bool = False, seed: int = 0) -> ChainGeometry
     n = 84
     pitch = (link_lengths(n, 0.0085, 0.0095, 0.5, np.random.default_rng(seed)) if randomised else 0.009)
     return chain_geometry(n, 0.033, pitch, 12, 1.4e9, 1.5, REFERENCE_SECTION, c_pin=2.0e8)
+
+
+def ring_positions(L: np.ndarray) -> tuple[np.ndarray, float]:
+    """Pins of a closed chain on a circle with every link straight and unstretched, counter-clockwise.
+
+    Returns positions (n, 2) m, pin 0 on the ``x1`` axis, and the radius R (m) that solves
+    ``sum 2 asin(L_p / (2 R)) = 2 pi`` (the circle through the vertices of a polygon with sides ``L``).
+    """
+    L = np.asarray(L, float)
+    total = L.sum()
+    R = brentq(lambda r: 2 * np.arcsin(np.minimum(L / (2 * r), 1.0)).sum() - 2 * np.pi, total / (2 * np.pi), total,
+               xtol=1e-15 * total, rtol=4 * np.finfo(float).eps)
+    theta = np.concatenate([[0.0], np.cumsum(2 * np.arcsin(L / (2 * R)))[:-1]])
+    return R * np.stack([np.cos(theta), np.sin(theta)], axis=1), float(R)

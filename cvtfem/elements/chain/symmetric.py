@@ -8,7 +8,7 @@ Coordinates, in block order (pin ``p`` = row ``p`` of each block):
 
 The mass matrix couples only the coordinates of one pin.  Equations of motion
 ``M q'' = Q(q, q') + Q_ext`` (§1.3) with ``Q = -dPi/dq - dPhi/dq'``.  Every kernel is a function of
-link differences built with ``np.roll`` (no loop over pins) and accepts complex states, which the
+link differences built with cyclic index arrays (no loop over pins) and accepts complex states, which the
 Jacobian uses (complex-step differentiation over a pin colouring, exact to round-off, §8.4).
 """
 from __future__ import annotations
@@ -27,19 +27,17 @@ from cvtfem.outputs import OutputSpec
 END_SLOPE_FACTOR = 2.0
 
 
+_KX = np.array([-1.0, 1.0])
+
+
 def _kx(v):
     """``k x v`` for in-plane vectors, (n, 2)."""
-    return np.stack([-v[:, 1], v[:, 0]], axis=1)
+    return v[:, ::-1] * _KX
 
 
 def _dot(a, b):
     """Row-wise dot product of (n, 2) arrays."""
     return (a * b).sum(axis=1)
-
-
-def _rear_front(f):
-    """Pin forces from link forces ``f`` on their rear pin (front pin gets ``-f``), (n, ...)."""
-    return f - np.roll(f, 1, axis=0)
 
 
 @dataclass(frozen=True)
@@ -97,13 +95,16 @@ class SymmetricChain:
         self.L = np.asarray(geom.L, float)
         self.on = geom.link_on
         self.iL = self.on / self.L                       # 1/L of existing links, 0 for an absent one
+        self.iLm = np.roll(self.iL, 1)                   # the same for link p-1
         self.m = geom.m_eff
         self.c = geom.c_link
         self.b = damping.beta_link * self.c
+        self.ip1, self.im1 = (np.arange(n) + 1) % n, (np.arange(n) - 1) % n
         self.bj = damping.b_joint * self.on * np.roll(self.on, 1)   # joint p between links p-1 and p
         self.size = self.ndof * n
         self.dof_index = self._dof_index()
         self._pattern()
+        self.M = None
 
     # ----- layout ---------------------------------------------------------------------------------
     @property
@@ -137,9 +138,13 @@ class SymmetricChain:
         return np.concatenate(parts)
 
     # ----- shared kernels -------------------------------------------------------------------------
+    def _rear_front(self, f):
+        """Pin forces from link forces ``f`` on their rear pin (front pin gets ``-f``), (n, ...)."""
+        return f - f[self.im1]
+
     def _links(self, u):
         """Link direction ``tt`` (1.74), ``tt.tt`` and stretch ``Delta`` (1.76), m."""
-        tt = (np.roll(u, -1, axis=0) - u) / self.L[:, None]
+        tt = (u[self.ip1] - u) / self.L[:, None]
         tt2 = _dot(tt, tt)
         return tt, tt2, 0.5 * self.L * (tt2 - 1.0)
 
@@ -150,12 +155,12 @@ class SymmetricChain:
 
     def _joint_forces(self, W, om):
         """Exact joint damping force ``-dPhi_joints/du'_perp`` (§2.8), (n, 2) N."""
-        mu = self.bj * (om - np.roll(om, 1))
-        return _rear_front((mu - np.roll(mu, -1))[:, None] * W)
+        mu = self.bj * (om - om[self.im1])
+        return self._rear_front((mu - mu[self.ip1])[:, None] * W)
 
     def _joint_rayleigh(self, om):
         """``Phi_joints`` (1.80), W."""
-        return 0.5 * (self.bj * (om - np.roll(om, 1)) ** 2).sum()
+        return 0.5 * (self.bj * (om - om[self.im1]) ** 2).sum()
 
     def _kernel(self, q, qd, elastic: bool, dissipative: bool):
         raise NotImplementedError
@@ -179,7 +184,9 @@ class SymmetricChain:
 
     def kinetic_energy(self, qd) -> float:
         """``T = qd . M qd / 2``, J (1.67, 1.69, 1.101)."""
-        return 0.5 * float(qd @ (self.mass_matrix() @ qd))
+        if self.M is None:
+            self.M = self.mass_matrix()
+        return 0.5 * float(qd @ (self.M @ qd))
 
     def solve_mass(self, f):
         """``M^-1 f`` per pin, closed form (§8.3)."""
@@ -263,10 +270,10 @@ class SymmetricChain:
         u, u3, _ = self.split(q)
         ud, u3d, _ = self.split(qd)
         tt, tt2, _ = self._links(u)
-        dd = np.roll(ud, -1, axis=0) - ud
+        dd = ud[self.ip1] - ud
         _, om = self._joint_rates(tt, tt2, dd)
         out = {f"{self.name}.link_tension": (N_el + N_d) * self.on, f"{self.name}.link_tension_elastic": N_el * self.on,
-               f"{self.name}.joint_rate": (om - np.roll(om, 1)) * self.on * np.roll(self.on, 1)}
+               f"{self.name}.joint_rate": (om - om[self.im1]) * self.on * np.roll(self.on, 1)}
         if u3 is not None:
             out[f"{self.name}.pin_axial_force"] = (self.geom.c_pin * (2 * u3 - self.geom.l)
                                                    + self.damping.beta_pin * self.geom.c_pin * 2 * u3d)
@@ -284,9 +291,9 @@ class ChainS1(SymmetricChain):
         u, _, _ = self.split(q)
         ud, _, _ = self.split(qd)
         tt, tt2, D = self._links(u)
-        dd = np.roll(ud, -1, axis=0) - ud
+        dd = ud[self.ip1] - ud
         N = (self.c * D if elastic else 0.0) + (self.b * _dot(tt, dd) if dissipative else 0.0)   # (1.92)
-        Q = _rear_front(N[:, None] * tt)
+        Q = self._rear_front(N[:, None] * tt)
         if dissipative:
             Q = Q + self._joint_forces(*self._joint_rates(tt, tt2, dd))
         return self._axial(Q, q, qd, elastic, dissipative)
@@ -304,7 +311,7 @@ class ChainS1(SymmetricChain):
         """``Phi = Phi_links + Phi_joints`` (1.78)-(1.83), W."""
         u, ud = self.split(q)[0], self.split(qd)[0]
         tt, tt2, _ = self._links(u)
-        dd = np.roll(ud, -1, axis=0) - ud
+        dd = ud[self.ip1] - ud
         _, om = self._joint_rates(tt, tt2, dd)
         return 0.5 * float((self.b * _dot(tt, dd) ** 2).sum()) + self._joint_rayleigh(om)
 
@@ -328,7 +335,7 @@ class ChainS1(SymmetricChain):
         """Named outputs (:attr:`output_specs`)."""
         u, ud = self.split(q)[0], self.split(qd)[0]
         tt, _, D = self._links(u)
-        return self._common_outputs(q, qd, self.c * D, self.b * _dot(tt, np.roll(ud, -1, axis=0) - ud))
+        return self._common_outputs(q, qd, self.c * D, self.b * _dot(tt, ud[self.ip1] - ud))
 
 
 class ChainS2(ChainS1):
@@ -378,15 +385,15 @@ class ChainS3(SymmetricChain):
     def _bisector(self, tt):
         """Pin section axes ``tau_p``, ``n_p`` and ``|x_p|`` of ``x_p = tt_{p-1,p} + tt_{p,p+1}`` (1.103)."""
         t = tt * self.on[:, None]
-        x = np.roll(t, 1, axis=0) + t
+        x = t[self.im1] + t
         nx = np.sqrt(_dot(x, x))
         tau = x / nx[:, None]
         return tau, _kx(tau), nx
 
     def _scatter_orientation(self, v):
         """Forces on pins ``p-1, p, p+1`` from ``v_p = dPi_p/dx_p`` (corrected 1.121/1.127 stencil), (n, 2)."""
-        iLm = np.roll(self.iL, 1)
-        return -np.roll(v * iLm[:, None], 1, axis=0) + (self.iL - iLm)[:, None] * v + np.roll(v, -1, axis=0) * self.iL[:, None]
+        iL, iLm = self.iL[:, None], self.iLm[:, None]
+        return -v[self.im1] * iLm + (iL - iLm) * v + v[self.ip1] * iL
 
     def _ahat(self, tau, nv, y):
         """``a_hat . y = A_tau (tau.y) tau + A_n (n.y) n`` (1.104, §3.5), per pin."""
@@ -397,10 +404,10 @@ class ChainS3(SymmetricChain):
         u, u3, up = self.split(q)
         ud, u3d, upd = self.split(qd)
         tt, tt2, D = self._links(u)
-        dp = np.roll(up, -1, axis=0) - up
+        dp = up[self.ip1] - up
         ttp = dp / self.L[:, None]                                     # tilde tau' (1.107)
-        dd = np.roll(ud, -1, axis=0) - ud
-        dpd = np.roll(upd, -1, axis=0) - upd
+        dd = ud[self.ip1] - ud
+        dpd = upd[self.ip1] - upd
         Dp = _dot(tt, dp)                                              # Delta' (1.107)
         Dd = _dot(tt, dd)                                              # (1.81)
         Dpd = _dot(tt, dpd) + _dot(ttp, dd)                            # (1.129)
@@ -409,7 +416,7 @@ class ChainS3(SymmetricChain):
     def _spin(self, tt, dd, nv, nx):
         """Pin spin rate ``omega_p = n_p . x_p' / |x_p|`` (1.116), rad/s."""
         t = (dd / self.L[:, None]) * self.on[:, None]
-        return _dot(nv, np.roll(t, 1, axis=0) + t) / nx
+        return _dot(nv, t[self.im1] + t) / nx
 
     def _kernel(self, q, qd, elastic, dissipative):
         u, u3, up, ud, u3d, upd, tt, tt2, D, ttp, dd, Dp, Dd, Dpd = self._strains(q, qd)
@@ -439,8 +446,8 @@ class ChainS3(SymmetricChain):
             Qu = Qu + self._scatter_orientation(w)                   # corrected (1.127)
             Qp = Qp - (16 * self.damping.beta_bend / l) * a_un       # (1.128)
             Q3 = Q3 - 4 * self.bp * u3d                              # (1.131)
-        Qu = Qu + _rear_front(N[:, None] * tt + Np[:, None] * ttp)
-        Qp = Qp + _rear_front(Np[:, None] * tt)
+        Qu = Qu + self._rear_front(N[:, None] * tt + Np[:, None] * ttp)
+        Qp = Qp + self._rear_front(Np[:, None] * tt)
         return np.concatenate([Qu.ravel(), Q3, Qp.ravel()])
 
     def potential_energy(self, q) -> float:
