@@ -77,7 +77,8 @@ def test_dissipative_forces_are_minus_the_rayleigh_gradient(Family, which):
     fam = Family(geometries()[which], damping)
     q, qd = state(fam, np.random.default_rng(2), spin=50.0)
     Qd = fam.dissipative_forces(q, qd)
-    err = blockwise_error(fam, Qd, -gradient(lambda v: fam.rayleigh(q, v), qd, steps(fam, 1e-6, 1e-4)))
+    # Phi is quadratic in the velocities: central differences are exact but for round-off, so take large steps
+    err = blockwise_error(fam, Qd, -gradient(lambda v: fam.rayleigh(q, v), qd, steps(fam, 1e-2, 1e-1)))
     assert err < 1e-6, err
     # Euler's identity for a Rayleigh function quadratic in the velocities (§8.5 test 2)
     assert np.isclose(qd @ Qd, -2 * fam.rayleigh(q, qd), rtol=1e-12)
@@ -190,12 +191,12 @@ def ring_rhs(fam):
     return rhs
 
 
-def free_ring_run(fam, periods, rng, damped=False):
-    """A ring spinning at 10 m/s with random displacements and velocities, over ``periods`` periods of
-    its lowest link (longitudinal) mode ``2 sqrt(c/m) sin(pi/n)``."""
+def free_ring_run(fam, periods, rng, damped=False, speed=10.0):
+    """A ring running at ``speed`` (m/s) with random displacements and velocities, over ``periods``
+    periods of its lowest link (longitudinal) mode ``2 sqrt(c/m) sin(pi/n)``."""
     g = fam.geom
     _, R = ring_positions(g.L)
-    q, qd = state(fam, rng, pos=2e-6, slope=2e-4, speed=0.3, spin=10.0 / R)
+    q, qd = state(fam, rng, pos=2e-6, slope=2e-4, speed=0.3, spin=speed / R)
     omega1 = 2 * np.sqrt(g.c_link.mean() / g.m_eff.mean()) * np.sin(np.pi / fam.n)
     y0 = np.concatenate([q, qd] + ([[0.0]] if damped else []))
     t_end = periods * 2 * np.pi / omega1
@@ -238,14 +239,14 @@ def test_reference_ring_conserves_momentum_and_energy(Family):
 
 @pytest.mark.parametrize("Family", FAMILIES)
 def test_energy_falls_at_the_rate_two_phi(Family):
-    """Damped 3-pin ring: E(t) + int 2 Phi dt stays E(0) along the run (power balance)."""
+    """Damped 3-pin ring vibrating about rest: E(t) + int 2 Phi dt stays E(0) along the run (power balance)."""
     g = small_ring()
     fam = Family(g, dataclasses.replace(damping_from_ratio(g, 0.05), b_joint=0.01))
-    res = free_ring_run(fam, 10, np.random.default_rng(8), damped=True)
+    res = free_ring_run(fam, 10, np.random.default_rng(8), damped=True, speed=0.0)
     n2 = fam.size
     E = np.array([fam.energy(y[:n2], y[n2:2 * n2]) for y in res.y.T])
     W = res.y[-1]
-    assert W[-1] > 1e-3 * E[0]                               # damping did work worth measuring
+    assert W[-1] > 0.01 * E[0]                               # damping did work worth measuring
     assert np.abs(E + W - E[0]).max() < 1e-6 * W[-1], np.abs(E + W - E[0]).max() / W[-1]
 
 
