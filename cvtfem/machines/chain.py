@@ -1,0 +1,99 @@
+"""A free discrete chain as a :class:`~cvtfem.assembly.model.Model`: one chain family (S1, S2 or S3 of
+:mod:`cvtfem.elements.chain.symmetric`) without sheaves, in the protocol every analysis uses.
+
+The first step of the chain into the machine (issue 13): time runs (``integrate.solve(model, ...)``),
+modal analysis of the linearised chain (``linearize``), outputs and energy through the same interface
+as the band models.  Sheave contact, the clamping loops and the initial state on the sheaves come later.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from functools import cached_property
+from typing import Any
+
+import numpy as np
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+from cvtfem.assembly.model import Linearization, ModelBase, StateLayout
+from cvtfem.outputs import OutputSpec
+
+
+@dataclass(frozen=True, eq=False)
+class FreeChain(ModelBase):
+    """``M q'' = Q(q, q')`` of a chain family with constant mass matrix, state ``x = [q, q']``.
+
+    Parameters
+    ----------
+    family : SymmetricChain
+        ``ChainS1``, ``ChainS2`` or ``ChainS3`` (``forces``, ``jacobian``, ``mass_matrix``, ``solve_mass``,
+        ``energy``, ``rayleigh``, ``outputs``).
+    q0 : array (n2,)
+        Start coordinates (absolute pin positions, m; S3 also end tangents); start velocity ``v0`` (m/s).
+    """
+
+    family: Any
+    q0: np.ndarray
+    v0: np.ndarray | None = field(default=None)
+
+    @cached_property
+    def layout(self) -> StateLayout:
+        return StateLayout(tuple(self.family.blocks))
+
+    @property
+    def output_specs(self) -> tuple[OutputSpec, ...]:
+        return tuple(self.family.output_specs)
+
+    def initial_state(self) -> np.ndarray:
+        v0 = np.zeros_like(self.q0) if self.v0 is None else self.v0
+        return np.concatenate([self.q0, v0]).astype(float)
+
+    def _split(self, x):
+        n = self.n2
+        return x[:n], x[n:]
+
+    def rhs(self, t: float, x: np.ndarray) -> np.ndarray:
+        """``[q', M^-1 Q(q, q')]``."""
+        q, v = self._split(x)
+        return np.concatenate([v, self.family.solve_mass(self.family.forces(q, v))])
+
+    @cached_property
+    def _inv_mass(self) -> sp.csr_matrix:
+        """``M^-1`` (block-diagonal per pin: its pattern is M's)."""
+        M = self.family.mass_matrix().tocsc()
+        return sp.csr_matrix(spla.inv(M))
+
+    def jac(self, t: float, x: np.ndarray) -> sp.csr_matrix:
+        """Sparse ``[[0, I], [M^-1 dQ/dq, M^-1 dQ/dq']]`` from the family's Jacobian blocks."""
+        q, v = self._split(x)
+        dq, dv = self.family.jacobian(q, v)
+        n = self.n2
+        eye = sp.identity(n, format="csr")
+        return sp.bmat([[None, eye], [self._inv_mass @ dq, self._inv_mass @ dv]], format="csr")
+
+    @cached_property
+    def jac_sparsity(self) -> sp.csr_matrix:
+        """``u' = v`` rows and ``M^-1`` times the family's pattern (pins ``p +- 2``) in the velocity rows."""
+        lower = (abs(self._inv_mass) @ sp.csr_matrix(self.family.jac_sparsity, dtype=float)) != 0
+        return sp.bmat([[None, sp.identity(self.n2, format="csr")], [lower, lower]], format="csr").astype(bool)
+
+    def outputs(self, t: float, x: np.ndarray) -> dict[str, Any]:
+        q, v = self._split(x)
+        return self.family.outputs(q, v)
+
+    def linearize(self, x0: np.ndarray) -> Linearization:
+        """``M du'' + C du' + K du = 0`` about ``x0``: ``K = -dQ/dq``, ``C = -dQ/dq'``, ``G = 0``."""
+        q, v = self._split(x0)
+        dq, dv = self.family.jacobian(q, v)
+        return Linearization(M=self.family.mass_matrix(), C=-dv, G=sp.csr_matrix(dq.shape), K=-dq)
+
+    def energy(self, x: np.ndarray) -> float:
+        """Kinetic plus elastic energy of the chain, J."""
+        q, v = self._split(x)
+        return float(self.family.energy(q, v))
+
+    def power(self, t: float, x: np.ndarray) -> dict[str, float]:
+        """Input power (none: a free chain) and the dissipated power ``2 Phi`` of the Rayleigh forces, W
+        (``dE/dt = input - dissipated``)."""
+        q, v = self._split(x)
+        return {"input": 0.0, "dissipated": 2.0 * float(self.family.rayleigh(q, v))}
