@@ -1,0 +1,1 @@
+"""Discrete chain element families (spec chain-models-1/2)."""
