@@ -33,6 +33,7 @@ _M_PERP = np.array([[1.0, 0.0, 1 / 12, -1 / 12],
                     [1 / 12, -1 / 60, 1 / 105, -1 / 140],
                     [-1 / 12, -1 / 60, -1 / 140, 1 / 105]])
 _M_PAR = np.diag([1.0, 1 / 3])
+_KX = np.array([-1.0, 1.0])
 
 
 def shape_functions(xi: np.ndarray, l: float) -> np.ndarray:
@@ -50,7 +51,7 @@ def shape_slopes(xi: np.ndarray, l: float) -> np.ndarray:
 
 def _kx(v: np.ndarray) -> np.ndarray:
     """``k x v`` for in-plane vectors ``v (..., 2)``."""
-    return np.stack([-v[..., 1], v[..., 0]], -1)
+    return v[..., ::-1] * _KX
 
 
 def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -142,6 +143,7 @@ class ChainA1:
 
         pad = n - n_links                      # 1 for an open chain: link n-1 is a dummy with weight 0
         self.n_pins, self.n_links, self.closed, self.kmax = n, n_links, closed, kmax
+        self._next, self._prev = (np.arange(n) + 1) % n, (np.arange(n) - 1) % n     # pins p+1, p-1 (cyclic)
         self.l = float(pin_length)
         self.m = m
         self.L = np.r_[pitch, np.ones(pad)]
@@ -158,7 +160,7 @@ class ChainA1:
         self.c_pin = np.broadcast_to(np.asarray(pin_axial_stiffness, float), (n,)).copy()
         self.b_pin = np.broadcast_to(np.asarray(pin_axial_damping, float), (n,)).copy()
         self.b_joint = (np.broadcast_to(np.asarray(joint_damping, float), (n,))
-                        * self.weight * np.roll(self.weight, 1))          # joint p needs links p-1 and p
+                        * self.weight * self.weight[self._prev])          # joint p needs links p-1 and p
         self.A_tau, self.A_n = float(pin_bending_tau), float(pin_bending_n)
         self.beta_ext, self.beta_tors = float(beta_link_ext), float(beta_link_tors)
         self.beta_shear, self.beta_bend = float(beta_link_shear), float(beta_bend)
@@ -267,28 +269,28 @@ class ChainA1:
     def _link_strains(self, u: np.ndarray, w: np.ndarray) -> dict:
         """Link differences, direction (1.138), stretches (1.140), twist (1.146), shear (1.153)."""
         L, l = self.L, self.l
-        du = np.roll(u, -1, 1) - u
-        dw0 = np.roll(w[0], -1) - w[0]
+        du = u[:, self._next] - u
+        dw0 = w[0][self._next] - w[0]
         tt = du[0] / L[:, None]
         D = np.empty((4, self.n_pins))
         D[0] = 0.5 * L * (_dot(tt, tt) - 1.0)
         D[1:] = _dot(tt[None], du[1:])
         phi = 2 / l * _cross(du[1], tt)
-        s1 = u[1] + np.roll(u[1], -1, 0)
+        s1 = u[1] + u[1][self._next]
         gam = self.s_gamma * (_dot(s1, tt) / l + dw0 / L)
         return dict(du=du, tt=tt, D=D, phi=phi, s1=s1, gam=gam)
 
     def _link_rates(self, s: dict, vu: np.ndarray, vw: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Strain rates of (1.154)-(1.157): the same gradients applied to the velocities (1.164)."""
         L, l = self.L, self.l
-        dv = np.roll(vu, -1, 1) - vu
-        dvw0 = np.roll(vw[0], -1) - vw[0]
+        dv = vu[:, self._next] - vu
+        dvw0 = vw[0][self._next] - vw[0]
         ttd = dv[0] / L[:, None]
         Dd = np.empty((4, self.n_pins))
         Dd[0] = _dot(s["tt"], dv[0])
         Dd[1:] = _dot(s["tt"][None], dv[1:]) + _dot(ttd[None], s["du"][1:])
         phid = 2 / l * (_cross(dv[1], s["tt"]) + _cross(s["du"][1], ttd))
-        s1d = vu[1] + np.roll(vu[1], -1, 0)
+        s1d = vu[1] + vu[1][self._next]
         gamd = self.s_gamma * ((_dot(s1d, s["tt"]) + _dot(s["s1"], ttd)) / l + dvw0 / L)
         return Dd, phid, gamd
 
@@ -304,18 +306,18 @@ class ChainA1:
         G[1] = f[1][:, None] * tt - (2 * ft / l)[:, None] * _kx(tt)
         G[2] = f[2][:, None] * tt
         G[3] = f[3][:, None] * tt
-        Qu = G - np.roll(G, 1, 1)
+        Qu = G - G[:, self._prev]
         sh = (sg * fs / l)[:, None] * tt                 # shear acts on the sum u_{p,1} + u_{p+1,1}
-        Qu[1] -= sh + np.roll(sh, 1, 0)
+        Qu[1] -= sh + sh[self._prev]
         gw = sg * fs / L
         Qw = np.zeros((2, self.n_pins))
-        Qw[0] = gw - np.roll(gw, 1)
+        Qw[0] = gw - gw[self._prev]
         return Qu, Qw
 
     def _bisector(self, tt: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Pin section axes (1.103): ``|x_p|``, ``tau_p``, ``n_p`` from the weighted link directions."""
         wt = self.weight[:, None] * tt
-        x = wt + np.roll(wt, 1, 0)
+        x = wt + wt[self._prev]
         r = np.sqrt(_dot(x, x))
         tau = x / r[:, None]
         return r, tau, _kx(tau)
@@ -326,8 +328,8 @@ class ChainA1:
 
     def _scatter_axes(self, v: np.ndarray) -> np.ndarray:
         """Force on ``u_{p,0}`` of a per-pin ``dPi/dx_p`` vector: stencil of (1.162)/(1.167), sign as a force."""
-        g, gm = self.g, np.roll(self.g, 1)
-        return g[:, None] * np.roll(v, -1, 0) + (g - gm)[:, None] * v - gm[:, None] * np.roll(v, 1, 0)
+        g, gm = self.g, self.g[self._prev]
+        return g[:, None] * v[self._next] + (g - gm)[:, None] * v - gm[:, None] * v[self._prev]
 
     # ------------------------------------------------------------------ energies
     def potential_energy(self, q: np.ndarray) -> float:
@@ -368,16 +370,16 @@ class ChainA1:
 
     def _corotated_rates(self, u, vu, s, r, nv) -> np.ndarray:
         """``u_i^nabla = u_i' - omega_p k x u_i`` (i = 2, 3) with the spin rate (1.116)."""
-        wt = self.weight[:, None] * (np.roll(vu[0], -1, 0) - vu[0]) / self.L[:, None]
-        omega = _dot(nv, wt + np.roll(wt, 1, 0)) / r
+        wt = self.weight[:, None] * (vu[0][self._next] - vu[0]) / self.L[:, None]
+        omega = _dot(nv, wt + wt[self._prev]) / r
         return vu[2:] - omega[None, :, None] * _kx(u[2:])
 
     def _joint_rates(self, s: dict, vu: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """``W_e = d omega_e / d u'_{e+1,0}`` and joint rates ``omega^joint_p = omega_{p,p+1} - omega_{p-1,p}`` (1.82)-(1.83)."""
         tt = s["tt"]
         W = _kx(tt) / (self.L * _dot(tt, tt))[:, None]
-        om = _dot(W, np.roll(vu[0], -1, 0) - vu[0])
-        return W, om - np.roll(om, 1)
+        om = _dot(W, vu[0][self._next] - vu[0])
+        return W, om - om[self._prev]
 
     # ------------------------------------------------------------------ forces
     def elastic_forces(self, q: np.ndarray) -> np.ndarray:
@@ -431,10 +433,10 @@ class ChainA1:
                 W, oj = self._joint_rates(s, vu)
                 tq = self.b_joint * oj
                 if self.joint_damping_form == "exact":
-                    G = (tq - np.roll(tq, -1))[:, None] * W
-                    Qu_pin[0] += G - np.roll(G, 1, 0)
+                    G = (tq - tq[self._next])[:, None] * W
+                    Qu_pin[0] += G - G[self._prev]
                 else:
-                    Qu_pin[0] += tq[:, None] * (W + np.roll(W, 1, 0))
+                    Qu_pin[0] += tq[:, None] * (W + W[self._prev])
         Qu, Qw = self._link_forces(s, f, ft, fs)
         Qu += Qu_pin
         Qu[0] += self._scatter_axes(daxes)
