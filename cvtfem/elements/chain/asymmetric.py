@@ -24,6 +24,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from cvtfem.elements.base import Block
+from cvtfem.elements.chain import asymmetric_kernel as ker
 from cvtfem.errors import InputError
 from cvtfem.outputs import OutputSpec
 
@@ -102,6 +103,9 @@ class ChainA1:
         ``gamma = (psi_1 + psi_2)/2`` (spec 2.5, default) or the printed (1.153), twice that.
     joint_damping_form : "exact" | "printed"
         Exact gradient of the joint Rayleigh function (spec 2.8) or the printed (1.165).
+    use_numba : bool
+        Evaluate forces with the compiled kernel of ``asymmetric_kernel`` (when numba is installed);
+        the numpy methods are its tested reference twin.
     """
 
     def __init__(self, *, pitch, plate_xi, n_plates, plate_stiffness, plate_bending_stiffness,
@@ -109,7 +113,8 @@ class ChainA1:
                  pin_bending_tau: float, pin_bending_n: float, beta_link_ext: float = 0.0,
                  beta_link_tors: float = 0.0, beta_link_shear: float = 0.0, beta_bend: float = 0.0,
                  pin_axial_damping=0.0, joint_damping=0.0, closed: bool = True,
-                 shear_convention: str = "derived", joint_damping_form: str = "exact") -> None:
+                 shear_convention: str = "derived", joint_damping_form: str = "exact",
+                 use_numba: bool = True) -> None:
         m = np.asarray(pin_mass, float)
         n = m.size
         n_links = n if closed else n - 1
@@ -173,6 +178,8 @@ class ChainA1:
         self._minv_perp = np.linalg.inv(unit[:8:2, :8:2])
         self._minv_par = np.linalg.inv(unit[8:, 8:])
         self.jac_sparsity = self._jac_sparsity()
+        self.backend = "numba" if use_numba and ker.HAVE_NUMBA else "numpy"
+        self._packed = ker.pack(self)
 
     # ------------------------------------------------------------------ layout
     @property
@@ -395,6 +402,14 @@ class ChainA1:
         return self._forces(q, v, elastic=True)
 
     def _forces(self, q: np.ndarray, v: np.ndarray | None, elastic: bool) -> np.ndarray:
+        if self.backend == "numba":
+            u, w = self.split(np.ascontiguousarray(q, dtype=float))
+            vu, vw = (u, w) if v is None else self.split(np.ascontiguousarray(v, dtype=float))
+            return self.join(*ker.forces(u, w, vu, vw, v is not None, elastic, *self._packed))
+        return self._forces_numpy(q, v, elastic)
+
+    def _forces_numpy(self, q: np.ndarray, v: np.ndarray | None, elastic: bool) -> np.ndarray:
+        """Reference twin of the compiled kernel."""
         l = self.l
         u, w = self.split(q)
         s = self._link_strains(u, w)
