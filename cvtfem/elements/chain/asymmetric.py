@@ -489,6 +489,142 @@ class ChainA1:
                 np.add.at(Qu[i], pins, (2 / self.l * dh[i])[:, None] * mk)
         return self.join(Qu, Qw)
 
+    # ------------------------------------------------------------------ Jacobian blocks
+    def stiffness_matrix(self, q: np.ndarray) -> sp.csr_matrix:
+        """``K = dQ/dq`` of the elastic forces (N/m etc.), exact: ``-(J^T c J + sum sigma H)`` per term.
+
+        With :meth:`damping_matrix` this is the exact linearisation at any state with ``v = 0`` (the
+        dissipative forces are linear in ``v``); at ``v != 0`` it omits ``dQ_d/dq``.
+        """
+        n, l, sg = self.n_pins, self.l, self.s_gamma
+        u, w = self.split(q)
+        s = self._link_strains(u, w)
+        gD, gphi, ggam = self._link_gradients(s)
+        f = np.einsum("eij,je->ie", self.cij, s["D"])
+        ft, fs = self.c_tors * s["phi"], self.c_shear * s["gam"]
+        K = (np.einsum("eij,ien,jem->enm", self.cij, gD, gD) + self.c_tors[:, None, None] * gphi[:, :, None] * gphi[:, None]
+             + self.c_shear[:, None, None] * ggam[:, :, None] * ggam[:, None])
+        I2, E = np.eye(2), np.array([[0.0, 1.0], [-1.0, 0.0]])
+        for a, sa in ((0, -1.0), (1, 1.0)):
+            for b, sb in ((0, -1.0), (1, 1.0)):
+                oa, ob = 10 * a, 10 * b
+                K[:, oa:oa + 2, ob:ob + 2] += (sa * sb * f[0] / self.L)[:, None, None] * I2          # H of Delta_0
+                for i in range(1, 4):                                                               # H of Delta_i
+                    blk = (sa * sb * f[i] / self.L)[:, None, None] * I2
+                    K[:, oa:oa + 2, ob + 2 * i:ob + 2 * i + 2] += blk
+                    K[:, ob + 2 * i:ob + 2 * i + 2, oa:oa + 2] += blk
+                blk = (sa * sb * ft * 2 / (l * self.L))[:, None, None] * E                           # H of phi
+                K[:, oa + 2:oa + 4, ob:ob + 2] += blk
+                K[:, ob:ob + 2, oa + 2:oa + 4] += np.swapaxes(blk, 1, 2)
+                blk = (sb * sg * fs / (l * self.L))[:, None, None] * I2                              # H of gamma
+                K[:, ob:ob + 2, oa + 2:oa + 4] += blk
+                K[:, oa + 2:oa + 4, ob:ob + 2] += blk
+        parts = [(self._link_index(), -K)]
+        # pin axial (1.136) and pin bending (1.137) with the bisector axes (1.103)
+        parts.append((self.dof_index[:, 9:10], np.full((n, 1, 1), -4.0) * self.c_pin[:, None, None]))
+        parts.append((self._bend_index(), -self._bending_hessian(u, s)))
+        return self._assemble(parts)
+
+    def damping_matrix(self, q: np.ndarray) -> sp.csr_matrix:
+        """``C = dQ/dv`` (N s/m etc.), exact: the dissipative forces are linear in ``v`` (1.154)-(1.159), (1.80)."""
+        n, l = self.n_pins, self.l
+        u, w = self.split(q)
+        s = self._link_strains(u, w)
+        gD, gphi, ggam = self._link_gradients(s)
+        C = (self.beta_ext * np.einsum("eij,ien,jem->enm", self.cij, gD, gD)
+             + (self.beta_tors * self.c_tors)[:, None, None] * gphi[:, :, None] * gphi[:, None]
+             + (self.beta_shear * self.c_shear)[:, None, None] * ggam[:, :, None] * ggam[:, None])
+        parts = [(self._link_index(), -C),
+                 (self.dof_index[:, 9:10], np.full((n, 1, 1), -4.0) * self.b_pin[:, None, None])]
+        # co-rotated bending rates u_i^nabla = B_i v_loc over (u_0 of p-1, p, p+1; u_2, u_3 of p)
+        r, tau, nv = self._bisector(s["tt"])
+        lam = np.stack([-self.g[self._prev], self.g[self._prev] - self.g, self.g], 1)        # dx_p/du_0
+        B = np.zeros((2, n, 2, 10))
+        for i in range(2):
+            kxu = _kx(u[2 + i])
+            for m in range(3):
+                B[i, :, :, 2 * m:2 * m + 2] = -(lam[:, m] / r)[:, None, None] * kxu[:, :, None] * nv[:, None, :]
+            B[i, :, :, 6 + 2 * i:8 + 2 * i] = np.eye(2)
+        ahat = self.A_tau * tau[:, :, None] * tau[:, None] + self.A_n * nv[:, :, None] * nv[:, None]
+        cb = np.array([[4.0, 2.0], [2.0, 4.0]]) / l
+        Cb = np.einsum("ij,ienx,enm,jemy->exy", cb, B, ahat, B)
+        parts.append((self._bend_index(), -self.beta_bend * Cb))
+        # joints: omega^joint_p = g_p . (v_0 of p-1, p, p+1), g = (W_{p-1}, -W_{p-1} - W_p, W_p)
+        W, _ = self._joint_rates(s, np.zeros_like(u))
+        Wm = W[self._prev]
+        gj = np.concatenate([Wm, -Wm - W, W], 1)
+        jidx = self._bend_index()[:, :6]
+        if self.joint_damping_form == "exact":
+            parts.append((jidx, -self.b_joint[:, None, None] * gj[:, :, None] * gj[:, None]))
+        else:                                      # printed (1.165): rows of pin p only
+            rows = np.zeros((n, 6, 6))
+            rows[:, 2:4] = self.b_joint[:, None, None] * (W + Wm)[:, :, None] * gj[:, None]
+            parts.append((jidx, rows))
+        return self._assemble(parts)
+
+    def _link_gradients(self, s: dict) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Gradients of ``Delta_i`` (4, n, 20), ``phi`` and ``gamma`` (n, 20) over the 20 coordinates of a link's pins."""
+        n, l, L, sg, tt, du = self.n_pins, self.l, self.L, self.s_gamma, s["tt"], s["du"]
+        gD, gphi, ggam = np.zeros((4, n, 20)), np.zeros((n, 20)), np.zeros((n, 20))
+        for a, sa in ((0, -1.0), (1, 1.0)):
+            o = 10 * a
+            gD[0, :, o:o + 2] = sa * tt
+            for i in range(1, 4):
+                gD[i, :, o:o + 2] = sa * du[i] / L[:, None]
+                gD[i, :, o + 2 * i:o + 2 * i + 2] = sa * tt
+            gphi[:, o:o + 2] = sa * (2 / (l * L))[:, None] * _kx(du[1])
+            gphi[:, o + 2:o + 4] = -sa * 2 / l * _kx(tt)
+            ggam[:, o:o + 2] = sa * sg * s["s1"] / (l * L)[:, None]
+            ggam[:, o + 2:o + 4] = sg * tt / l
+            ggam[:, o + 8] = sa * sg / L
+        return gD, gphi, ggam
+
+    def _bending_hessian(self, u: np.ndarray, s: dict) -> np.ndarray:
+        """Hessian (n, 10, 10) of ``Pi^pin,bend_p`` over (u_0 of p-1, p, p+1; u_2, u_3 of p)."""
+        n, l = self.n_pins, self.l
+        r, tau, nv = self._bisector(s["tt"])
+        dA = self.A_tau - self.A_n
+        cb = np.array([[4.0, 2.0], [2.0, 4.0]]) / l
+        U = u[2:]                                                    # (2, n, 2)
+        a = _dot(tau[None], U)                                       # tau . u_i
+        b = _dot(nv[None], U)                                        # n . u_i
+        g = b[:, :, None] * nv[None] / r[None, :, None]              # d a_i / dx
+        ca = cb @ a                                                   # sum_j c_ij a_j
+        tn = tau[:, :, None] * nv[:, None] + nv[:, :, None] * tau[:, None]
+        nn = nv[:, :, None] * nv[:, None]
+        Hxx = dA * (np.einsum("ij,inx,jny->nxy", cb, g, g)
+                    - np.einsum("in,in,nxy->nxy", ca, b, tn) / r[:, None, None] ** 2
+                    - np.einsum("in,in,nxy->nxy", ca, a, nn) / r[:, None, None] ** 2)
+        H = np.zeros((n, 10, 10))
+        lam = np.stack([-self.g[self._prev], self.g[self._prev] - self.g, self.g], 1)
+        ahat = self.A_tau * tau[:, :, None] * tau[:, None] + self.A_n * nn
+        cg = np.einsum("ij,inx->jnx", cb, g)                          # sum_i c_ik g_i
+        for k in range(2):
+            Hxu = dA * ((ca[k] / r)[:, None, None] * nn + cg[k][:, :, None] * tau[:, None])   # d2/dx du_k
+            for m in range(3):
+                H[:, 2 * m:2 * m + 2, 6 + 2 * k:8 + 2 * k] = lam[:, m, None, None] * Hxu
+                H[:, 6 + 2 * k:8 + 2 * k, 2 * m:2 * m + 2] = lam[:, m, None, None] * np.swapaxes(Hxu, 1, 2)
+            for j in range(2):
+                H[:, 6 + 2 * k:8 + 2 * k, 6 + 2 * j:8 + 2 * j] = cb[k, j] * ahat
+        for m in range(3):
+            for mm in range(3):
+                H[:, 2 * m:2 * m + 2, 2 * mm:2 * mm + 2] = (lam[:, m] * lam[:, mm])[:, None, None] * Hxx
+        return H
+
+    def _link_index(self) -> np.ndarray:
+        return np.concatenate([self.dof_index, self.dof_index[self._next]], 1)
+
+    def _bend_index(self) -> np.ndarray:
+        d = self.dof_index
+        return np.concatenate([d[self._prev, :2], d[:, :2], d[self._next, :2], d[:, 4:8]], 1)
+
+    def _assemble(self, parts) -> sp.csr_matrix:
+        """Sum local blocks ``(index (n, k), values (n, k, k))`` into one CSR matrix (COO, duplicates summed)."""
+        rows = np.concatenate([np.broadcast_to(i[:, :, None], v.shape).ravel() for i, v in parts])
+        cols = np.concatenate([np.broadcast_to(i[:, None, :], v.shape).ravel() for i, v in parts])
+        vals = np.concatenate([v.ravel() for _, v in parts])
+        return sp.csr_matrix((vals, (rows, cols)), shape=(self.n2, self.n2))
+
     # ------------------------------------------------------------------ Jacobian pattern
     def _jac_sparsity(self) -> sp.csr_matrix:
         """Pattern of ``dQ/dq`` and ``dQ/dv``: pin ``p`` couples to pins ``p-2..p+2`` (bisector axes and joints, spec 8)."""

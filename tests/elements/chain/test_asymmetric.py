@@ -288,6 +288,44 @@ def test_jacobian_pattern_contains_finite_differences(closed):
     assert sp.issparse(ch.jac_sparsity) and ch.jac_sparsity.nnz == 50 * 10 * ch.n_pins - (0 if closed else 600)
 
 
+@pytest.mark.parametrize("closed", [True, False])
+@pytest.mark.parametrize("part", list(ONLY))
+def test_stiffness_matrix_equals_finite_differences(part, closed):
+    """Per block of coordinates (u_0, u_1, u_2/u_3, w), so that the small bisector-rotation terms count."""
+    ch = chain(closed=closed, **ONLY[part])
+    q = random_state(ch, np.random.default_rng(16), amp=1e-3)
+    K = ch.stiffness_matrix(q)
+    Kfd = grad(ch.elastic_forces, q, 1e-8).T
+    Kd = K.toarray()
+    assert np.allclose(Kd, Kd.T, rtol=0, atol=1e-12 * np.abs(Kd).max())         # a Hessian
+    assert not np.any(Kd[~ch.jac_sparsity.toarray()])
+    d = ch.dof_index
+    groups = [d[:, :2], d[:, 2:4], d[:, 4:8], d[:, 8:]]
+    for a in groups:
+        for b in groups:
+            blk = np.ix_(a.ravel(), b.ravel())
+            scale = np.abs(Kfd[blk]).max()
+            if scale > 1e-9 * np.abs(Kfd).max():
+                assert np.abs(Kd[blk] - Kfd[blk]).max() <= 1e-6 * scale
+
+
+@pytest.mark.parametrize("closed", [True, False])
+@pytest.mark.parametrize("form", ["exact", "printed"])
+def test_damping_matrix_equals_finite_differences(form, closed):
+    ch = chain(closed=closed, joint_damping_form=form)
+    rng = np.random.default_rng(17)
+    q, v = random_state(ch, rng, amp=1e-3), rng.standard_normal(ch.n2)
+    C = ch.damping_matrix(q).toarray()
+    Cfd = grad(lambda x: ch.dissipative_forces(q, x), v, 1.0).T       # Q_d is linear in v
+    assert np.abs(C - Cfd).max() <= 1e-9 * np.abs(Cfd).max()
+    if form == "exact":
+        assert np.allclose(C, C.T, rtol=0, atol=1e-12 * np.abs(C).max())
+        assert np.all(np.linalg.eigvalsh(C) <= 1e-10 * np.abs(C).max())   # C = -d2 Phi/dv2
+    # at rest the dissipative forces vanish with their q-derivative: K, C are the exact linearisation
+    J = grad(lambda x: ch.forces(x, np.zeros(ch.n2)), q, 1e-8).T
+    assert np.abs(J - ch.stiffness_matrix(q).toarray()).max() <= 1e-6 * np.abs(J).max()
+
+
 def test_outputs_and_layout():
     ch = chain()
     rng = np.random.default_rng(14)
