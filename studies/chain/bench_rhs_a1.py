@@ -4,7 +4,8 @@
 
 Prints the machine and its load with the medians of 1,000 calls of ``elastic_forces``, ``forces``
 (elastic + all damping) and ``accel`` (forces + per-pin mass solve) at a perturbed ring state, for
-the compiled kernel (numba) and its numpy twin.
+the compiled kernel (numba) and its numpy twin, and of 100 calls of the analytic ``stiffness_matrix``
+and ``damping_matrix`` (sparse, numpy).
 """
 import os
 import platform
@@ -58,6 +59,8 @@ def main() -> None:
                           ("accel", lambda: c.accel(q, v))):
             fun()
             lines.append(f"{c.backend:<6} {name:<24} median of 1000: {median_us(fun):8.1f} us")
+    for name, fun in (("stiffness_matrix", lambda: ch.stiffness_matrix(q)), ("damping_matrix", lambda: ch.damping_matrix(q))):
+        lines.append(f"numpy  {name:<24} median of 100:  {median_us(fun, 100):8.1f} us")
     lines.append(f"machine after: {machine()}")
     print("\n".join(lines))
     OUT.mkdir(parents=True, exist_ok=True)

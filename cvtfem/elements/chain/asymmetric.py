@@ -178,6 +178,9 @@ class ChainA1:
         self._minv_perp = np.linalg.inv(unit[:8:2, :8:2])
         self._minv_par = np.linalg.inv(unit[8:, 8:])
         self.jac_sparsity = self._jac_sparsity()
+        pat = self.jac_sparsity.tocoo()
+        self._pattern_keys = pat.row.astype(np.int64) * self.n2 + pat.col     # sorted: canonical CSR order
+        self._positions: dict = {}
         self.backend = "numba" if use_numba and ker.HAVE_NUMBA else "numpy"
         self._packed = ker.pack(self)
 
@@ -228,6 +231,20 @@ class ChainA1:
         u[0] = centres
         w = np.stack([np.zeros(n) if axial is None else np.asarray(axial, float), np.full(n, self.l / 2)])
         return self.join(u, w)
+
+    def from_raw(self, far: np.ndarray, near: np.ndarray, slope_far: np.ndarray, slope_near: np.ndarray) -> np.ndarray:
+        """State from the raw end coordinates (2.1): end points ``(n, 3)`` m and end slopes ``dU_perp/ds (n, 2)``."""
+        far, near = np.asarray(far, float), np.asarray(near, float)
+        u1 = (near[:, :2] - far[:, :2]) / 2
+        u = np.stack([(near[:, :2] + far[:, :2]) / 2, u1, slope_far - 2 / self.l * u1, slope_near - 2 / self.l * u1])
+        return self.join(u, np.stack([(near[:, 2] + far[:, 2]) / 2, (near[:, 2] - far[:, 2]) / 2]))
+
+    def to_raw(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """Inverse of :meth:`from_raw`: ``far, near (n, 3)`` m and ``slope_far, slope_near (n, 2)``."""
+        u, w = self.split(q)
+        far = np.column_stack([u[0] - u[1], w[0] - w[1]])
+        near = np.column_stack([u[0] + u[1], w[0] + w[1]])
+        return far, near, u[2] + 2 / self.l * u[1], u[3] + 2 / self.l * u[1]
 
     # ------------------------------------------------------------------ inertia
     def _unit_block(self) -> np.ndarray:
@@ -502,7 +519,7 @@ class ChainA1:
         gD, gphi, ggam = self._link_gradients(s)
         f = np.einsum("eij,je->ie", self.cij, s["D"])
         ft, fs = self.c_tors * s["phi"], self.c_shear * s["gam"]
-        K = (np.einsum("eij,ien,jem->enm", self.cij, gD, gD) + self.c_tors[:, None, None] * gphi[:, :, None] * gphi[:, None]
+        K = (np.einsum("eij,ien,jem->enm", self.cij, gD, gD, optimize=True) + self.c_tors[:, None, None] * gphi[:, :, None] * gphi[:, None]
              + self.c_shear[:, None, None] * ggam[:, :, None] * ggam[:, None])
         I2, E = np.eye(2), np.array([[0.0, 1.0], [-1.0, 0.0]])
         for a, sa in ((0, -1.0), (1, 1.0)):
@@ -519,10 +536,10 @@ class ChainA1:
                 blk = (sb * sg * fs / (l * self.L))[:, None, None] * I2                              # H of gamma
                 K[:, ob:ob + 2, oa + 2:oa + 4] += blk
                 K[:, oa + 2:oa + 4, ob:ob + 2] += blk
-        parts = [(self._link_index(), -K)]
+        parts = [("link", self._link_index(), -K)]
         # pin axial (1.136) and pin bending (1.137) with the bisector axes (1.103)
-        parts.append((self.dof_index[:, 9:10], np.full((n, 1, 1), -4.0) * self.c_pin[:, None, None]))
-        parts.append((self._bend_index(), -self._bending_hessian(u, s)))
+        parts.append(("axial", self.dof_index[:, 9:10], np.full((n, 1, 1), -4.0) * self.c_pin[:, None, None]))
+        parts.append(("bend", self._bend_index(), -self._bending_hessian(u, s)))
         return self._assemble(parts)
 
     def damping_matrix(self, q: np.ndarray) -> sp.csr_matrix:
@@ -531,11 +548,11 @@ class ChainA1:
         u, w = self.split(q)
         s = self._link_strains(u, w)
         gD, gphi, ggam = self._link_gradients(s)
-        C = (self.beta_ext * np.einsum("eij,ien,jem->enm", self.cij, gD, gD)
+        C = (self.beta_ext * np.einsum("eij,ien,jem->enm", self.cij, gD, gD, optimize=True)
              + (self.beta_tors * self.c_tors)[:, None, None] * gphi[:, :, None] * gphi[:, None]
              + (self.beta_shear * self.c_shear)[:, None, None] * ggam[:, :, None] * ggam[:, None])
-        parts = [(self._link_index(), -C),
-                 (self.dof_index[:, 9:10], np.full((n, 1, 1), -4.0) * self.b_pin[:, None, None])]
+        parts = [("link", self._link_index(), -C),
+                 ("axial", self.dof_index[:, 9:10], np.full((n, 1, 1), -4.0) * self.b_pin[:, None, None])]
         # co-rotated bending rates u_i^nabla = B_i v_loc over (u_0 of p-1, p, p+1; u_2, u_3 of p)
         r, tau, nv = self._bisector(s["tt"])
         lam = np.stack([-self.g[self._prev], self.g[self._prev] - self.g, self.g], 1)        # dx_p/du_0
@@ -547,19 +564,19 @@ class ChainA1:
             B[i, :, :, 6 + 2 * i:8 + 2 * i] = np.eye(2)
         ahat = self.A_tau * tau[:, :, None] * tau[:, None] + self.A_n * nv[:, :, None] * nv[:, None]
         cb = np.array([[4.0, 2.0], [2.0, 4.0]]) / l
-        Cb = np.einsum("ij,ienx,enm,jemy->exy", cb, B, ahat, B)
-        parts.append((self._bend_index(), -self.beta_bend * Cb))
+        Cb = np.einsum("ij,ienx,enm,jemy->exy", cb, B, ahat, B, optimize=True)
+        parts.append(("bend", self._bend_index(), -self.beta_bend * Cb))
         # joints: omega^joint_p = g_p . (v_0 of p-1, p, p+1), g = (W_{p-1}, -W_{p-1} - W_p, W_p)
         W, _ = self._joint_rates(s, np.zeros_like(u))
         Wm = W[self._prev]
         gj = np.concatenate([Wm, -Wm - W, W], 1)
         jidx = self._bend_index()[:, :6]
         if self.joint_damping_form == "exact":
-            parts.append((jidx, -self.b_joint[:, None, None] * gj[:, :, None] * gj[:, None]))
+            parts.append(("joint", jidx, -self.b_joint[:, None, None] * gj[:, :, None] * gj[:, None]))
         else:                                      # printed (1.165): rows of pin p only
             rows = np.zeros((n, 6, 6))
             rows[:, 2:4] = self.b_joint[:, None, None] * (W + Wm)[:, :, None] * gj[:, None]
-            parts.append((jidx, rows))
+            parts.append(("joint", jidx, rows))
         return self._assemble(parts)
 
     def _link_gradients(self, s: dict) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -619,11 +636,22 @@ class ChainA1:
         return np.concatenate([d[self._prev, :2], d[:, :2], d[self._next, :2], d[:, 4:8]], 1)
 
     def _assemble(self, parts) -> sp.csr_matrix:
-        """Sum local blocks ``(index (n, k), values (n, k, k))`` into one CSR matrix (COO, duplicates summed)."""
-        rows = np.concatenate([np.broadcast_to(i[:, :, None], v.shape).ravel() for i, v in parts])
-        cols = np.concatenate([np.broadcast_to(i[:, None, :], v.shape).ravel() for i, v in parts])
-        vals = np.concatenate([v.ravel() for _, v in parts])
-        return sp.csr_matrix((vals, (rows, cols)), shape=(self.n2, self.n2))
+        """Sum named local blocks ``(name, index (n, k), values (n, k, k))`` on the structure of :attr:`jac_sparsity`.
+
+        The positions of each index set in the pattern's CSR data are computed once; a call is then
+        one ``bincount`` (explicit zeros of the pattern are kept).
+        """
+        pat = self.jac_sparsity
+        pos = []
+        for key, idx, _ in parts:
+            if key not in self._positions:
+                rows = np.broadcast_to(idx[:, :, None], idx.shape + idx.shape[1:]).ravel()
+                cols = np.broadcast_to(idx[:, None, :], idx.shape + idx.shape[1:]).ravel()
+                self._positions[key] = np.searchsorted(self._pattern_keys, rows.astype(np.int64) * self.n2 + cols)
+            pos.append(self._positions[key])
+        data = np.bincount(np.concatenate(pos), weights=np.concatenate([v.ravel() for _, _, v in parts]),
+                           minlength=pat.nnz)
+        return sp.csr_matrix((data, pat.indices, pat.indptr), shape=pat.shape)
 
     # ------------------------------------------------------------------ Jacobian pattern
     def _jac_sparsity(self) -> sp.csr_matrix:
@@ -639,7 +667,9 @@ class ChainA1:
         idx = self.dof_index
         rows = np.repeat(idx[pairs[:, 0]][:, :, None], 10, 2).ravel()
         cols = np.repeat(idx[pairs[:, 1]][:, None, :], 10, 1).ravel()
-        return sp.csr_matrix((np.ones(rows.size, bool), (rows, cols)), shape=(self.n2, self.n2))
+        pattern = sp.csr_matrix((np.ones(rows.size, bool), (rows, cols)), shape=(self.n2, self.n2))
+        pattern.sort_indices()
+        return pattern
 
     # ------------------------------------------------------------------ outputs
     def outputs(self, q: np.ndarray, v: np.ndarray | None = None) -> dict[str, np.ndarray]:

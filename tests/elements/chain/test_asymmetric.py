@@ -133,6 +133,18 @@ def test_mass_matrix_equals_quadrature_of_kinetic_energy():
     assert np.allclose(raw, ref, rtol=1e-13, atol=0)
 
 
+def test_raw_end_coordinates_round_trip():
+    ch = chain(n=5)
+    q = random_state(ch, np.random.default_rng(18), amp=1e-2)
+    far, near, sf, sn = ch.to_raw(q)
+    assert np.allclose(ch.from_raw(far, near, sf, sn), q, rtol=0, atol=1e-15)
+    pins = np.arange(5)
+    assert np.allclose(ch.axis_points(q, pins, -np.ones(5)), far) and np.allclose(ch.axis_points(q, pins, np.ones(5)), near)
+    u, _ = ch.split(q)
+    for x, slope in ((-1.0, sf), (1.0, sn)):                 # dU_perp/ds = (2/l) sum u_i h_i'(xi) (1.142)
+        assert np.allclose(2 / PIN_L * np.einsum("i,inc->nc", shape_slopes(np.array(x), PIN_L), u), slope)
+
+
 def test_accel_solves_the_mass_matrix():
     ch = chain()
     rng = np.random.default_rng(8)
