@@ -409,25 +409,26 @@ def free_vibration(n_periods):
     assert sol.success
     E = [ch.kinetic_energy(y[ch.n2:]) + ch.potential_energy(y[:ch.n2]) for y in sol.y.T]
     P = [ch.momentum(y[:ch.n2], y[ch.n2:]) for y in sol.y.T]
-    return ch, np.array(E), P, omega
+    # momentum exchanged between pins: the scale of the round-off in the sums of internal forces
+    flow = max(np.abs(ch.mass_matrix @ y[ch.n2:]).sum() for y in sol.y.T)
+    return ch, np.array(E), P, flow
 
 
-def check_conservation(E, P):
+def check_conservation(E, P, flow):
     assert np.abs(E / E[0] - 1).max() < 1e-6
     p0, L0 = P[0]
-    scale = np.abs(p0).max() + 1e-3
     for p, Lk in P:
-        assert np.abs(p - p0).max() < 1e-12 * scale       # linear invariants: round-off
+        assert np.abs(p - p0).max() < 1e-12 * flow        # linear invariants: round-off
         assert Lk == pytest.approx(L0, rel=1e-6)          # quadratic invariant: to the tolerance
 
 
 def test_free_ring_conserves_momentum_and_energy():
-    ch, E, P, omega = free_vibration(10)
+    ch, E, P, flow = free_vibration(10)
     assert E[0] > 0
-    check_conservation(E, P)
+    check_conservation(E, P, flow)
 
 
 @pytest.mark.slow
 def test_free_ring_conserves_energy_over_100_periods():
-    ch, E, P, omega = free_vibration(100)
-    check_conservation(E, P)
+    ch, E, P, flow = free_vibration(100)
+    check_conservation(E, P, flow)
