@@ -17,6 +17,9 @@ the section axes (1.103) following the link bisector, link extension (1.140)-(1.
 exact gradients of spec 2.8.  The strains are linearised as in the source: they are exactly
 invariant under translations and rotations about ``k``; rotations about in-plane axes leave them
 unchanged only to first order (pin length and plate stretch change at second order).
+
+Forces come from the compiled kernel ``asymmetric_kernel`` (numba) or from the numpy methods here,
+its tested reference twin; the stiffness and damping matrices are exact and sparse.
 """
 from __future__ import annotations
 

@@ -2,6 +2,7 @@
 rigid-body invariance, a tensioned straight segment, conservation in free vibration."""
 import numpy as np
 import pytest
+import scipy.linalg as sl
 import scipy.sparse as sp
 from scipy.integrate import solve_ivp
 
@@ -143,6 +144,20 @@ def test_raw_end_coordinates_round_trip():
     u, _ = ch.split(q)
     for x, slope in ((-1.0, sf), (1.0, sn)):                 # dU_perp/ds = (2/l) sum u_i h_i'(xi) (1.142)
         assert np.allclose(2 / PIN_L * np.einsum("i,inc->nc", shape_slopes(np.array(x), PIN_L), u), slope)
+
+
+def test_free_pin_frequencies():
+    """Pins without plates (chain-models-1 8.5): axial 12 c_p/m, bending 720 A/(m l^3) (exact beam: 500.6)
+    and 8400 A/(m l^3) in each of the two section directions, at the rest state."""
+    free = dict(plate_stiffness=0.0, plate_bending_stiffness=0.0, plate_torsion_stiffness=0.0)
+    ch = chain(n=5, **free)
+    q = ch.rest_state(ring(ch) * 3.0)
+    lam = sl.eigh(-ch.stiffness_matrix(q).toarray(), ch.mass_matrix.toarray(), eigvals_only=True)
+    m, l = ch.m, PIN_L
+    ref = np.concatenate([12 * ch.c_pin / m] + [k * A / (m * l ** 3) for k in (720, 8400) for A in (ch.A_tau, ch.A_n)])
+    nonzero = np.sort(lam[np.abs(lam) > 1e-9 * lam.max()])
+    assert nonzero == pytest.approx(np.sort(ref), rel=1e-10)
+    assert lam.size - nonzero.size == 5 * ch.n_pins      # u_0 (2), u_1 (2), w_0 of each pin are free
 
 
 def test_accel_solves_the_mass_matrix():
