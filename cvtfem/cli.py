@@ -13,6 +13,7 @@ import sys
 from importlib import import_module
 
 from cvtfem import __version__
+from cvtfem.commands.paths import check_output_args
 from cvtfem.errors import CvtfemError
 
 #: Command modules in ``cvtfem.commands``, in the order ``--help`` lists them.
@@ -52,6 +53,7 @@ def main(argv: list[str] | None = None) -> int:
     logging.basicConfig(level=logging.INFO if args.verbose else logging.WARNING,
                         format="%(levelname)s %(name)s: %(message)s")
     try:
+        check_output_args(args)
         return int(args.func(args) or 0)
     except CvtfemError as err:
         print(f"cvtfem {args.command}: error: {err}", file=sys.stderr)

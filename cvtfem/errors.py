@@ -8,6 +8,10 @@ from __future__ import annotations
 from typing import Any
 
 
+#: Longest representation of an offending value that an :class:`InputError` message quotes, characters.
+MAX_SHOWN = 200
+
+
 class CvtfemError(Exception):
     """Base of all expected, user-facing failures."""
 
@@ -33,7 +37,10 @@ class InputError(CvtfemError, ValueError):
 
     def __init__(self, where: str, value: Any, rule: str, hint: str = "") -> None:
         self.where, self.value, self.rule, self.hint = where, value, rule, hint
-        text = f"`{where}` {rule}, got {value!r}"
+        shown = repr(value)
+        if len(shown) > MAX_SHOWN:
+            shown = f"{shown[:MAX_SHOWN - 20]}... ({len(shown)} characters)"
+        text = f"`{where}` {rule}, got {shown}"
         if hint:
             text += f" ({hint})"
         super().__init__(" ".join(text.splitlines()))  # one line, whatever the value holds

@@ -23,6 +23,9 @@ from cvtfem.errors import InputError, NumericalError
 #: Stall guard: a run fails when STALL_STEPS consecutive accepted steps each advance time by less than
 #: STALL_FRACTION * t_end (1e-10 s for a 0.1 s run; the band models' fastest time scales are ~1e-5 s).
 STALL_STEPS = 50
+#: Most output samples (rows of the results file) and checkpoints one run may ask for.
+MAX_SAMPLES = 10_000_000
+MAX_CHECKPOINTS = 100_000
 STALL_FRACTION = 1e-9
 log = logging.getLogger(__name__)
 
@@ -50,8 +53,8 @@ def run_scene(scene, until: float | None = None, results: str | Path | None = No
     if scene.kind != "cvt":
         raise InputError("SCENE", scene.source, f"must describe a CVT for `cvtfem run`, not a `{scene.kind}` machine")
     t_end = scene.solver.t_end if until is None else until
-    if not t_end > 0:
-        raise InputError("--until", t_end, "must be positive (simulated seconds)")
+    if not (math.isfinite(t_end) and t_end > 0):
+        raise InputError("--until", t_end, "must be a positive, finite number of simulated seconds")
     run = _Run(scene, t_end)
     x0 = run.x_start = run.loop.initial_state(**(start or {}))
     run.check_events(x0)
@@ -108,13 +111,23 @@ class _Run:
         self.loop = closed_loop(scene)
         self.specs = list(self.loop.output_specs)
         dt = scene.output.step
+        rows = t_end / dt + 1
+        if rows > MAX_SAMPLES:
+            width = sum(s.size for s in self.specs) + 1
+            raise InputError("output.step", dt, f"must give at most {MAX_SAMPLES:.0e} output samples over "
+                             f"{t_end:g} s: {rows:.3g} samples would take {rows * width * 8 / 1e9:.3g} GB",
+                             "raise `output.step` or shorten the run")
+        self.interval = float(scene.output.checkpoint_interval)
+        if self.interval > 0 and t_end / self.interval > MAX_CHECKPOINTS:
+            raise InputError("output.checkpoint_interval", self.interval, f"must give at most {MAX_CHECKPOINTS:.0e} "
+                             f"checkpoints over {t_end:g} s ({t_end / self.interval:.3g} asked for)",
+                             "checkpoints cost a full-state write each: one every few seconds of wall time is plenty")
         t_out = np.arange(0.0, t_end + 0.5 * dt, dt)
         self.t_out = t_out[t_out <= t_end * (1 + 1e-12)]
         # the samples a finished run emits (the stepper lands on t_end) and the start of the efficiency window
         final = self.t_out[self.t_out <= t_end]
         j = int(np.searchsorted(final, final[-1] - EFFICIENCY_WINDOW))
         self.j_window = 0 if j >= len(final) - 1 else j  # run shorter than one output step past the window
-        self.interval = float(scene.output.checkpoint_interval)
         sol = scene.solver
         if sol.on_failure == "retry":  # the fallback runs adaptive: refuse one without error estimate now
             try:

@@ -58,6 +58,9 @@ def run(args: argparse.Namespace) -> int:
               f"= {c['speed_rad_s'] * 30 / np.pi:9.5g} rpm")
     if not result.crossings:
         print("  none in the speed range")
+    for jump in result.jumps:
+        print(f"  warning: tracked mode {jump['mode']} changed identity at {jump['speed_rad_s']:.4g} rad/s "
+              f"(MAC {jump['mac']:.2f} with the previous speed): refine the speeds there")
     if args.json:
         with open(args.json, "w") as fh:
             json.dump({"scene": scene.source, "backend": problem.method, **result.to_dict()}, fh)

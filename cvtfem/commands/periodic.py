@@ -38,14 +38,16 @@ def run(args: argparse.Namespace) -> int:
     from cvtfem.machines.torsional import build, periodic_settings
     from cvtfem.periodic.response import response_sweep
     from cvtfem.scene.loader import load_scene
+    from cvtfem.scene.schema.torsional import MAX_HARMONICS
 
     scene = load_scene(args.scene)
     if scene.kind != "torsional":
         raise InputError("SCENE", args.scene, f"must describe a torsional network, not a {scene.kind}")
     cfg = periodic_settings(scene)
     N = cfg.harmonics if args.harmonics is None else args.harmonics
-    if N < 1:
-        raise InputError("--harmonics", N, "must be a positive integer")
+    if not 1 <= N <= MAX_HARMONICS:
+        raise InputError("--harmonics", N, f"must be a whole number in 1..{MAX_HARMONICS} (the Newton blocks grow "
+                         f"as (2N+1)^2 per node: {N} harmonics would need {8 * (2 * N + 1) ** 2 / 1e9:.3g} GB each)")
     if args.sweep:
         a, b, n = _sweep(args.sweep)
         freqs = np.linspace(a, b, n)

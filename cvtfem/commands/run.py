@@ -49,8 +49,7 @@ def run(args: argparse.Namespace) -> int:
         scene = load_scene(args.scene)
         results = args.results
         if results is None:
-            stem = Path(args.scene).stem if args.scene.endswith(".toml") else args.scene
-            results = Path("out") / "runs" / f"{stem}.h5"
+            results = Path("out") / "runs" / f"{Path(args.scene).stem}.h5"   # a file's or a preset's name
         elif results.lower() == "none":
             results = None
         summary = run_scene(scene, until=args.until, results=results, overwrite=args.overwrite,

@@ -31,7 +31,9 @@ name next to it and moved over the original once it is consistent.
 """
 from __future__ import annotations
 
+import fcntl
 import os
+import struct
 import time
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
@@ -48,6 +50,34 @@ from cvtfem.io import checkpoint as ckpt
 from cvtfem.outputs import OutputSpec
 
 CHUNK_ROWS = 256
+
+
+class RunLock:
+    """An exclusive lock on a results file while one process writes it (``flock`` on a hidden sidecar
+    ``.NAME.lock``, released by :meth:`release` or by the process's death, also by ``kill -9``)."""
+
+    def __init__(self, path: Path, where: str) -> None:
+        self.path = path.with_name(f".{path.name}.lock")
+        path.parent.mkdir(parents=True, exist_ok=True)
+        self._fh = open(self.path, "a+")
+        try:
+            fcntl.flock(self._fh, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            self._fh.seek(0)
+            owner = self._fh.read().strip() or "unknown"
+            self._fh.close()
+            raise InputError(where, str(path), f"must not be in use: a running cvtfem process (pid {owner}) is "
+                             "writing it", "wait for it to end, or stop it first") from None
+        self._fh.seek(0)
+        self._fh.truncate()
+        self._fh.write(str(os.getpid()))
+        self._fh.flush()
+
+    def release(self) -> None:
+        """Unlock and remove the sidecar (idempotent)."""
+        if not self._fh.closed:
+            self.path.unlink(missing_ok=True)
+            self._fh.close()
 
 
 class ResultsWriter:
@@ -73,12 +103,12 @@ class ResultsWriter:
 
     def __init__(self, path: str | Path, scene_toml: str, kind: str, outputs: Sequence[OutputSpec],
                  flush_interval: float = 2.0, overwrite: bool = False, checkpoint: ckpt.Layout | None = None,
-                 _resume: dict[str, Any] | None = None) -> None:
+                 _resume: dict[str, Any] | None = None, _lock: RunLock | None = None) -> None:
         self.path = Path(path)
         if self.path.exists() and not overwrite:
             raise InputError("results file", str(self.path), "must not exist already (results are never overwritten)",
                              "choose another name or delete it")
-        self.path.parent.mkdir(parents=True, exist_ok=True)
+        self._lock = _lock or RunLock(self.path, "results file")
         self.flush_interval = flush_interval
         self.scene_toml = scene_toml
         self._file = h5py.File(self.path, "w", libver="latest")
@@ -156,10 +186,17 @@ class ResultsWriter:
         path = Path(path)
         if not path.is_file():
             raise InputError(where, str(path), "must be an existing results file (.h5) of a killed run")
+        lock = RunLock(path, where)
         try:
-            f = h5py.File(path, "r", libver="latest", swmr=True, locking=False)
-        except OSError as err:
-            raise InputError(where, str(path), f"must be a readable HDF5 file ({err})") from None
+            return cls._resume(path, flush_interval, where, lock)
+        except BaseException:
+            lock.release()
+            raise
+
+    @classmethod
+    def _resume(cls, path: Path, flush_interval: float, where: str,
+                lock: RunLock) -> tuple[ResultsWriter, int, dict[str, np.ndarray]]:
+        f = _open_for_reading(path, where)
         with f:
             attrs = dict(f.attrs)
             if attrs.get("kind") != "run" or "series" not in f:
@@ -193,7 +230,7 @@ class ResultsWriter:
         fields = tuple(fd for fd in layout.fields if fd[0] != "rows")
         tmp = path.with_name(path.name + ".resume-tmp")
         writer = cls(tmp, scene_toml, "run", specs, flush_interval, overwrite=True, checkpoint=ckpt.Layout(fields),
-                     _resume=resume)
+                     _resume=resume, _lock=lock)
         os.replace(tmp, path)  # the open file follows the rename
         writer.path = path
         return writer, seq, values
@@ -252,14 +289,17 @@ class ResultsWriter:
         """Flush, then record statistics, arrays and the final status ("finished" or "failed")."""
         if not self._file.id.valid:
             return
-        self.flush()
-        self._file.close()
-        with h5py.File(self.path, "r+", libver="latest") as f:
-            f.attrs.update(status=status, message=message)
-            f["stats"].attrs.update(self._stats)
-            for name, (data, unit, doc) in self._arrays.items():
-                d = f.create_dataset(name, data=data)
-                d.attrs.update(unit=unit, doc=doc)
+        try:
+            self.flush()
+            self._file.close()
+            with h5py.File(self.path, "r+", libver="latest") as f:
+                f.attrs.update(status=status, message=message)
+                f["stats"].attrs.update(self._stats)
+                for name, (data, unit, doc) in self._arrays.items():
+                    d = f.create_dataset(name, data=data)
+                    d.attrs.update(unit=unit, doc=doc)
+        finally:
+            self._lock.release()
 
     def __enter__(self) -> ResultsWriter:
         return self
@@ -284,16 +324,44 @@ class Results:
     units: dict[str, str] = field(repr=False)
 
 
+#: First 8 bytes of every HDF5 file.
+HDF5_SIGNATURE = b"\x89HDF\r\n\x1a\n"
+
+
+def _open_for_reading(path: Path, where: str) -> h5py.File:
+    """Open a results file read-only (SWMR), after checking that it is not cut short.
+
+    A truncated file (a partial copy, a full disk) is refused up front: HDF5's SWMR reader retries
+    metadata reads of a missing region without end, so reading one would hang.  The check reads the
+    end-of-file address of the version 2/3 superblock that the writer creates (``libver="latest"``).
+    """
+    try:
+        with open(path, "rb") as raw:
+            head = raw.read(44)
+            size = os.fstat(raw.fileno()).st_size
+    except OSError as err:
+        raise InputError(where, str(path), f"must be a readable file ({err.strerror})") from None
+    if head[:8] == HDF5_SIGNATURE and len(head) == 44 and head[8] in (2, 3) and head[9] == 8:
+        base, _, eof = struct.unpack("<QQQ", head[12:36])
+        if size < base + eof:
+            raise InputError(where, str(path), f"is truncated: HDF5 says {base + eof} bytes, the file has {size} "
+                             "(a partial copy or a full disk?)")
+    try:
+        return h5py.File(path, "r", libver="latest", swmr=True, locking=False)
+    except OSError as err:
+        raise InputError(where, str(path), f"must be a readable HDF5 file ({err})") from None
+
+
 def read_results(path: str | Path) -> Results:
     """Read a results file (also one whose run was killed: complete rows only)."""
     path = Path(path)
     if not path.is_file():
         raise InputError("RESULTS", str(path), "must be an existing results file (.h5)")
-    try:
-        f = h5py.File(path, "r", libver="latest", swmr=True, locking=False)
-    except OSError as err:
-        raise InputError("RESULTS", str(path), f"must be a readable HDF5 file ({err})") from None
+    f = _open_for_reading(path, "RESULTS")
     with f:
+        missing = [name for name in ("series", "scene", "stats") if name not in f]
+        if missing:
+            raise InputError("RESULTS", str(path), f"must be a cvtfem results file (it has no {', '.join(missing)})")
         group = f["series"]
         rows = min(d.shape[0] for d in group.values())
         series = {name: d[:rows] for name, d in group.items() if name != "time"}

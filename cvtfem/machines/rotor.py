@@ -21,8 +21,10 @@ from cvtfem.elements.base import Block, Layout
 from cvtfem.elements.beam import BeamFamily, BeamOptions
 from cvtfem.elements.bearing import BearingFamily, RadialLaw
 from cvtfem.elements.disk import DiskFamily, connection_stiffness, disc_profile, sheave_profile
+from cvtfem.errors import InputError
 from cvtfem.outputs import OutputSpec
 from cvtfem.scene.loader import Scene
+from cvtfem.scene.schema.rotor import MAX_ELEMENTS
 
 #: Names of the 6 DOF of a node, in order.
 DOF_NAMES = ("u1", "u2", "u3", "theta1", "theta2", "phi")
@@ -135,6 +137,10 @@ class RotorModel(ModelBase):
 
 def _shaft_arrays(scene: Scene) -> dict[str, np.ndarray]:
     mats = {m.name: m for m in scene.material}
+    n = sum(s.repeat for s in scene.shaft)
+    if n > MAX_ELEMENTS:
+        raise InputError("shaft[].repeat", n, f"must add up to at most {MAX_ELEMENTS} shaft elements "
+                         f"({6 * (n + 1):.3g} DOF asked for)")
     rows = [s for s in scene.shaft for _ in range(s.repeat)]
     return {"L": np.array([s.length for s in rows]),
             "Do": np.array([s.outer_diameter for s in rows]),

@@ -60,7 +60,11 @@ class Campbell:
         Per speed, ascending in wd (untracked order).
     orders : tuple of (label, factor)
     crossings : tuple of dict
-        ``{"mode", "whirl", "order", "speed_rad_s", "frequency_rad_s"}``.
+        ``{"mode", "whirl", "order", "speed_rad_s", "frequency_rad_s", "damping_ratio"}``; modes damped above
+        :data:`CRITICALLY_DAMPED` have none.
+    jumps : tuple of dict
+        ``{"mode", "speed_rad_s", "mac"}`` where tracking lost a mode (MAC with the previous speed below
+        :data:`MAC_JUMP`): the curve there may join another mode.
     """
 
     speeds: np.ndarray
@@ -71,6 +75,7 @@ class Campbell:
     modes: tuple[Modes, ...]
     orders: tuple[tuple[str, float], ...]
     crossings: tuple[dict[str, object], ...]
+    jumps: tuple[dict[str, object], ...] = ()
 
     def to_dict(self) -> dict[str, object]:
         """JSON-ready data: per-speed mode lists, tracked curves, orders, crossings."""
@@ -79,7 +84,7 @@ class Campbell:
                 "tracked": {"wd_rad_s": self.wd.tolist(), "wn_rad_s": self.wn.tolist(),
                             "damping_ratio": self.damping_ratio.tolist(), "whirl": self.whirl.tolist()},
                 "orders": [{"label": lab, "factor": f} for lab, f in self.orders],
-                "crossings": list(self.crossings)}
+                "crossings": list(self.crossings), "tracking_jumps": list(self.jumps)}
 
     def write_csv(self, path: Path) -> None:
         """One row per (speed, tracked mode): speed, mode, wd, wn, zeta, whirl."""
@@ -92,7 +97,15 @@ class Campbell:
                                 f"{self.damping_ratio[i, j]:.6g}", self.whirl[i, j]])
 
 
-def track(modes: list[Modes], n_modes: int) -> np.ndarray:
+#: A tracked mode whose MAC with its predecessor falls below this is flagged as a jump (a new mode took
+#: its place between two speeds: refine the speed grid there).
+MAC_JUMP = 0.5
+#: Modes damped above this ratio have no crossing: API 684 treats an amplification factor
+#: ``1 / (2 zeta)`` below 2.5 (zeta > 0.2) as critically damped, with no separation margin to keep.
+CRITICALLY_DAMPED = 0.2
+
+
+def track(modes: list[Modes], n_modes: int) -> tuple[np.ndarray, np.ndarray]:
     """Column permutations that follow mode identity across speeds by MAC.
 
     Parameters
@@ -102,33 +115,41 @@ def track(modes: list[Modes], n_modes: int) -> np.ndarray:
 
     Returns
     -------
-    int array (s, n_modes)
+    index : int array (s, n_modes)
         ``index[i, j]``: which mode at speed ``i`` is tracked mode ``j``.
+    match : array (s, n_modes)
+        MAC of tracked mode ``j`` at speed ``i`` with itself at speed ``i - 1`` (1 at the first speed).
     """
     index = np.zeros((len(modes), n_modes), dtype=int)
+    match = np.ones((len(modes), n_modes))
     index[0] = np.arange(n_modes)
     ref = modes[0].shapes[:, :n_modes]
     for i in range(1, len(modes)):
         cand = modes[i].shapes
-        _, col = linear_sum_assignment(1.0 - mac(ref, cand))
-        index[i] = col
+        m = mac(ref, cand)
+        rows, col = linear_sum_assignment(1.0 - m)
+        index[i], match[i] = col, m[rows, col]
         ref = cand[:, col]
-    return index
+    return index, match
 
 
-def crossings(speeds: np.ndarray, wd: np.ndarray, whirl: np.ndarray,
+def crossings(speeds: np.ndarray, wd: np.ndarray, whirl: np.ndarray, zeta: np.ndarray,
               orders: tuple[tuple[str, float], ...]) -> tuple[dict[str, object], ...]:
-    """Speeds where tracked curves cross excitation lines (linear interpolation)."""
+    """Speeds where tracked curves cross excitation lines (linear interpolation), for modes damped at most
+    :data:`CRITICALLY_DAMPED` at both ends of the bracketing interval."""
     out = []
     for label, factor in orders:
         d = wd - factor * speeds[:, None]
         for j in range(wd.shape[1]):
             hits = np.flatnonzero(np.sign(d[:-1, j]) * np.sign(d[1:, j]) < 0)
             for i in hits:
+                if max(zeta[i, j], zeta[i + 1, j]) > CRITICALLY_DAMPED:
+                    continue
                 t = d[i, j] / (d[i, j] - d[i + 1, j])
                 s = speeds[i] + t * (speeds[i + 1] - speeds[i])
                 out.append({"mode": j, "whirl": str(whirl[i, j]), "order": label, "speed_rad_s": float(s),
-                            "frequency_rad_s": float(factor * s)})
+                            "frequency_rad_s": float(factor * s),
+                            "damping_ratio": float(zeta[i, j] + t * (zeta[i + 1, j] - zeta[i, j]))})
     return tuple(sorted(out, key=lambda c: c["speed_rad_s"]))
 
 
@@ -152,7 +173,7 @@ def campbell(problem: ModalProblem, speeds: np.ndarray, n_modes: int,
     if speeds.ndim != 1 or len(speeds) < 1 or np.any(np.diff(speeds) <= 0):
         raise InputError("speeds", speeds.tolist()[:5], "must be one or more increasing speeds")
     modes = [problem.solve(s, n_modes + extra, min_modes=n_modes) for s in speeds]
-    idx = track(modes, n_modes)
+    idx, match = track(modes, n_modes)
     rows = np.arange(len(speeds))[:, None]
     wd = np.array([m.wd for m in modes])[rows, idx]
     wn = np.array([m.wn for m in modes])[rows, idx]
@@ -160,4 +181,7 @@ def campbell(problem: ModalProblem, speeds: np.ndarray, n_modes: int,
     whirl = np.array([m.whirl for m in modes])[rows, idx]
     trimmed = tuple(Modes(m.speed, m.eigenvalues[:n_modes], m.shapes[:, :n_modes], m.whirl[:n_modes],
                           m.whirl_ratio[:n_modes]) for m in modes)
-    return Campbell(speeds, wd, wn, zeta, whirl, trimmed, tuple(orders), crossings(speeds, wd, whirl, orders))
+    jumps = tuple({"mode": int(j), "speed_rad_s": float(speeds[i]), "mac": float(match[i, j])}
+                  for i, j in zip(*np.nonzero(match < MAC_JUMP)))
+    return Campbell(speeds, wd, wn, zeta, whirl, trimmed, tuple(orders), crossings(speeds, wd, whirl, zeta, orders),
+                    jumps)

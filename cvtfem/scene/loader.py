@@ -55,6 +55,10 @@ class Scene:
         return scene_from_dict(merge(_drop_none(thaw(self.data)), overrides), source=self.source)
 
 
+#: Largest scene file read, bytes (the reference scenes are ~2 KiB).
+MAX_SCENE_BYTES = 1 << 20
+
+
 def _drop_none(value: Any) -> Any:
     if isinstance(value, dict):
         return {k: _drop_none(v) for k, v in value.items() if v is not None}
@@ -95,6 +99,27 @@ def _parse(text: str, source: str) -> dict[str, Any]:
         return tomllib.loads(text)
     except tomllib.TOMLDecodeError as err:
         raise InputError(source, "<file>", f"must be valid TOML: {err}") from None
+    except RecursionError:
+        raise InputError(source, "<file>", "must be valid TOML nested to a sane depth (arrays or tables "
+                         "nested too deeply to parse)") from None
+
+
+def _read_scene_file(path: Path) -> str:
+    """The text of a scene file: readable, at most :data:`MAX_SCENE_BYTES`, UTF-8."""
+    try:
+        size = path.stat().st_size
+        if size > MAX_SCENE_BYTES:
+            raise InputError("SCENE", str(path), f"must be a scene file of at most {MAX_SCENE_BYTES // 1024} KiB "
+                             f"({size} bytes given): scenes are short TOML files")
+        data = path.read_bytes()
+    except OSError as err:
+        raise InputError("SCENE", str(path), f"must be a readable file ({err.strerror})") from None
+    try:
+        return data.decode("utf-8")
+    except UnicodeDecodeError as err:
+        line = data[:err.start].count(b"\n") + 1
+        raise InputError("SCENE", str(path), f"must be UTF-8 text (TOML): byte {data[err.start]:#04x} at line {line} "
+                         "is not") from None
 
 
 def resolve_presets(data: Mapping[str, Any], seen: tuple[str, ...] = ()) -> dict[str, Any]:
@@ -131,11 +156,16 @@ def load_scene(spec: str | Path, overrides: Mapping[str, Any] | None = None) -> 
         Nested keys merged over the file's content before validation.
     """
     path = Path(spec)
-    if path.suffix == ".toml" or path.exists():
+    try:
+        exists = path.exists()
+    except OSError as err:   # e.g. a name too long for the file system
+        raise InputError("SCENE", str(spec), f"must be an existing TOML file or a preset name ({err.strerror})",
+                         "see `cvtfem scenes` for presets") from None
+    if path.suffix == ".toml" or exists:
         if not path.is_file():
             raise InputError("SCENE", str(spec), "must be an existing TOML file or a preset name",
                              "see `cvtfem scenes` for presets")
-        data, source = _parse(path.read_text(encoding="utf-8"), str(path)), str(path)
+        data, source = _parse(_read_scene_file(path), str(path)), str(path)
     else:
         preset_text(str(spec))  # raises a clear error for an unknown name
         data, source = {"preset": str(spec)}, f"preset:{spec}"

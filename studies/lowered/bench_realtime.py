@@ -8,7 +8,7 @@ Target (issue 12, not asserted): <= 0.1 s wall per simulated second for band-4do
 the results file on.
 
 ``--integrators`` instead times the bare closed loop under several integrator settings (no outputs):
-scipy's ``solve_ivp`` with ``ClosedLoop.jac`` or cvtfem's methods through ``cvtfem.integrate.solve``
+scipy's ``solve_ivp`` with ``BandCVT.jac`` or cvtfem's methods through ``cvtfem.integrate.solve``
 with the loop's ``n2`` structure.  BDF is slow on the compressible models (lightly damped elastic modes;
 BDF orders > 2 are not A-stable): pass ``--methods Radau`` for them.  ``--settings Radau:1e-3:1e-5``
 replaces the list of settings, ``--nodes 8`` overrides the Gauss nodes per arc, ``--numpy`` runs the

@@ -16,7 +16,7 @@ import math
 import numpy as np
 import pytest
 
-from cvtfem.elements.band.friction import LAWS, friction_coefficient, friction_vector
+from cvtfem.elements.contact.friction import LAWS, friction_coefficient, friction_vector
 from cvtfem.integrate import solve
 from cvtfem.problems import sliding_point
 from cvtfem.problems.mechanics import friction_coefficient as table21_coefficient
@@ -37,13 +37,13 @@ def test_zero_slip_at_the_kink_is_finite_and_continuous(law):
     and the law is continuous across |v_r| = v0 (the kink of (1.48))."""
     f0, v0 = 0.09, 1e-9
     with np.errstate(divide="raise", invalid="raise", over="raise"):
-        zero = friction_vector(np.zeros((3, 4)), f0, v0, law)
+        zero = friction_vector(np.zeros((3, 4)), f0, v0, law, axis=0)
         assert np.array_equal(zero, np.zeros((3, 4)))
         tiny = np.array([[1e-300, 0.0, -1e-300], [0.0, 1e-300, 0.0], [0.0, 0.0, 0.0]])
         # far below v0 every law is linear, with its slope f'(0) (f0/v0; 1.5 f0/v0 for "smoothed")
         slope = friction_coefficient(1e-9 * v0, f0, v0, law) / (1e-9 * v0)
         assert slope == pytest.approx(f0 / v0 * (1.5 if law == "smoothed" else 1.0), rel=1e-9)
-        assert np.allclose(friction_vector(tiny, f0, v0, law), slope * tiny, rtol=1e-9, atol=0)
+        assert np.allclose(friction_vector(tiny, f0, v0, law, axis=0), slope * tiny, rtol=1e-9, atol=0)
         below, above = v0 * (1 - 1e-12), v0 * (1 + 1e-12)
         fb, fa = friction_coefficient(np.array([below, above]), f0, v0, law)
     assert abs(fa - fb) < 1e-9 * f0
@@ -52,7 +52,7 @@ def test_zero_slip_at_the_kink_is_finite_and_continuous(law):
     d = rng.normal(size=(3, 200))
     d /= np.linalg.norm(d, axis=0)
     speeds = v0 * np.concatenate([[0.0, 1.0, 1.0 - 1e-15, 1.0 + 1e-15], np.geomspace(1e-6, 1e6, 196)])
-    vec = friction_vector(d * speeds, f0, v0, law)
+    vec = friction_vector(d * speeds, f0, v0, law, axis=0)
     assert np.all(np.isfinite(vec))
     assert np.allclose(np.linalg.norm(vec, axis=0), friction_coefficient(speeds, f0, v0, law), rtol=1e-12, atol=0)
     assert np.all(np.linalg.norm(vec, axis=0) <= f0 * (1 + 1e-15))

@@ -66,3 +66,29 @@ def test_cli_modes_and_campbell(cli, tmp_path):
     assert len(csv.read_text().splitlines()) == 1 + 11 * 4
     r = cli("campbell", "friswell_5_9_1", "--speeds", "0:4000:11")
     assert r.returncode == 2 and "--speeds" in r.stderr
+
+
+def test_overdamped_mode_has_no_critical_speed():
+    """A mode damped near critically (zeta ~0.9) crossing the 1x line is not a critical speed (API 684:
+    amplification factor below 2.5); the lightly damped mode crossing it still is (issue 18)."""
+    from cvtfem.modal.campbell import CRITICALLY_DAMPED, crossings
+
+    speeds = np.linspace(0.0, 200.0, 5)
+    wd = np.column_stack([np.full(5, 110.0), np.full(5, 140.0)])
+    zeta = np.column_stack([np.full(5, 0.9), np.full(5, 0.01)])
+    whirl = np.full((5, 2), "forward")
+    found = crossings(speeds, wd, whirl, zeta, (("1x", 1.0),))
+    assert [c["mode"] for c in found] == [1] and found[0]["speed_rad_s"] == pytest.approx(140.0)
+    assert found[0]["damping_ratio"] == pytest.approx(0.01) and CRITICALLY_DAMPED == 0.2
+
+
+def test_tracking_flags_a_lost_mode():
+    """MAC tracking records where a tracked mode's shape has no match at the next speed."""
+    from cvtfem.modal.campbell import MAC_JUMP, track
+    from cvtfem.modal.eigen import Modes
+
+    e = np.eye(3, dtype=complex)
+    first = Modes(0.0, np.array([1j, 2j]), e[:, :2], ("forward", "forward"), np.ones(2))
+    swapped = Modes(1.0, np.array([1j, 2j]), e[:, [1, 2]], ("forward", "forward"), np.ones(2))
+    index, match = track([first, swapped], 2)
+    assert index[1].tolist() == [1, 0] and match[1].tolist() == [0.0, 1.0] and MAC_JUMP == 0.5

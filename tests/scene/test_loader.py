@@ -116,7 +116,7 @@ def test_non_physical_values():
     with pytest.raises(InputError) as e:
         reference_with("cvt.chain.mass", -1.5)
     assert "`cvt.chain.mass`" in _message(e) and "> 0" in _message(e) and "-1.5" in _message(e)
-    with pytest.raises(InputError, match=r"`shaft\[0\].length` must be > 0 m"):
+    with pytest.raises(InputError, match=r"`shaft\[0\].length` must be >= 1e-06 m"):   # 1 um .. 100 m (issue 18)
         scene_from_dict(rotor(shaft__0__length=0.0))
 
 

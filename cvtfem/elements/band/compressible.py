@@ -25,7 +25,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from cvtfem.elements.band import compressible_kernel as ker
-from cvtfem.elements.band.friction import friction_vector
+from cvtfem.elements.contact.friction import friction_vector
 from cvtfem.elements.band.geometry import radii
 from cvtfem.elements.band.inertia import band_inertia
 from cvtfem.elements.band.params import BandParams, gauss_nodes
@@ -247,7 +247,7 @@ class CompressibleBand:
             vr_r = vr_r - (U[:, :1] * cs + U[:, 1:] * sn) - a * (-P[:, :1] * sn + P[:, 1:] * cs)
             vr_t = vr_t - (-U[:, :1] * sn + U[:, 1:] * cs) + a * (P[:, :1] * cs + P[:, 1:] * sn)
         vr = np.stack([vr_r, vr_t, tg * vr_r])
-        ft = friction_vector(vr, p.f0, p.v0, p.law)
+        ft = friction_vector(vr, p.f0, p.v0, p.law, axis=0)
         cosg = 1.0 / np.sqrt(1.0 + tg ** 2)
         N = np.maximum(0.0, -p.c * eps / (cosg + ft[2]))
         T = ft * N * ds  # (3, 2, g): f N t ds

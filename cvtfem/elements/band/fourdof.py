@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from cvtfem.elements.band import compressible_kernel, fourdof_kernel
-from cvtfem.elements.band.friction import friction_gain
+from cvtfem.elements.contact.friction import friction_gain
 from cvtfem.elements.band.geometry import radii, wrap_half_angles
 from cvtfem.elements.band.inertia import band_inertia
 from cvtfem.elements.band.params import BandParams, gauss_nodes

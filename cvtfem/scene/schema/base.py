@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import difflib
 import math
+import unicodedata
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import Any
@@ -28,6 +29,8 @@ REQUIRED: Any = _Required()
 
 #: Scalar and list types a :class:`Key` may declare.
 TYPES = ("float", "int", "bool", "str", "float[]", "int[]", "str[]")
+#: Longest string value a scene key takes (titles, descriptions, names), characters.
+MAX_STRING = 1000
 
 Check = Callable[[Mapping[str, Any], str], None]
 """Cross-field check: ``check(validated_table, path)`` raises :class:`InputError`."""
@@ -166,6 +169,10 @@ def _check_scalar(key: Key, scalar_type: str, value: Any, where: str) -> Any:
     elif scalar_type == "str":
         if not isinstance(value, str):
             raise InputError(where, value, f"must be a string, not {_type_name(value)}")
+        if len(value) > MAX_STRING:
+            raise InputError(where, value, f"must be at most {MAX_STRING} characters long ({len(value)} given)")
+        if any(unicodedata.category(c) == "Cc" for c in value):
+            raise InputError(where, value, "must hold no control characters (terminal escapes, tabs, newlines)")
     if key.choices is not None and value not in key.choices:
         hint = _suggest(str(value), [str(c) for c in key.choices])
         raise InputError(where, value, f"must be {key.allowed()}", hint)

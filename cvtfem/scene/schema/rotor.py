@@ -12,19 +12,23 @@ from typing import Any
 from cvtfem.errors import InputError
 from cvtfem.scene.schema.base import Key, Table, TableArray
 
+#: Most shaft elements a rotor may have in all (6 DOF per node: 1e5 elements -> 6e5 DOF).
+MAX_ELEMENTS = 100_000
+
 MATERIAL = TableArray("material", "Materials referenced by name.", Table("material", "A material.", (
     Key("name", "str", "Name used by `shaft.material`.", ""),
-    Key("E", "float", "Young's modulus.", "Pa", gt=0.0),
-    Key("G", "float", "Shear modulus.", "Pa", gt=0.0),
-    Key("rho", "float", "Density.", "kg/m^3", gt=0.0),
+    Key("E", "float", "Young's modulus (foams to diamond: 1e3 .. 1e13 Pa).", "Pa", ge=1e3, le=1e13),
+    Key("G", "float", "Shear modulus (1e3 .. 1e13 Pa).", "Pa", ge=1e3, le=1e13),
+    Key("rho", "float", "Density (aerogels to osmium and beyond: 1 .. 1e5 kg/m^3).", "kg/m^3", ge=1.0, le=1e5),
 )))
 
 SHAFT = TableArray("shaft", "Shaft elements in order along the axis.", Table("shaft", "A shaft element.", (
-    Key("length", "float", "Element length.", "m", gt=0.0),
-    Key("outer_diameter", "float", "Outer diameter.", "m", gt=0.0),
+    Key("length", "float", "Element length (1 um .. 100 m).", "m", ge=1e-6, le=100.0),
+    Key("outer_diameter", "float", "Outer diameter (1 um .. 100 m).", "m", ge=1e-6, le=100.0),
     Key("inner_diameter", "float", "Inner diameter (0: solid).", "m", 0.0, ge=0.0),
     Key("material", "str", "Name of a `[[material]]`.", ""),
-    Key("repeat", "int", "Number of identical consecutive elements this entry stands for.", "-", 1, ge=1),
+    Key("repeat", "int", "Number of identical consecutive elements this entry stands for.", "-", 1, ge=1,
+        le=MAX_ELEMENTS),
 ), checks=(lambda t, p: _check_section(t, p),)))
 
 ROTOR = Table("rotor", "Rotor model options (beam theory, switches, damping, analysis defaults).", (

@@ -14,6 +14,9 @@ from typing import Any
 from cvtfem.errors import InputError
 from cvtfem.scene.schema.base import Key, Table, TableArray, _suggest
 
+#: Most harmonics a periodic solution may keep (blocks of (2N+1)^2 per node: 1000 -> 32 MB each).
+MAX_HARMONICS = 1000
+
 LINK_KINDS = ("shaft", "mesh", "backlash", "gap", "damper")
 
 DISK = TableArray("disk", "Rigid disks (crank throws, flywheels, gears, damper rings, loads).", Table(
@@ -61,8 +64,9 @@ TORSIONAL = Table("torsional", "A branched torsional network (section 8 of the p
 PERIODIC = Table("periodic", "Harmonic-balance settings (`cvtfem periodic`).", (
     Key("frequency", "float", "Cycle frequency (base harmonic), e.g. rpm / 120 for a four-stroke engine.",
         "Hz", 10.0, gt=0.0),
-    Key("harmonics", "int", "Number of harmonics N (n = -N..N).", "-", 24, ge=1),
-    Key("samples", "int", "AFT time samples per period (0: power of two >= 8N).", "-", 0, ge=0),
+    Key("harmonics", "int", "Number of harmonics N (n = -N..N); at most 1000 (the Newton blocks grow as N^2).",
+        "-", 24, ge=1, le=MAX_HARMONICS),
+    Key("samples", "int", "AFT time samples per period (0: power of two >= 8N).", "-", 0, ge=0, le=1 << 20),
     Key("backlash", "bool", "Use the nonlinear backlash and gap laws (false: contact stiffness everywhere).",
         "", True),
     Key("tol", "float", "Newton stop: relative residual norm.", "-", 1e-10, gt=0.0, lt=1.0),

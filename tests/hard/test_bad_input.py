@@ -1,0 +1,180 @@
+"""Issue 18, first classes: scene files the loader did not survive, and counts and spans a run cannot take.
+
+Each case ends in one line naming what is wrong (exit 2), before any work starts; each failed on the code
+before the fix (UnicodeDecodeError, RecursionError, OSError tracebacks; a raw terminal escape printed; a
+ValueError from numpy for `--until inf`; a never-ending checkpoint loop for `checkpoint_interval = 1e-300`;
+ten billion rows for `output.step = 1e-10`).
+"""
+import pytest
+
+pytestmark = pytest.mark.hard
+
+
+def _one_line_error(res, *needles):
+    assert res.returncode == 2, res.stderr
+    lines = res.stderr.strip().splitlines()
+    assert len(lines) == 1 and "Traceback" not in res.stderr, res.stderr
+    for needle in needles:
+        assert needle in lines[0], lines[0]
+    return lines[0]
+
+
+@pytest.mark.parametrize("content,needles", [
+    (b'title = "\xff"\npreset = "band-4dof"\n', ("must be UTF-8", "0xff", "line 1")),
+    (bytes(range(256)) * 2, ("must be UTF-8",)),
+    (("a = " + "[" * 3000 + "]" * 3000 + "\n").encode(), ("nested",)),
+    (b'preset = "band-4dof"\ntitle = "\\u001b[31mred"\n', ("`title`", "control characters", "\\x1b")),
+    (b'preset = "band-4dof"\ndescription = "' + b"x" * 5000 + b'"\n', ("`description`", "at most 1000")),
+])
+def test_scene_files_the_loader_did_not_survive(tmp_path, cli, content, needles):
+    path = tmp_path / "scene.toml"
+    path.write_bytes(content)
+    line = _one_line_error(cli("describe", str(path)), *needles)
+    assert "\x1b" not in line   # an escape sequence is quoted, never sent to the terminal
+
+
+def test_oversized_scene_file_is_refused_before_reading(tmp_path, cli):
+    path = tmp_path / "huge.toml"
+    path.write_bytes(b"# " + b"x" * (2 << 20) + b"\n")
+    _one_line_error(cli("describe", str(path)), "at most 1024 KiB")
+
+
+def test_a_name_too_long_for_the_file_system(cli):
+    line = _one_line_error(cli("describe", "x" * 5000), "`SCENE`", "File name too long", "5002 characters")
+    assert len(line) < 400   # the value is quoted shortened
+
+
+@pytest.mark.parametrize("args,needles", [
+    (("--until", "inf"), ("`--until`", "finite")),
+    (("--until", "nan"), ("`--until`",)),
+    (("--until", "1e300"), ("`output.step`", "samples")),
+])
+def test_run_spans_refused_up_front(cli, args, needles):
+    _one_line_error(cli("run", "band-4dof", "--results", "none", *args), *needles)
+
+
+@pytest.mark.parametrize("output,needles", [
+    ("step = 1e-10", ("`output.step`", "1e+10 samples", "GB")),
+    ("checkpoint_interval = 1e-300", ("`output.checkpoint_interval`", "checkpoints")),
+])
+def test_run_counts_bounded_up_front(tmp_path, cli, output, needles):
+    scene = tmp_path / "s.toml"
+    scene.write_text(f'preset = "band-4dof"\n[output]\n{output}\n')
+    results = tmp_path / "r.h5"
+    _one_line_error(cli("run", str(scene), "--until", "1", "--results", str(results), timeout=60), *needles)
+    assert not results.exists()   # refused before any work or file
+
+
+@pytest.mark.parametrize("argv,needles", [
+    (("run", "band-4dof", "--until", "0.001", "--results", "{dir}"), ("`--results`", "not a folder")),
+    (("run", "band-4dof", "--until", "0.001", "--results", "none", "--summary-json", "{file}/s.json"),
+     ("`--summary-json`", "is a file")),
+    (("campbell", "friswell_5_9_1", "--speeds", "0:100:3", "--png", "{dir}"), ("`--png`", "not a folder")),
+    (("campbell", "friswell_5_9_1", "--speeds", "0:100:3", "--csv", "{file}/c.csv"), ("`--csv`",)),
+    (("periodic", "engine_gear_train", "--json", "{dir}"), ("`--json`",)),
+    (("modes", "friswell_5_9_1", "--json", "{long}.json"), ("`--json`", "255 bytes")),
+    (("docs", "scenes", "--out", "{file}/scenes.md"), ("`--out`",)),
+    (("demo", "--out", "{file}"), ("`--out`", "must be a folder")),
+])
+def test_output_paths_checked_before_the_work(tmp_path, cli, argv, needles):
+    """Each of these used to end in a traceback after the work was done (the work lost)."""
+    folder, file = tmp_path / "folder", tmp_path / "file"
+    folder.mkdir()
+    file.write_text("")
+    args = [a.format(dir=folder, file=file, long=tmp_path / ("y" * 300)) for a in argv]
+    _one_line_error(cli(*args, timeout=60), *needles)
+
+
+def test_default_results_name_stays_in_out_runs(tmp_path, cli):
+    """`cvtfem run ../x` (a scene file without .toml) used to write `out/runs/../x.h5`, outside out/runs."""
+    (tmp_path / "x").write_text('preset = "band-4dof"\n')
+    work = tmp_path / "work"
+    work.mkdir()
+    res = cli("run", "../x", "--until", "0.002", cwd=work)
+    assert res.returncode == 0, res.stderr
+    assert (work / "out" / "runs" / "x.h5").is_file() and not (work / "out" / "x.h5").exists()
+
+
+@pytest.fixture(scope="module")
+def finished_run(tmp_path_factory):
+    from cvtfem.analysis.run import run_scene
+    from cvtfem.scene.loader import load_scene
+
+    path = tmp_path_factory.mktemp("run") / "r.h5"
+    run_scene(load_scene("band-4dof"), until=0.01, results=path, show_progress=False)
+    return path
+
+
+@pytest.mark.parametrize("command", [("show",), ("run", "--resume")])
+def test_truncated_results_file_is_refused_not_read(tmp_path, cli, finished_run, command):
+    """`head -c 1000 run.h5 > t.h5`: `show` and `--resume` hung in HDF5's SWMR metadata retries."""
+    cut = tmp_path / "t.h5"
+    cut.write_bytes(finished_run.read_bytes()[:1000])
+    _one_line_error(cli(*command, str(cut), timeout=30), "is truncated", "the file has 1000")
+
+
+def test_hdf5_file_that_is_not_a_results_file(tmp_path, cli):
+    import h5py
+
+    path = tmp_path / "other.h5"
+    with h5py.File(path, "w") as f:
+        f.attrs["status"] = "finished"
+    _one_line_error(cli("show", str(path)), "must be a cvtfem results file", "series")
+
+
+def _friswell_with(tmp_path, change):
+    import copy
+    import tomllib
+
+    import tomli_w
+
+    from cvtfem.scene.loader import preset_text
+
+    data = copy.deepcopy(tomllib.loads(preset_text("friswell_5_9_1")))
+    change(data)
+    path = tmp_path / "rotor.toml"
+    path.write_text(tomli_w.dumps(data))
+    return str(path)
+
+
+@pytest.mark.parametrize("change,needles", [
+    (lambda d: d["shaft"][0].update(repeat=10 ** 7), ("`shaft[0].repeat`", "<= 100000")),      # hung
+    (lambda d: d.update(shaft=[dict(d["shaft"][0], repeat=90_000)] * 2), ("`shaft[].repeat`", "DOF")),
+    (lambda d: d["material"][0].update(rho=1e-300), ("`material[0].rho`", ">= 1")),         # geev ValueError
+    (lambda d: d["material"][0].update(E=1e300), ("`material[0].E`", "<= 1e+13")),
+    (lambda d: d["shaft"][0].update(length=1e-300), ("`shaft[0].length`",)),
+])
+def test_rotor_sizes_and_physical_ranges(tmp_path, cli, change, needles):
+    _one_line_error(cli("modes", _friswell_with(tmp_path, change), timeout=60), *needles)
+
+
+def test_periodic_harmonics_bounded(cli):
+    """10^7 harmonics ran out of memory (or time) before saying anything."""
+    _one_line_error(cli("periodic", "engine_gear_train", "--harmonics", "10000000", timeout=60),
+                    "`--harmonics`", "1..1000", "GB")
+
+
+def test_resume_of_a_running_run_is_refused_and_works_after_a_kill(tmp_path, cli):
+    """`--resume` on a file another process is writing was accepted and the original died with a traceback;
+    the writer now holds a lock (flock on a sidecar), which a kill -9 releases."""
+    import os
+    import signal
+    import subprocess
+    import sys
+
+    scene = tmp_path / "s.toml"
+    scene.write_text('preset = "band-4dof"\n[solver]\nmethod = "rk4"\nh = 2e-6\n'
+                     '[output]\ncheckpoint_interval = 0.002\n')
+    results = tmp_path / "r.h5"
+    proc = subprocess.Popen([sys.executable, "-m", "cvtfem.cli", "run", str(scene), "--until", "1", "--results",
+                             str(results), "--report-checkpoints"], stdout=subprocess.PIPE, text=True)
+    try:
+        assert proc.stdout.readline().startswith("checkpoint 1")
+        _one_line_error(cli("run", "--resume", str(results)), "must not be in use", f"pid {proc.pid}")
+        _one_line_error(cli("run", str(scene), "--results", str(results), "--overwrite"), "must not be in use")
+    finally:
+        os.kill(proc.pid, signal.SIGKILL)
+        proc.wait()
+    from cvtfem.io.results import RunLock
+
+    RunLock(results, "--resume").release()   # the killed writer's lock is gone with it
