@@ -14,14 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 
-try:
-    from numba import njit
-    HAVE_NUMBA = True
-except ImportError:  # pragma: no cover - exercised only without numba
-    HAVE_NUMBA = False
-
-    def njit(*args, **kwargs):  # noqa: D103 - identity decorator, the kernel then runs as (slow) Python
-        return (lambda f: f) if not args or not callable(args[0]) else args[0]
+from cvtfem.elements.jit import HAVE_NUMBA, njit
 
 
 def pack(ch) -> tuple:
