@@ -7,7 +7,7 @@ as the band models.  Sheave contact, the clamping loops and the initial state on
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from functools import cached_property
 from typing import Any
 
@@ -34,7 +34,7 @@ class FreeChain(ModelBase):
 
     family: Any
     q0: np.ndarray
-    v0: np.ndarray | None = field(default=None)
+    v0: np.ndarray | None = None
 
     @cached_property
     def layout(self) -> StateLayout:
