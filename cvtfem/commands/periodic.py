@@ -31,6 +31,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     import json
+    import sys
 
     import numpy as np
 
@@ -91,4 +92,9 @@ def run(args: argparse.Namespace) -> int:
 
         plot_summary(result, probe, args.png)
         print(f"wrote {args.png}")
-    return 3 if n_fail else 0
+    if n_fail:
+        first = next(sol.message for sol in result.nonlinear if not sol.converged)
+        print(f"cvtfem periodic: error: harmonic balance did not converge at {n_fail} of {len(freqs)} frequencies "
+              f"(first: {first})", file=sys.stderr)
+        return 3
+    return 0

@@ -13,6 +13,7 @@ from typing import Any
 
 import numpy as np
 import scipy.sparse as sp
+from scipy.sparse.csgraph import connected_components
 
 from cvtfem.assembly.model import Linearization, ModelBase, StateLayout
 from cvtfem.assembly.numbering import through_numbering
@@ -49,6 +50,20 @@ def _load_coefficients(load: Any, radius: float) -> dict[int, complex]:
     return out
 
 
+def _check_grounded(names: tuple[str, ...], i: np.ndarray, j: np.ndarray, k: np.ndarray) -> None:
+    """InputError unless every disk is tied to ground through links of non-zero stiffness (a floating group
+    has no mean angle: the harmonic-0 equations of the periodic solution are singular)."""
+    S = len(names)
+    stiff = k > 0
+    ends = np.where(j >= 0, j, S)   # node S stands for the ground
+    graph = sp.coo_matrix((np.ones(int(stiff.sum())), (i[stiff], ends[stiff])), shape=(S + 1, S + 1))
+    _, label = connected_components(graph, directed=False)
+    floating = [name for s, name in enumerate(names) if label[s] != label[S]]
+    if floating:
+        raise InputError("torsional.link", floating, "must tie every disk to ground through links with stiffness "
+                         "> 0 (these disks float: their mean angle is undetermined)")
+
+
 def build(scene: Scene) -> TorsionalNetwork:
     """The network of a torsional scene in circumferential coordinates."""
     net = scene.torsional
@@ -67,6 +82,7 @@ def build(scene: Scene) -> TorsionalNetwork:
         s = index[load.disk]
         for n, q in _load_coefficients(load, r[s]).items():
             coeffs.setdefault(n, np.zeros(len(r), complex))[s] += q
+    _check_grounded(tuple(index), i, j, k)
     orders = np.array(sorted(coeffs), int)
     Q = np.stack([coeffs[n] for n in orders], axis=1) if len(orders) else np.zeros((len(r), 0), complex)
     return TorsionalNetwork(

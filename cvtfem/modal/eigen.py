@@ -45,6 +45,9 @@ PLANAR_SPEED = 1e-6
 #: Default shift of the sparse backend, rad/s: a real shift below the lowest frequency of interest keeps
 #: the shift-inverted spectrum well separated (|lambda - sigma| grows with the frequency).
 SIGMA = 1.0
+#: ARPACK restarts before the sparse backend gives up with a NumericalError (shift-invert converges in tens;
+#: scipy's default, 10 x the size, let a pathological model run for hours).
+ARPACK_RESTARTS = 300
 #: Relative real parts below this count as round-off in undamped problems.
 ROUNDOFF = 1e-9
 
@@ -286,6 +289,9 @@ class ModalProblem:
             self._dense[b] = (sla.cho_solve(cho, K), sla.cho_solve(cho, C),
                               sla.cho_solve(cho, G) if np.any(G) else None)
         MK, MC, MG = self._dense[b]
+        if not all(np.all(np.isfinite(X)) for X in (MK, MC) + (() if MG is None else (MG,))):
+            raise NumericalError("M^-1 K (or C, G) overflows: stiffness or damping far too large for the masses "
+                                 "(ratios beyond double precision)", component="modal.dense")
         m = MK.shape[0]
         A = np.zeros((2 * m, 2 * m))
         A[:m, m:] = np.eye(m)
@@ -318,7 +324,7 @@ class ModalProblem:
         k = min(2 * n_modes + 6, 2 * n - 2)
         A = spla.LinearOperator((2 * n, 2 * n), matvec=op, dtype=float)
         try:
-            mu, Z = spla.eigs(A, k=k, which="LM", ncv=min(2 * n, 2 * k + 1), tol=1e-12)
+            mu, Z = spla.eigs(A, k=k, which="LM", ncv=min(2 * n, 2 * k + 1), tol=1e-12, maxiter=ARPACK_RESTARTS)
         except spla.ArpackNoConvergence as err:
             raise NumericalError(f"ARPACK did not converge at Omega = {speed:g} rad/s ({err})",
                                  component="modal.sparse") from None
@@ -330,7 +336,8 @@ class ModalProblem:
         """Undamped, non-gyroscopic block: ``K x = w^2 M x`` (Lanczos, shift ``-s^2``); rigid modes stay simple."""
         k = min(n_modes + 4, M.shape[0] - 1)
         try:
-            w2, X = spla.eigsh(K.tocsc(), k=k, M=M.tocsc(), sigma=-s * s, which="LM", tol=1e-12)
+            w2, X = spla.eigsh(K.tocsc(), k=k, M=M.tocsc(), sigma=-s * s, which="LM", tol=1e-12,
+                               maxiter=ARPACK_RESTARTS)
         except spla.ArpackNoConvergence as err:
             raise NumericalError(f"ARPACK (Lanczos) did not converge ({err})", component="modal.sparse") from None
         return 1j * np.sqrt(np.clip(w2, 0.0, None)), X.astype(complex)

@@ -87,7 +87,13 @@ def solve_sparse(N, L, i, j, g) -> np.ndarray:
     S, B, K = g.shape
     a = np.empty_like(g, dtype=complex)
     for bb in range(B):
-        a[:, bb] = spla.splu(assemble(N, L, i, j, bb)).solve(g[:, bb].reshape(-1)).reshape(S, K)
+        try:
+            lu = spla.splu(assemble(N, L, i, j, bb))
+        except RuntimeError as err:   # SuperLU: "Factor is exactly singular"
+            raise NumericalError(f"the harmonic-balance Newton system is singular ({err}): a group of disks has no "
+                                 "stiffness to ground in its current contact state (an open gap with zero "
+                                 "`gap_stiffness`?)", component="periodic.blocktri") from None
+        a[:, bb] = lu.solve(g[:, bb].reshape(-1)).reshape(S, K)
     return a
 
 

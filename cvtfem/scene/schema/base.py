@@ -29,6 +29,8 @@ REQUIRED: Any = _Required()
 
 #: Scalar and list types a :class:`Key` may declare.
 TYPES = ("float", "int", "bool", "str", "float[]", "int[]", "str[]")
+#: Magnitudes a float key may take besides 0 (SI units: no quantity of these machines comes near either end).
+TINY, HUGE = 1e-30, 1e30
 #: Longest string value a scene key takes (titles, descriptions, names), characters.
 MAX_STRING = 1000
 
@@ -160,6 +162,9 @@ def _check_scalar(key: Key, scalar_type: str, value: Any, where: str) -> Any:
         value = float(value)
         if not math.isfinite(value):
             raise InputError(where, value, "must be finite")
+        if value != 0.0 and not TINY <= abs(value) <= HUGE:
+            raise InputError(where, value, f"must be 0 or of magnitude {TINY:g} .. {HUGE:g} ({key.unit or '-'}): "
+                             "beyond that the model's arithmetic overflows or underflows")
     elif scalar_type == "int":
         if isinstance(value, bool) or not isinstance(value, int):
             raise InputError(where, value, f"must be an integer, not {_type_name(value)}")
