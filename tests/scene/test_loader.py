@@ -139,7 +139,7 @@ def test_missing_required_key():
     ("cvt.chain.n_pins", 85, "multiple of `lacing_period`"),
     ("cvt.chain.n_pins", 150, "closes on the pulleys"),
     ("cvt.control.i_max", 0.05, "`cvt.control.i_max` must be greater than `i_min`"),
-    ("cvt.geometry.torus_radius", 0.05, "`cvt.geometry.torus_radius` must be set and exceed `r_max`"),
+    ("cvt.geometry.torus_radius", 0.05, "`cvt.geometry.torus_radius` must exceed |r + torus_offset| over r_min..r_max"),
 ])
 def test_inconsistent_geometry(path, value, fragment):
     with pytest.raises(InputError) as e:

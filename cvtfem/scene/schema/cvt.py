@@ -157,9 +157,12 @@ def _check_geometry(t: Mapping[str, Any], path: str) -> None:
     if 2 * t["r_max"] >= 2 * t["centre_distance"]:
         raise InputError(f"{path}.centre_distance", t["centre_distance"],
                          f"must exceed 2 `r_max` / 2 = {t['r_max']:g} m so the pulleys do not overlap")
-    if t["sheave_profile"] == "toroidal" and t["torus_radius"] <= t["r_max"]:
-        raise InputError(f"{path}.torus_radius", t["torus_radius"],
-                         f"must be set and exceed `r_max` = {t['r_max']:g} m for toroidal sheaves")
+    if t["sheave_profile"] == "toroidal":
+        reach = max(abs(t["r_min"] + t["torus_offset"]), abs(t["r_max"] + t["torus_offset"]))
+        if t["torus_radius"] <= reach:
+            raise InputError(f"{path}.torus_radius", t["torus_radius"],
+                             f"must exceed |r + torus_offset| over r_min..r_max = {reach:g} m for toroidal sheaves "
+                             "(the generating arc must reach every contact radius)")
 
 
 def _check_chain(t: Mapping[str, Any], path: str) -> None:
