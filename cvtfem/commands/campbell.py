@@ -16,6 +16,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--json", metavar="OUT", help="write per-speed modes, tracked curves, crossings as JSON")
     p.add_argument("--csv", metavar="OUT", help="write tracked curves as CSV")
     p.add_argument("--png", metavar="OUT", help="plot the diagram")
+    p.add_argument("--fmax", type=float, metavar="HZ", help="upper frequency limit of the plot, Hz (default: all modes)")
     p.set_defaults(func=run)
 
 
@@ -47,6 +48,10 @@ def run(args: argparse.Namespace) -> int:
     from cvtfem.units import parse_speeds
 
     speeds = parse_speeds(args.speeds)
+    if args.fmax is not None and not 0.0 < args.fmax < 1e9:
+        from cvtfem.errors import InputError
+
+        raise InputError("--fmax", args.fmax, "must be a frequency in Hz with 0 < fmax < 1e9")
     scene, model = load_rotor(args.scene)
     n_modes = args.n_modes or (scene.rotor.n_modes if scene.rotor else 12)
     problem = ModalProblem(model.M, model.K, model.C, model.G, model.dof_kind, args.method)
@@ -71,6 +76,6 @@ def run(args: argparse.Namespace) -> int:
     if args.png:
         from cvtfem.post.campbell import plot_campbell
 
-        plot_campbell(result, args.png, title=scene.title or scene.source)
+        plot_campbell(result, args.png, title=scene.title or scene.source, fmax=args.fmax)
         print(f"wrote {args.png}")
     return 0
