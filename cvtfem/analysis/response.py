@@ -129,6 +129,8 @@ def scene_response(scene: Scene, unbalances: list[Unbalance], speeds: np.ndarray
     if not unbalances:
         raise InputError("--unbalance", [], "needs at least one unbalance NODE:ME:PHASE")
     node = _node(model, node, "--node")
+    for u in unbalances:
+        _node(model, u.node, "--unbalance")
     n = model.n_dof
     load = sum(model.unbalance_load(u.node, u.me, u.phase) for u in unbalances)
     out = displacement([6 * node, 6 * node + 1], n, ("u1", "u2"))
