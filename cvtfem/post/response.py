@@ -65,7 +65,7 @@ def plot_order_map(res: Response, path: str | Path, title: str = "") -> Path:
                         mec="w", ms=7)
     for k in res.orders:
         ax.plot(rpm, k * res.speeds / (2 * np.pi), color="w", lw=1.0)
-        ax.annotate(f"{k:g}x", (rpm[-1], k * res.speeds[-1] / (2 * np.pi)), color="w", fontsize=8,
+        ax.annotate(f"{k:.4g}x", (rpm[-1], k * res.speeds[-1] / (2 * np.pi)), color="w", fontsize=8,
                     xytext=(-24, -12), textcoords="offset points")
     ax.set_ylim(hz[0], hz[-1])
     ax.set_xlim(rpm[0], rpm[-1])
