@@ -81,7 +81,8 @@ def run(args: argparse.Namespace) -> int:
             print(f"  order {k:g}: peak {res.order_amplitude[m, j]:.4g} m/N at {rpm[m]:.5g} rpm")
         print("  Campbell crossings of the order lines (lateral, torsional, axial):")
         for c in res.campbell.crossings:
-            print(f"    {c['order']:>8} mode {c['mode']:>2} ({c['whirl']:<9}) at {c['speed_rad_s'] * 30 / np.pi:9.5g} rpm")
+            rpm_c = c["speed_rad_s"] * 30 / np.pi
+            print(f"    {c['order']:>8} mode {c['mode']:>2} ({c['whirl']:<9}) at {rpm_c:9.5g} rpm")
     if args.json:
         with open(args.json, "w") as fh:
             json.dump({"scene": scene.source, **res.to_dict()}, fh)

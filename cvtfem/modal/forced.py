@@ -5,11 +5,11 @@ Two routes give the same complex receptance ``H(w) = Y(w) Z(w)^{-1} F`` with the
 
 * :func:`frf_direct`: one sparse LU (``scipy.sparse.linalg.splu``) of ``Z`` per frequency, on one
   sparsity pattern assembled once (:class:`DynamicStiffness`); exact up to round-off;
-* :class:`ModalBasis` / :func:`frf_modal`: the lowest undamped modes at rest (from
-  :class:`~cvtfem.modal.eigen.ModalProblem`), optionally with the static correction vectors ``K^{-1} F``
-  (residual flexibility), as a real basis; C and G are projected on it and per speed the complex modes
-  of the reduced state-space pencil are summed, ``H = Y Phi (i w - Lambda)^{-1} Psi F``.  With
-  ``C = G = 0`` the reduced modes are the real modes themselves.
+* :class:`ModalBasis` / :func:`frf_modal`: a real basis of modes (per speed the right and left complex
+  modes from :class:`~cvtfem.modal.eigen.ModalProblem`, or the undamped modes at rest), optionally with
+  residual-flexibility vectors; M, K, C, G are projected on it and the complex modes of the reduced
+  state-space matrix are summed, ``H = Y Phi (i w - Lambda)^{-1} Psi F``.  With ``C = G = 0`` the reduced
+  modes are the real modes themselves.
 
 Only the DOF blocks the inputs reach (connected components of the sparsity of M + K + C + G) are
 solved: the response of the other blocks is zero.  Amplitudes are complex: the motion is
@@ -162,9 +162,10 @@ def frf_direct(M, K, C, G, inputs, outputs: OutputMap, omegas, speed: float = 0.
 
 
 #: Columns of a basis group with an M-norm below this fraction of the group's largest are round-off (the
-#: imaginary part of a real mode); Gram eigenvalues below this fraction of the largest are dependent columns.
+#: imaginary part of a real mode); Gram eigenvalues below this fraction of the largest are dependent columns
+#: (1e-10 dropped directions that carried 1e-3 of a Friswell FRF: keep all but round-off).
 COLUMN_RTOL = 1e-8
-GRAM_RTOL = 1e-10
+GRAM_RTOL = 1e-13
 
 
 def _unit_columns(X: np.ndarray, M) -> np.ndarray:
@@ -185,8 +186,10 @@ class ModalBasis:
     n_modes : int
         Modes in the basis.
     residual : bool
-        Add the static responses ``K^{-1} F`` (residual flexibility): the reduced model is then exact at
-        ``w = 0`` and keeps the quasi-static part of the neglected modes.
+        Add the static responses ``X0 = K^{-1} F`` and ``K^{-1} A X0`` for A = M, C, G (residual flexibility
+        to first order in w): the reduced model is exact at ``w = 0`` and keeps the quasi-static, damping and
+        gyroscopic parts of the neglected modes (stiffness-proportional damping gives even far modes a
+        response ``~ beta w`` out of phase, which ``K^{-1} F`` alone misses).
     modes : {"complex", "rest"}
         "complex": per speed, the right and the left complex modes of ``(M, K, C, speed G)`` (the left ones
         as right modes of the transposed matrices).  A Galerkin projection on a space holding both keeps
@@ -226,7 +229,8 @@ class ModalBasis:
         except RuntimeError as err:
             raise NumericalError(f"stiffness singular in the excited blocks ({err}): no static correction "
                                  "(use residual=False)", component="modal.forced") from None
-        return np.hstack([lu.solve(self.F.real), lu.solve(self.F.imag)])
+        X = np.hstack([lu.solve(self.F.real), lu.solve(self.F.imag)])
+        return np.hstack([X] + [lu.solve(A @ X) for A in (self.mats[0], self.mats[2], self.mats[3]) if A.nnz])
 
     def _shapes(self, speed: float) -> tuple[list[np.ndarray], float]:
         """Mode shapes (complex columns) spanning the basis at ``speed``, and the highest |lambda| among them."""

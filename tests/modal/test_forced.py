@@ -49,7 +49,7 @@ def test_frf_equals_steady_state_of_time_integration(friswell):
         assert err < 1e-4, (w, err)
 
 
-@pytest.mark.parametrize("n_modes", [4, 8])
+@pytest.mark.parametrize("n_modes", [4, 8, 12])
 def test_modal_equals_direct_below_highest_mode(friswell, sheave, n_modes):
     """Complex-mode superposition with static correction within 1e-3 of direct solves up to 0.9 x the highest
     retained mode (gyroscopic, non-proportional bearing damping); without the correction it is worse."""
