@@ -89,6 +89,26 @@ class Response:
         return rows
 
 
+def write_results(res: Response, path: str, scene: Scene) -> None:
+    """An HDF5 results file (kind "response", :mod:`cvtfem.io.results`) with the response as whole arrays."""
+    from cvtfem.io.results import ResultsWriter
+
+    with ResultsWriter(path, scene.to_toml(), "response", ()) as w:
+        w.set_stats({"node": res.node, "force_node": res.force_node})
+        w.add_array("response/speeds", res.speeds, "rad/s", "Spin speeds.")
+        w.add_array("response/x", res.x, "m", "Complex amplitude of u1 at the node: u1 = Re(x e^{i Omega t}).")
+        w.add_array("response/y", res.y, "m", "Complex amplitude of u2 at the node.")
+        w.add_array("response/major", res.major, "m", "Orbit major semi-axis.")
+        w.add_array("response/minor", res.minor, "m", "Orbit minor semi-axis, < 0 backward.")
+        if res.orders:
+            w.add_array("response/orders", np.asarray(res.orders), "-", "Excitation orders k (w = k Omega).")
+            w.add_array("response/order_amplitude", res.order_amplitude, "m/N",
+                        "|(u1, u2)| per unit x force along each order line, (speeds, orders).")
+            w.add_array("response/map_freqs", res.freqs, "rad/s", "Frequency lines of the order map.")
+            w.add_array("response/map", res.map, "m/N", "|(u1, u2)| per unit x force, (speeds, freqs).")
+            w.add_array("response/campbell_wd", res.campbell.wd, "rad/s", "Tracked damped natural frequencies.")
+
+
 def rotor_of(scene: Scene) -> RotorModel:
     """The rotor model of a scene; InputError naming the supported kinds otherwise."""
     if scene.kind not in SUPPORTED:

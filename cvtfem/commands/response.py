@@ -15,6 +15,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--force-node", type=int, help="node of the unit x force of the order map (default: first "
                                                   "unbalance node)")
     p.add_argument("--n-modes", type=int, default=12, help="modes of the modal superposition (default 12)")
+    p.add_argument("--results", metavar="OUT.h5", help="write the response as an HDF5 results file")
     p.add_argument("--json", metavar="OUT", help="write amplitudes, phases, orbit, order map as JSON")
     p.add_argument("--csv", metavar="OUT", help="write the unbalance response per speed as CSV")
     p.add_argument("--png", metavar="OUT", help="Bode plot (amplitude, phase, orbit axes over speed); with "
@@ -56,7 +57,7 @@ def run(args: argparse.Namespace) -> int:
 
     import numpy as np
 
-    from cvtfem.analysis.response import scene_response
+    from cvtfem.analysis.response import scene_response, write_results
     from cvtfem.errors import InputError
     from cvtfem.scene.loader import load_scene
     from cvtfem.units import parse_speeds
@@ -83,6 +84,9 @@ def run(args: argparse.Namespace) -> int:
         for c in res.campbell.crossings:
             rpm_c = c["speed_rad_s"] * 30 / np.pi
             print(f"    {c['order']:>8} mode {c['mode']:>2} ({c['whirl']:<9}) at {rpm_c:9.5g} rpm")
+    if args.results:
+        write_results(res, args.results, scene)
+        print(f"wrote {args.results}")
     if args.json:
         with open(args.json, "w") as fh:
             json.dump({"scene": scene.source, **res.to_dict()}, fh)
