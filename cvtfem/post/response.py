@@ -30,8 +30,8 @@ def plot_bode(res: Response, path: str | Path, title: str = "") -> Path:
     ax.set_title(title or "unbalance response")
     ax.grid(alpha=0.3, which="both")
     ax.legend(fontsize=8)
-    ax2.plot(rpm, np.degrees(np.angle(res.x)), color="tab:red", label="phase x")
-    ax2.plot(rpm, np.degrees(np.angle(res.y)), color="tab:blue", ls="--", label="phase y")
+    for z, color, ls, label in ((res.x, "tab:red", "-", "phase x"), (res.y, "tab:blue", "--", "phase y")):
+        ax2.plot(rpm, np.where(z != 0, np.degrees(np.angle(z)), np.nan), color=color, ls=ls, label=label)
     ax2.set_ylim(-180, 180)
     ax2.set_yticks([-180, -90, 0, 90, 180])
     ax2.set_ylabel("phase (deg)")
