@@ -52,6 +52,8 @@ class RotorModel(ModelBase):
         Per disk its (r, z) section polygon relative to the centre of mass (m), or None.
     speed : float, rad/s
         Spin speed of the time-domain model (:meth:`rhs`); modal analyses take theirs from the caller.
+    seats : tuple of int (n_disks,)
+        Shaft node each disk sits on (its own node when elastically connected is ``disks.nodes``).
     """
 
     M: sp.csr_matrix
@@ -64,6 +66,7 @@ class RotorModel(ModelBase):
     bearings: BearingFamily
     profiles: tuple = ()
     speed: float = 0.0
+    seats: tuple = ()
 
     @property
     def n_dof(self) -> int:
@@ -74,9 +77,36 @@ class RotorModel(ModelBase):
         return StateLayout((Block("nodes", self.n_dof, "m (u1, u2, u3), rad (theta1, theta2, phi) per node"),))
 
     @property
+    def n_shaft_nodes(self) -> int:
+        return int(self.beam.nodes.max()) + 1
+
+    @property
     def output_specs(self) -> tuple[OutputSpec, ...]:
-        shaft, bearings = _output_specs(int(self.beam.nodes.max()) + 1, len(self.bearings.nodes))
+        shaft, bearings = _output_specs(self.n_shaft_nodes, len(self.bearings.nodes))
         return shaft + bearings
+
+    def bearing_force_map(self) -> tuple[sp.csr_matrix, sp.csr_matrix]:
+        """``(D, V)``, each ``(2 n_bearings, n)``: the x, y bearing forces are ``D u + V v`` (N)."""
+        b, n = self.bearings, self.n_dof
+        rows = np.repeat(np.arange(2 * len(b.nodes)), 6)
+        cols = np.repeat(b.dofs, 2, axis=0).ravel()
+        return tuple(sp.csr_matrix((X[:, :2, :].ravel(), (rows, cols)), shape=(2 * len(b.nodes), n))
+                     for X in (b.stiffness(), b.damping()))
+
+    def unbalance_load(self, node: int, me: float, phase: float) -> np.ndarray:
+        """Complex force amplitude per unit ``Omega^2`` of an unbalance ``me`` (kg m) at angle ``phase`` (rad).
+
+        The force ``me Omega^2 (cos(Omega t + phase), sin(Omega t + phase))`` turns with the spin: its
+        amplitude is ``me e^{i phase} (e1 - i e2)`` at the disk seated on shaft node ``node`` (on the
+        disk's own node when it is elastically connected), else at the shaft node itself.
+        """
+        if not 0 <= node < self.n_shaft_nodes:
+            raise InputError("unbalance node", node, f"must be a shaft node 0..{self.n_shaft_nodes - 1}")
+        on = np.flatnonzero(np.asarray(self.seats) == node)
+        target = int(self.disks.nodes[on[0]]) if len(on) else node
+        f = np.zeros(self.n_dof, dtype=complex)
+        f[6 * target: 6 * target + 2] = me * np.exp(1j * phase) * np.array([1.0, -1.0j])
+        return f
 
     @cached_property
     def _lu(self):  # noqa: ANN202 - scipy SuperLU of M
@@ -121,12 +151,12 @@ class RotorModel(ModelBase):
 
     def outputs(self, t: float, x: np.ndarray) -> dict[str, np.ndarray]:
         """Shaft-node displacements and the x, y forces the bearings carry, ``K_b u + C_b v`` (N)."""
-        n, b = self.n_dof, self.bearings
+        n = self.n_dof
         u, v = x[:n], x[n:]
-        out = {"shaft.displacement": u[:6 * (int(self.beam.nodes.max()) + 1)].copy()}
-        if len(b.nodes):
-            f = np.einsum("eij,ej->ei", b.stiffness(), u[b.dofs]) + np.einsum("eij,ej->ei", b.damping(), v[b.dofs])
-            out["bearing.force"] = f[:, :2].ravel()
+        out = {"shaft.displacement": u[:6 * self.n_shaft_nodes].copy()}
+        if len(self.bearings.nodes):
+            D, V = self.bearing_force_map()
+            out["bearing.force"] = D @ u + V @ v
         return out
 
     @property
@@ -236,7 +266,8 @@ def build_model(scene: Scene) -> RotorModel:
                      (bearings.gyroscopic(), bearings.dofs)])
     z = np.concatenate([[0.0], np.cumsum(arrays["L"]), np.zeros(len(elastic))])
     z[n_shaft:] = z[[scene.disk[i].node for i in elastic]]
-    return RotorModel(M, K, C, G, z, beam, disks, bearings, profiles, opts.speed if opts else 0.0)
+    return RotorModel(M, K, C, G, z, beam, disks, bearings, profiles, opts.speed if opts else 0.0,
+                      tuple(d.node for d in scene.disk))
 
 
 def layout(scene: Scene) -> tuple[Layout, ...]:

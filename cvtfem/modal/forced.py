@@ -1,0 +1,338 @@
+"""Forced harmonic response of ``M x'' + (C + Omega G) x' + K x = f e^{i w t}``: receptances, unbalance, orders.
+
+Two routes give the same complex receptance ``H(w) = Y(w) Z(w)^{-1} F`` with the dynamic stiffness
+``Z(w) = K - w^2 M + i w (C + Omega G)``, inputs ``F`` (n x m) and outputs ``Y(w) = D + i w V`` (p x n):
+
+* :func:`frf_direct`: one sparse LU (``scipy.sparse.linalg.splu``) of ``Z`` per frequency, on one
+  sparsity pattern assembled once (:class:`DynamicStiffness`); exact up to round-off;
+* :class:`ModalBasis` / :func:`frf_modal`: a real basis of modes (per speed the right and left complex
+  modes from :class:`~cvtfem.modal.eigen.ModalProblem`, or the undamped modes at rest), optionally with
+  residual-flexibility vectors; M, K, C, G are projected on it and the complex modes of the reduced
+  state-space matrix are summed, ``H = Y Phi (i w - Lambda)^{-1} Psi F``.  With ``C = G = 0`` the reduced
+  modes are the real modes themselves.
+
+Only the DOF blocks the inputs reach (connected components of the sparsity of M + K + C + G) are
+solved: the response of the other blocks is zero.  Amplitudes are complex: the motion is
+``Re(x e^{i w t})``.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.linalg as sla
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+from scipy.sparse.csgraph import connected_components
+
+from cvtfem.errors import InputError, NumericalError
+from cvtfem.modal.eigen import ModalProblem
+
+
+@dataclass(frozen=True)
+class OutputMap:
+    """Outputs ``y = D x + V x'`` (p rows over n DOFs); at frequency w, ``y = (D + i w V) x``.
+
+    Attributes
+    ----------
+    D, V : scipy.sparse.csr_matrix (p, n)
+    names : tuple of str (p,)
+    """
+
+    D: sp.csr_matrix
+    V: sp.csr_matrix
+    names: tuple[str, ...]
+
+
+def displacement(dofs, n: int, names: tuple[str, ...] = ()) -> OutputMap:
+    """Displacements of the DOFs ``dofs`` (m or rad)."""
+    dofs = np.atleast_1d(np.asarray(dofs, dtype=np.int64))
+    S = sp.csr_matrix((np.ones(len(dofs)), (np.arange(len(dofs)), dofs)), shape=(len(dofs), n))
+    return OutputMap(S, sp.csr_matrix(S.shape), names or tuple(f"x[{d}]" for d in dofs))
+
+
+def velocity(dofs, n: int, names: tuple[str, ...] = ()) -> OutputMap:
+    """Velocities of the DOFs ``dofs`` (m/s or rad/s)."""
+    d = displacement(dofs, n, names or tuple(f"v[{k}]" for k in np.atleast_1d(dofs)))
+    return OutputMap(d.V, d.D, d.names)
+
+
+def _check(M, K, C, G) -> list[sp.csr_matrix]:
+    mats = [sp.csr_matrix(X) for X in (M, K, C, G)]
+    n = mats[0].shape[0]
+    for name, X in zip("MKCG", mats):
+        if X.shape != (n, n):
+            raise InputError(name, X.shape, f"must be a square matrix of the size of M, ({n}, {n})")
+        if not np.all(np.isfinite(X.data)):
+            raise InputError(name, "non-finite entries", "must be finite")
+    return mats
+
+
+def _inputs(F, n: int) -> np.ndarray:
+    F = np.asarray(F.toarray() if sp.issparse(F) else F, dtype=complex)
+    F = F[:, None] if F.ndim == 1 else F
+    if F.shape[0] != n or F.ndim != 2:
+        raise InputError("inputs", F.shape, f"must be a force vector or matrix with {n} rows")
+    return F
+
+
+def reached(M, K, C, G, F: np.ndarray) -> np.ndarray:
+    """DOFs in the blocks (connected components of M + K + C + G) where ``F`` has non-zero rows."""
+    pattern = abs(M) + abs(K) + abs(C) + abs(G)
+    _, label = connected_components(pattern, directed=False)
+    hit = np.unique(label[np.any(F != 0, axis=1)])
+    return np.flatnonzero(np.isin(label, hit))
+
+
+def _omegas(omegas) -> np.ndarray:
+    w = np.atleast_1d(np.asarray(omegas, dtype=float))
+    if w.ndim != 1 or not np.all(np.isfinite(w)) or np.any(w < 0):
+        raise InputError("omegas", w.tolist()[:5], "must be finite frequencies >= 0 rad/s")
+    return w
+
+
+class DynamicStiffness:
+    """``Z(w, Omega) = K - w^2 M + i w (C + Omega G)`` on the DOFs ``dofs``, one CSC pattern for all w.
+
+    Parameters
+    ----------
+    M, K, C, G : sparse (n, n)
+    dofs : int array
+        The DOFs kept (a union of independent blocks).
+    """
+
+    def __init__(self, M, K, C, G, dofs: np.ndarray) -> None:
+        sub = [X[dofs][:, dofs].tocsc() for X in _check(M, K, C, G)]
+        P = (abs(sub[0]) + abs(sub[1]) + abs(sub[2]) + abs(sub[3])).tocsc()
+        P.sort_indices()
+        m = len(dofs)
+        key = np.repeat(np.arange(m), np.diff(P.indptr)) * m + P.indices
+        self.pattern = P
+        self.data = []
+        for X in sub:
+            X = X.tocoo()
+            d = np.zeros(P.nnz)
+            np.add.at(d, np.searchsorted(key, X.col.astype(np.int64) * m + X.row), X.data)
+            self.data.append(d)
+
+    def __call__(self, w: float, speed: float) -> sp.csc_matrix:
+        Md, Kd, Cd, Gd = self.data
+        Z = sp.csc_matrix((Kd - w * w * Md + 1j * w * (Cd + speed * Gd), self.pattern.indices,
+                           self.pattern.indptr), shape=self.pattern.shape)
+        return Z
+
+    def solve(self, w: float, speed: float, F: np.ndarray) -> np.ndarray:
+        """``Z(w, speed)^{-1} F``; NumericalError when Z is singular (a resonance of an undamped system)."""
+        try:
+            return spla.splu(self(w, speed)).solve(F)
+        except RuntimeError as err:
+            raise NumericalError(f"dynamic stiffness singular at w = {w:g} rad/s, speed {speed:g} rad/s ({err}): "
+                                 "an undamped resonance or an unsupported rigid-body mode",
+                                 component="modal.forced") from None
+
+
+def frf_direct(M, K, C, G, inputs, outputs: OutputMap, omegas, speed: float = 0.0) -> np.ndarray:
+    """Receptances by one sparse solve per frequency.
+
+    Parameters
+    ----------
+    M, K, C, G : sparse (n, n)
+        G per unit spin speed.
+    inputs : array (n,) or (n, m)
+        Force distributions (N per unit input).
+    outputs : OutputMap
+    omegas : array (w,), rad/s
+    speed : float, rad/s
+
+    Returns
+    -------
+    complex array (w, p, m): output per unit input.
+    """
+    M, K, C, G = _check(M, K, C, G)
+    F = _inputs(inputs, M.shape[0])
+    w = _omegas(omegas)
+    dofs = reached(M, K, C, G, F)
+    Z = DynamicStiffness(M, K, C, G, dofs)
+    D, V = outputs.D[:, dofs], outputs.V[:, dofs]
+    H = np.zeros((len(w), D.shape[0], F.shape[1]), dtype=complex)
+    for i, wi in enumerate(w):
+        X = Z.solve(wi, speed, F[dofs])
+        H[i] = D @ X + 1j * wi * (V @ X)
+    return H
+
+
+#: Columns of a basis group with an M-norm below this fraction of the group's largest are round-off (the
+#: imaginary part of a real mode); Gram eigenvalues below this fraction of the largest are dependent columns
+#: (1e-10 dropped directions that carried 1e-3 of a Friswell FRF: keep all but round-off).
+COLUMN_RTOL = 1e-8
+GRAM_RTOL = 1e-13
+
+
+def _unit_columns(X: np.ndarray, M) -> np.ndarray:
+    """Columns of X with M-norm 1, round-off columns dropped."""
+    norm = np.sqrt(np.abs(np.einsum("ij,ij->j", X, M @ X)))
+    keep = norm > COLUMN_RTOL * norm.max(initial=0.0)
+    return X[:, keep] / norm[keep]
+
+
+class ModalBasis:
+    """Modal superposition on a real basis of modes (+ static correction vectors), reduced per speed.
+
+    Parameters
+    ----------
+    M, K, C, G : sparse (n, n)
+    inputs : array (n,) or (n, m)
+        Force distributions; they select the DOF blocks and, with ``residual``, add ``K^{-1} F``.
+    n_modes : int
+        Modes in the basis.
+    residual : bool
+        Add the static responses ``X0 = K^{-1} F`` and ``K^{-1} A X0`` for A = M, C, G (residual flexibility
+        to first order in w): the reduced model is exact at ``w = 0`` and keeps the quasi-static, damping and
+        gyroscopic parts of the neglected modes (stiffness-proportional damping gives even far modes a
+        response ``~ beta w`` out of phase, which ``K^{-1} F`` alone misses).
+    modes : {"complex", "rest"}
+        "complex": per speed, the right and the left complex modes of ``(M, K, C, speed G)`` (the left ones
+        as right modes of the transposed matrices).  A Galerkin projection on a space holding both keeps
+        each retained mode's eigenvalue and residue ``x y^H / (y^H (2 lam M + D) x)`` exactly: the modal
+        FRF differs from the direct one only by the neglected modes.  "rest": the undamped modes of
+        ``((K + K^T)/2, M)`` at rest, one eigen-solve for every speed (the classic pseudo-modal method;
+        exact for ``C = G = 0``, approximate when G or non-proportional C couple the modes).
+    method : str
+        Eigen backend of :class:`~cvtfem.modal.eigen.ModalProblem`.
+
+    Attributes
+    ----------
+    dofs : int array
+        DOFs of the reached blocks.
+    """
+
+    def __init__(self, M, K, C, G, inputs, n_modes: int, residual: bool = True, modes: str = "complex",
+                 method: str = "auto") -> None:
+        M, K, C, G = _check(M, K, C, G)
+        F = _inputs(inputs, M.shape[0])
+        if n_modes < 1:
+            raise InputError("n_modes", n_modes, "must be >= 1")
+        if modes not in ("complex", "rest"):
+            raise InputError("modes", modes, "must be 'complex' or 'rest'")
+        self.dofs = dofs = reached(M, K, C, G, F)
+        self.mats = [X[dofs][:, dofs].tocsr() for X in (M, K, C, G)]
+        self.F = F[dofs]
+        self.n_modes, self.method = min(n_modes, len(dofs)), method
+        self.kind = np.full(len(dofs), 2)  # no whirl pairs needed: labels are not used here
+        self.modes = "rest" if self.mats[2].nnz == 0 and self.mats[3].nnz == 0 else modes
+        self.static = self._static() if residual else None
+        self._reduced: dict[float, tuple] = {}
+
+    def _static(self) -> np.ndarray:
+        try:
+            lu = spla.splu(self.mats[1].tocsc())
+        except RuntimeError as err:
+            raise NumericalError(f"stiffness singular in the excited blocks ({err}): no static correction "
+                                 "(use residual=False)", component="modal.forced") from None
+        X = np.hstack([lu.solve(self.F.real), lu.solve(self.F.imag)])
+        return np.hstack([X] + [lu.solve(A @ X) for A in (self.mats[0], self.mats[2], self.mats[3]) if A.nnz])
+
+    def _shapes(self, speed: float) -> tuple[list[np.ndarray], float]:
+        """Mode shapes (complex columns) spanning the basis at ``speed``, and the highest |lambda| among them."""
+        M, K, C, G = self.mats
+        if self.modes == "rest":
+            zero = sp.csr_matrix(M.shape)
+            md = ModalProblem(M, (K + K.T) / 2, zero, zero, self.kind, self.method, damped=False).solve(
+                0.0, self.n_modes)
+            return [md.shapes], float(md.wn.max())
+        right = ModalProblem(M, K, C, G, self.kind, self.method).solve(speed, self.n_modes)
+        left = ModalProblem(M.T, K.T, C.T, G.T, self.kind, self.method).solve(speed, self.n_modes)
+        return [right.shapes, left.shapes], float(max(right.wn.max(), left.wn.max()))
+
+    def reduced(self, speed: float) -> tuple[np.ndarray, ...]:
+        """``(V, K_r, D_r, F_r, wmax)`` at ``speed``: M-orthonormal basis V (dofs x r), reduced stiffness and
+        damping ``V^T (C + speed G) V``, forces; wmax (rad/s) is the highest retained natural frequency."""
+        key = 0.0 if self.modes == "rest" else float(speed)
+        if key not in self._reduced:
+            shapes, wmax = self._shapes(key)
+            M, K, C, G = self.mats
+            groups = [np.hstack([X.real, X.imag]) for X in shapes]
+            if self.static is not None:
+                groups.append(self.static)
+            B = np.hstack([_unit_columns(X, M) for X in groups])
+            lam, U = sla.eigh(B.T @ (M @ B))
+            keep = lam > GRAM_RTOL * lam.max()  # drop dependent columns (both halves of a circular pair, ...)
+            V = B @ (U[:, keep] / np.sqrt(lam[keep]))  # M-orthonormal
+            self._reduced = {} if self.modes == "complex" else self._reduced  # keep one speed
+            self._reduced[key] = (V, V.T @ (K @ V), V.T @ (C @ V), V.T @ (G @ V), V.T @ self.F, wmax)
+        V, Kr, Cr, Gr, Fr, wmax = self._reduced[key]
+        return V, Kr, Cr + speed * Gr, Fr, wmax
+
+    def wmax(self, speed: float = 0.0) -> float:
+        """Highest natural frequency in the basis at ``speed``, rad/s (modal FRFs are meant below it)."""
+        return self.reduced(speed)[4]
+
+    def frf(self, outputs: OutputMap, omegas, speed: float = 0.0) -> np.ndarray:
+        """Receptances (w, p, m) by summing the complex modes of the reduced state-space matrix
+        ``A = [[0, I], [-K_r, -D_r]] = Phi diag(lam) Phi^{-1}`` (see :func:`frf_direct`)."""
+        w = _omegas(omegas)
+        V, Kr, Dr, Fr, _ = self.reduced(speed)
+        r = V.shape[1]
+        A = np.zeros((2 * r, 2 * r))
+        A[:r, r:] = np.eye(r)
+        A[r:, :r], A[r:, r:] = -Kr, -Dr
+        lam, Phi = sla.eig(A)
+        try:
+            L = sla.solve(Phi, np.vstack([np.zeros_like(Fr), Fr]))  # (2r, m) modal participations
+        except sla.LinAlgError:
+            raise NumericalError(f"reduced state matrix defective at speed {speed:g} rad/s",
+                                 component="modal.forced") from None
+        X = V @ Phi[:r]  # (dofs, 2r)
+        Dq, Vq = outputs.D[:, self.dofs] @ X, outputs.V[:, self.dofs] @ X
+        g = 1.0 / (1j * w[:, None] - lam[None, :])  # (w, 2r)
+        return (np.einsum("pk,wk,km->wpm", Dq, g, L)
+                + 1j * w[:, None, None] * np.einsum("pk,wk,km->wpm", Vq, g, L))
+
+
+def frf_modal(M, K, C, G, inputs, outputs: OutputMap, omegas, speed: float = 0.0, n_modes: int = 20,
+              residual: bool = True, modes: str = "complex", method: str = "auto") -> np.ndarray:
+    """Receptances (w, p, m) by modal superposition (one-shot :class:`ModalBasis`)."""
+    return ModalBasis(M, K, C, G, inputs, n_modes, residual, modes, method).frf(outputs, omegas, speed)
+
+
+def unbalance_response(M, K, C, G, load, outputs: OutputMap, speeds) -> np.ndarray:
+    """Steady response to a synchronous load ``Omega^2 load e^{i Omega t}`` at each spin speed Omega.
+
+    Parameters
+    ----------
+    load : complex array (n,)
+        Force amplitude per unit ``Omega^2`` (e.g. ``me e^{i phase} (e1 - i e2)`` at a disk: forward).
+    speeds : array (s,), rad/s
+        The spin speed is also the excitation frequency; G and C are those at each speed.
+
+    Returns
+    -------
+    complex array (s, p): output amplitudes.
+    """
+    M, K, C, G = _check(M, K, C, G)
+    F = _inputs(load, M.shape[0])
+    s = _omegas(speeds)
+    dofs = reached(M, K, C, G, F)
+    Z = DynamicStiffness(M, K, C, G, dofs)
+    D, V = outputs.D[:, dofs], outputs.V[:, dofs]
+    out = np.zeros((len(s), D.shape[0]), dtype=complex)
+    for i, w in enumerate(s):
+        X = Z.solve(w, w, w * w * F[dofs])[:, 0]
+        out[i] = D @ X + 1j * w * (V @ X)
+    return out
+
+
+def orbit(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Semi-axes of the elliptic orbit ``(Re(a e^{i w t}), Re(b e^{i w t}))``.
+
+    The orbit is ``r_f e^{i w t} + r_b e^{-i w t}`` in the complex plane ``x + i y`` with
+    ``r_f = (a + i b)/2``, ``r_b = (conj(a) + i conj(b))/2``.
+
+    Returns
+    -------
+    major : array, ``|r_f| + |r_b|``
+    minor : array, ``|r_f| - |r_b|``: positive for a forward orbit (from e1 to e2), negative backward.
+    """
+    rf = np.abs(a + 1j * b) / 2
+    rb = np.abs(np.conj(a) + 1j * np.conj(b)) / 2
+    return rf + rb, rf - rb
