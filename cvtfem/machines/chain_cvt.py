@@ -92,6 +92,8 @@ class ChainCVT(ModelBase):
             OutputSpec("contact.friction_force", "N", "Friction force on one pin end, x1 x2 x3 per pin and shaft.", 6 * n),
             OutputSpec("contact.friction_power", "W", "Friction power of both sheaves of each shaft (<= 0).", 2),
             OutputSpec("contact.sheave_axial_force", "N", "Sum of the pin axial contact forces on one sheave of each shaft.", 2),
+            OutputSpec("chain.span_tension", "N", "Mean link tension of the tight (x2 < 0) and slack (x2 > 0) span: "
+                       "links with both pins off contact.", 2),
             OutputSpec("driving.speed", "rad/s", "Angular speed of the driving shaft."),
             OutputSpec("driven.speed", "rad/s", "Angular speed of the driven shaft."),
             OutputSpec("driving.torque", "N m", "External torque on the driving shaft."),
@@ -299,7 +301,8 @@ class ChainCVT(ModelBase):
         P = dx[-4:]
         w, M, F = diag["w"], diag["M"], diag["F"]
         out = dict(self.family.outputs(q[:nc], v[:nc]))
-        out.update({"contact.normal_force": per(c["N"]), "contact.penetration": per(c["delta"]),
+        out.update({"chain.span_tension": self.span_tensions(q, v, pins, c["delta"]),
+                    "contact.normal_force": per(c["N"]), "contact.penetration": per(c["delta"]),
                     "contact.radius": per(np.where(on, c["radius"], 0.0)),
                     "contact.slip_speed": per(np.where(on, np.linalg.norm(c["slip"], axis=1), 0.0)),
                     "contact.friction_force": per(c["F_fr"], 3),
@@ -312,8 +315,22 @@ class ChainCVT(ModelBase):
                     "control.ratio_estimate": diag["ratio_estimate"], "control.resistance": diag["resistance"]})
         return {s.name: out[s.name] for s in self.output_specs}
 
+    def span_tensions(self, q, v, pins, delta):
+        """Mean link tension (N) of the tight and the slack span: links with both pins off contact
+        (``pins``, ``delta`` of the candidate contacts), split by the sign of the link midpoint's ``x2``."""
+        nc = self._idx[0]
+        fam = self.family
+        u = fam.split(q[:nc])[0]
+        touching = np.zeros(fam.n, bool)
+        touching[pins[delta > 0]] = True
+        free = ~touching & ~touching[fam.ip1] & (fam.on > 0)
+        y = 0.5 * (u[:, 1] + u[fam.ip1, 1])
+        T = fam.outputs(q[:nc], v[:nc])[f"{fam.name}.link_tension"]
+        return np.array([T[free & (y < 0)].mean() if (free & (y < 0)).any() else math.nan,
+                         T[free & (y > 0)].mean() if (free & (y > 0)).any() else math.nan])
+
     # ----- initial state -----------------------------------------------------------------------
-    def static_state(self, ratio: float, speed: float, tol: float = 1e-10):
+    def static_state(self, ratio: float, w1: float, tol: float = 1e-10):
         """Pins on the sheaves at ``ratio`` in quasi-static balance, and the running state around it.
 
         The pins are placed on the band path of the ratio with unstretched links
@@ -321,17 +338,19 @@ class ChainCVT(ModelBase):
         where its face meets the unloaded pin ends at ``r1``, and the chain coordinates plus ``z_2`` are
         solved (scipy ``least_squares``) for the balance of the chain's elastic forces, the Hertz
         forces, the clamping force ``F_appl[1]`` on the driven sheave and the centrifugal forces of
-        steady running at chain speed ``speed`` (m/s) on the arcs; friction is not loaded (no slip).
+        steady running at the driving speed ``w1`` (rad/s; chain speed ``w1 r1``) on the arcs; friction is not
+        loaded (no slip).
         The driving clamping force that holds the ratio is the reaction on ``z_1``.
 
-        Returns ``(x0, report)``: the state with the pins moving along the path at ``speed``, shafts at
-        ``speed / r_k``, loops at those speeds; ``report`` with ``residual`` (largest generalized force
+        Returns ``(x0, report)``: the state with the pins on the spans moving along the path at ``w1 r1``,
+        shafts at ``w1 r1 / r_k`` and the pins in contact turning with them (no slip), loops at those speeds; ``report`` with ``residual`` (largest generalized force
         over ``F_appl[1]``), ``max_penetration`` (m), ``F1`` (N), ``tension`` (mean elastic link tension, N)
         and the ``placement``.
         """
         fam, nc = self.family, self._idx[0]
         _, iphi, iz, _ = self._idx
         pl = place_on_path(fam.geom.L, ratio, self.contact.centres[0, 0])
+        speed = w1 * pl.r[0]
         n2, l = self.n2, fam.geom.l
         F2 = float(self.F_appl[1])
         faces = self.contact.faces
@@ -383,7 +402,7 @@ class ChainCVT(ModelBase):
                 (Jl[:, :5, :4].ravel(), (np.repeat(rws[:, :, None], 4, 2).ravel(),
                                          np.repeat(cin[:, None, :], 5, 1).ravel())), shape=(n2, n2))
             return (K[free][:, free] / F2).toarray()
-        sol = least_squares(residual, q[free], jac=jacobian, method="trf", xtol=tol, ftol=tol, gtol=tol,
+        sol = least_squares(residual, q[free], jac=jacobian, method="lm", xtol=tol, ftol=tol, gtol=tol,
                             x_scale=1e-5, max_nfev=200)
         q[free] = sol.x
         Q = forces(sol.x)
@@ -397,11 +416,20 @@ class ChainCVT(ModelBase):
         vu = fam.split(v[:nc])[0]
         vu[:] = speed * pl.tangent
         v[iphi] = speed / pl.r
+        u = fam.split(q[:nc])[0]
+        for k in (0, 1):                                        # pins in contact turn with their sheave
+            on = pins[(shafts == k) & (c["delta"] > 0)]
+            vu[on] = v[iphi[k]] * (u[on] - self.contact.centres[k]) @ np.array([[0.0, 1.0], [-1.0, 0.0]])
         x0 = np.concatenate([q, v, self.control.initial_state(*v[iphi]), np.zeros(4)])
         report = {"residual": res, "max_penetration": float(c["delta"].max()), "F1": F1,
                   "tension": float(out[f"{fam.name}.link_tension_elastic"].mean()), "placement": pl,
                   "nfev": sol.nfev, "status": sol.status}
         return x0, report
+
+    def initial_state(self) -> np.ndarray:
+        """The quasi-static state (:meth:`static_state`) at the regime's ratio and driving speed at ``t = 0``."""
+        w1, _, i = self.regime.targets(0.0)
+        return self.static_state(i, w1)[0]
 
     def with_clamping(self, F_appl) -> "ChainCVT":
         """The same model with other prescribed clamping forces (N per sheave)."""
@@ -434,3 +462,47 @@ class ChainCVT(ModelBase):
         loop = OpenLoop() if control is None else Stabilisation(control)
         return cls(family, contact, np.asarray(J, float), np.asarray(m_sheave, float), regime,
                    np.asarray(F_appl, float), loop)
+
+
+def from_scene(scene, geom, F_appl, model: str = "chain-S2", **overrides) -> ChainCVT:
+    """:meth:`ChainCVT.from_parameters` with the values of a CVT scene's existing keys (geometry, shafts,
+    friction, control, regime, ``chain.damping_ratio``) for the chain ``geom`` and clamping forces
+    ``F_appl`` (N per sheave); ``overrides`` replace keyword arguments (e.g. ``law``)."""
+    from cvtfem.elements.band.geometry import phi_for_ratio, radii
+
+    cvt = scene.cvt
+    g, rg, c = cvt.geometry, cvt.regime, cvt.control
+    shafts = (cvt.driving, cvt.driven)
+    r2 = radii(phi_for_ratio(rg.ratio, geom.length, g.centre_distance), geom.length, g.centre_distance)[0][1]
+    J = tuple(s.inertia for s in shafts)
+    loop = StabilisationParams(c.tau_omega, c.eps, c.i_min, c.i_max, c.k_sat, c.c_f0, c.c_f1, c.c_sat, c.tau, c.nu,
+                               J[0] * rg.ratio ** 2 + J[1] + cvt.chain.mass * r2 ** 2)
+    kw = dict(model=model, centre_distance=g.centre_distance,
+              face=Sheave(g.sheave_profile, g.flank_angle, g.torus_radius, g.torus_offset),
+              r_outer=g.sheave_outer_radius, J=J, m_sheave=tuple(s.sheave_mass for s in shafts),
+              f0=cvt.friction.f0, v0=cvt.friction.v0, law=cvt.friction.law,
+              regime=Regime(rg.kind, rg.input_speed, rg.torque, rg.ratio, rg.end_value, rg.ramp_time),
+              F_appl=F_appl, control=loop if cvt.effects.stabilisation else None,
+              damping_ratio=cvt.chain.damping_ratio, E=cvt.young_modulus)
+    kw.update(overrides)
+    return ChainCVT.from_parameters(geom, **kw)
+
+
+def band_span_tensions(band, x) -> np.ndarray:
+    """Tight and slack span tension (N) of a compressible band CVT (6+2n, :class:`~cvtfem.machines.band_cvt.BandCVT`)
+    at state ``x``: the radial balance of a band element ``T = rho v^2 + 2 r N sin(gamma)`` (``N`` per sheave
+    and unit length; no radial slip in steady running) at the arc ends, extrapolated to ``xi = +-1`` by a
+    parabola through the three end Gauss nodes.  The band runs counter-clockwise: the tight span leaves
+    the driven arc at ``xi = +1`` and enters the driving arc at ``xi = -1``."""
+    from cvtfem.elements.band.geometry import radii
+    from cvtfem.elements.band.params import gauss_nodes
+
+    p = band.model.p
+    q, v, _, _ = band.split(x)
+    r = radii(q[0], p.length, p.L)[0]
+    N = np.asarray(band.outputs(0.0, x)["band.normal_force"]).reshape(2, -1)
+    sg = np.array([np.sin(p.sheaves[k].gamma_at(r[k])) for k in range(2)])
+    T = p.rho * v[1] ** 2 + 2 * r[:, None] * N * sg[:, None]
+    xi = gauss_nodes(N.shape[1])[0]
+    end = lambda k, s: np.polyval(np.polyfit(xi[::s][:3], T[k][::s][:3], 2), -s)  # noqa: E731  s=1: xi=-1
+    return np.array([0.5 * (end(0, 1) + end(1, -1)), 0.5 * (end(0, -1) + end(1, 1))])

@@ -114,8 +114,9 @@ class SheaveContact:
         Rc[:, :2] = self.centres[shafts]
         Rc[:, 2] = X[:, 3]
         delta, grad, normal, arm, radius = (np.zeros(m), np.zeros((m, 3)), np.zeros((m, 3)), R - Rc, np.zeros(m))
-        for k in (0, 1):  # two profiles: one vectorised call per shaft
-            sel = shafts == k
+        same = self.faces[0] == self.faces[1]
+        for k in ((0,) if same else (0, 1)):  # one vectorised call per distinct face
+            sel = np.ones(m, bool) if same else shafts == k
             if sel.any():
                 con = pin_axis_contact(R[sel], Rc[sel], np.zeros((sel.sum(), 3)), self._profiles[k], _SIDE)
                 delta[sel], grad[sel], normal[sel], radius[sel] = con.delta, con.grad, con.normal, con.radius

@@ -1,0 +1,93 @@
+"""The chain on two rigid sheaves at the stationary regime (3500 rpm, 200 N m, ratio 2.4) against the 6+2n band.
+
+Run:  .venv/bin/python studies/chain/chain_cvt_stationary.py [--t-end 0.005] [--window 0.002] [--model chain-S2]
+1. The band-6+2n preset runs 1 s (both loops) to its stationary state: clamping forces F1, F2 and the
+   span tensions of :func:`~cvtfem.machines.chain_cvt.band_span_tensions`.
+2. The reference chain (84 pins, 9 mm) with the same scene values (friction law of the band preset) and
+   F_appl = the band's (F1, F2) starts from its quasi-static state at the ratio and runs ``t_end`` (Radau,
+   rtol 1e-3, atol 1e-6); means over the last ``window`` of the span tensions and of the sheave axial
+   forces against the clamping forces are printed, with the wall time per simulated ms and the cost
+   of one RHS and one Jacobian (median of 200 / 10 calls), machine named.
+"""
+from __future__ import annotations
+
+import argparse
+import os
+import platform
+import time
+
+import numpy as np
+
+from cvtfem.elements.chain.geometry import reference_geometry
+from cvtfem.integrate import solve
+from cvtfem.machines import build_model
+from cvtfem.machines.chain_cvt import band_span_tensions, from_scene
+from cvtfem.scene.loader import load_scene
+
+
+def band_reference():
+    """``(F (2,), T (2,), outputs)`` of the band-6+2n preset after 1 s."""
+    band = build_model(load_scene("band-6+2n"))
+    res = solve(band, (0.0, 1.0), band.initial_state(), method="Radau", rtol=1e-6, atol=1e-8, n2=band.n2,
+                jac=band.jac, jac_sparsity=band.jac_sparsity)
+    x = res.y[:, -1]
+    o = band.outputs(1.0, x)
+    return np.array([o["driving.clamping_force"], o["driven.clamping_force"]]), band_span_tensions(band, x), o
+
+
+def chain_run(F, t_end, window, model="chain-S2", n_out=101):
+    """Run the chain from its quasi-static state; returns the model, the static report and the sampled outputs."""
+    scene = load_scene("band-6+2n")
+    m = from_scene(scene, reference_geometry(), F, model=model)
+    x0, rep = m.static_state(scene.cvt.regime.ratio, scene.cvt.regime.input_speed)
+    t_eval = np.linspace(t_end - window, t_end, n_out)
+    t0 = time.perf_counter()
+    res = solve(m, (0.0, t_end), x0, method="Radau", rtol=1e-3, atol=1e-6, n2=m.n2, jac=m.jac,
+                jac_sparsity=m.jac_sparsity, t_eval=t_eval)
+    wall = time.perf_counter() - t0
+    outs = [m.outputs(t, y) for t, y in zip(res.t, res.y.T)]
+    return m, x0, rep, res, outs, wall
+
+
+def median_s(fn, calls):
+    times = []
+    for _ in range(calls):
+        t = time.perf_counter()
+        fn()
+        times.append(time.perf_counter() - t)
+    return float(np.median(times))
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--t-end", type=float, default=0.005)
+    ap.add_argument("--window", type=float, default=0.002)
+    ap.add_argument("--model", default="chain-S2")
+    a = ap.parse_args()
+    print(f"machine: {platform.processor() or platform.machine()}, {os.cpu_count()} cores, "
+          f"load {os.getloadavg()[0]:.1f}")
+    F, Tb, ob = band_reference()
+    print(f"band 6+2n: F1 {F[0]:.0f} N, F2 {F[1]:.0f} N, ratio {ob['ratio']:.4f}, tight {Tb[0]:.0f} N, "
+          f"slack {Tb[1]:.0f} N, efficiency {ob['efficiency']:.4f}")
+    m, x0, rep, res, outs, wall = chain_run(F, a.t_end, a.window, a.model)
+    print(f"static state: residual {rep['residual']:.2e} of F2, max penetration {rep['max_penetration'] * 1e6:.2f} um, "
+          f"F1 to hold the ratio without torque {rep['F1']:.0f} N, mean link tension {rep['tension']:.0f} N")
+    print(f"run 0..{a.t_end * 1e3:g} ms: status {res.status}, {res.stats['nsteps']} steps, wall {wall:.1f} s "
+          f"= {wall / (a.t_end * 1e3):.1f} s per simulated ms")
+    T = np.array([o["chain.span_tension"] for o in outs])
+    A = np.array([o["contact.sheave_axial_force"] for o in outs])
+    Fc = np.array([[o["driving.clamping_force"], o["driven.clamping_force"]] for o in outs])
+    tm, sm = np.nanmean(T, axis=0)
+    print(f"chain ({a.model}), mean over the last {a.window * 1e3:g} ms: tight {tm:.0f} N ({tm / Tb[0] - 1:+.2%} vs band), "
+          f"slack {sm:.0f} N ({sm / Tb[1] - 1:+.2%}), tight - slack {tm - sm:.0f} N (M1/r1 {200 / rep['placement'].r[0]:.0f} N)")
+    bal = A.mean(axis=0) / Fc.mean(axis=0) - 1
+    print(f"sheave axial force / clamping force - 1: driving {bal[0]:+.2%}, driven {bal[1]:+.2%}; "
+          f"ratio {np.mean([o['ratio'] for o in outs]):.4f}, efficiency {np.mean([o['efficiency'] for o in outs]):.4f}")
+    x = res.y[:, -1]
+    t_rhs = median_s(lambda: m.rhs(0.0, x), 200)
+    t_jac = median_s(lambda: m.jac(0.0, x), 10)
+    print(f"one RHS {t_rhs * 1e3:.2f} ms, one Jacobian {t_jac * 1e3:.0f} ms ({t_jac / t_rhs:.0f} RHS)")
+
+
+if __name__ == "__main__":
+    main()
