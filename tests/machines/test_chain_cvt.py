@@ -183,3 +183,10 @@ def test_stationary_regime_against_the_band_model(scene):
           f"axial/clamping {axial / clamp}")
     np.testing.assert_allclose(axial, clamp, rtol=0.01)
     np.testing.assert_allclose(T, T_band, rtol=0.05)
+
+
+def test_closed_forms_equal_the_contact_primitives(model, static):
+    x = _perturbed(model, static[0], seed=4)
+    pins, shafts, X, Y = model._contacts(x[:model.n2], x[model.n2:2 * model.n2])
+    Y_ref = model.contact.local(X, shafts, reference=True)
+    assert np.all(np.abs(Y - Y_ref) <= 1e-12 * np.abs(Y_ref).max(axis=0))   # per output, of its scale

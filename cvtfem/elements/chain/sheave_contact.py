@@ -104,32 +104,57 @@ class SheaveContact:
         """Local inputs ``X`` (m, 9) of the contacts from the chain and shaft states (see :data:`N_IN`)."""
         return np.column_stack([u[pins], u3[pins], z[shafts], ud[pins], u3d[pins], zd[shafts], w[shafts]])
 
-    def local(self, X, shafts, details: bool = False):
+    def local(self, X, shafts, details: bool = False, reference: bool = False):
         """Local outputs ``Y`` (m, 6) of contacts with inputs ``X`` on shafts ``shafts``: ``2F`` on the pin end
         (N), the generalized forces on ``z`` (N) and ``phi`` (N m) of the shaft, and the friction power
-        ``2 F_fr . v_slip`` (W, <= 0); with ``details`` also a dict of per-contact quantities."""
+        ``2 F_fr . v_slip`` (W, <= 0); with ``details`` also a dict of per-contact quantities.
+
+        The untilted sheaves of model 1 get the closed forms of the H1 primitives at zero tilt;
+        ``reference=True`` calls the primitives themselves (pin_axis_contact, pin_axis_slip,
+        sheave_generalized: the tested reference, equal to round-off)."""
         m = len(X)
-        R = X[:, :3]
-        Rc = np.zeros((m, 3))
-        Rc[:, :2] = self.centres[shafts]
-        Rc[:, 2] = X[:, 3]
-        delta, grad, normal, arm, radius = (np.zeros(m), np.zeros((m, 3)), np.zeros((m, 3)), R - Rc, np.zeros(m))
-        same = self.faces[0] == self.faces[1]
-        for k in ((0,) if same else (0, 1)):  # one vectorised call per distinct face
-            sel = np.ones(m, bool) if same else shafts == k
-            if sel.any():
-                con = pin_axis_contact(R[sel], Rc[sel], np.zeros((sel.sum(), 3)), self._profiles[k], _SIDE)
-                delta[sel], grad[sel], normal[sel], radius[sel] = con.delta, con.grad, con.normal, con.radius
-        N, _ = hertz_force(delta, self.c[shafts])
+        arm = X[:, :3].copy()
+        arm[:, :2] -= self.centres[shafts]
+        arm[:, 2] -= X[:, 3]
         vc = np.zeros((m, 3))
         vc[:, 2] = X[:, 7]
         omega = np.zeros((m, 3))
         omega[:, 2] = X[:, 8]
-        slip = pin_axis_slip(_Geometry(normal, arm), X[:, 4:7], vc, omega)
+        same = self.faces[0] == self.faces[1]
+        delta, grad, normal, radius = np.zeros(m), np.zeros((m, 3)), np.zeros((m, 3)), np.zeros(m)
+        for k in ((0,) if same else (0, 1)):  # one vectorised call per distinct face
+            sel = np.ones(m, bool) if same else shafts == k
+            if not sel.any():
+                continue
+            if reference:
+                con = pin_axis_contact(arm[sel], np.zeros((sel.sum(), 3)), np.zeros((sel.sum(), 3)),
+                                       self._profiles[k], _SIDE)
+                delta[sel], grad[sel], normal[sel], radius[sel] = con.delta, con.grad, con.normal, con.radius
+            else:                                   # (1.317)-(1.321) at zero tilt, side -1
+                a = arm[sel]
+                r = np.hypot(a[:, 0], a[:, 1])
+                f, fp, _ = self._profiles[k](r)
+                g = np.empty_like(a)
+                g[:, :2] = (fp / r)[:, None] * a[:, :2]
+                g[:, 2] = 1.0
+                delta[sel], grad[sel], radius[sel] = f + a[:, 2], g, r
+                normal[sel] = -g / np.sqrt(1.0 + fp * fp)[:, None]
+        N, _ = hertz_force(delta, self.c[shafts])
+        if reference:
+            slip = pin_axis_slip(_Geometry(normal, arm), X[:, 4:7], vc, omega)
+        else:
+            w = X[:, 4:7] - vc
+            w[:, 0] += X[:, 8] * arm[:, 1]                      # - omega k x arm
+            w[:, 1] -= X[:, 8] * arm[:, 0]
+            slip = w - np.sum(normal * w, axis=1, keepdims=True) * normal
         F_fr, _ = friction_force(slip, N, self.f0, self.v0, self.law, self.eps)
         F = normal_force(grad, N) + F_fr
-        F_sheave, _, Q_phi = sheave_generalized(F, arm, np.zeros((m, 3)))
-        Y = np.column_stack([2 * F, 2 * F_sheave[:, 2], 2 * Q_phi, 2 * np.sum(F_fr * slip, axis=1)])
+        if reference:
+            F_sheave, _, Q_phi = sheave_generalized(F, arm, np.zeros((m, 3)))
+            Fz = F_sheave[:, 2]
+        else:
+            Fz, Q_phi = -F[:, 2], arm[:, 1] * F[:, 0] - arm[:, 0] * F[:, 1]    # k . (-(arm x F))
+        Y = np.column_stack([2 * F, 2 * Fz, 2 * Q_phi, 2 * np.sum(F_fr * slip, axis=1)])
         if not details:
             return Y
         return Y, {"delta": delta, "N": N, "radius": radius, "slip": slip, "F_fr": F_fr, "F": F,
