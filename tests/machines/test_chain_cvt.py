@@ -190,3 +190,23 @@ def test_closed_forms_equal_the_contact_primitives(model, static):
     pins, shafts, X, Y = model._contacts(x[:model.n2], x[model.n2:2 * model.n2])
     Y_ref = model.contact.local(X, shafts, reference=True)
     assert np.all(np.abs(Y - Y_ref) <= 1e-12 * np.abs(Y_ref).max(axis=0))   # per output, of its scale
+
+
+def test_s3_chain_on_the_sheaves(scene):
+    """S3 (pin bending) shares the interface: quasi-static state, axial balance, Jacobian columns."""
+    m = from_scene(scene, reference_geometry(), F_APPL, model="chain-S3")
+    x0, rep = m.static_state(RATIO, scene.cvt.regime.input_speed)
+    assert rep["residual"] < 1e-8
+    o = m.outputs(0.0, x0)
+    np.testing.assert_allclose(o["contact.sheave_axial_force"], [rep["F1"], F_APPL[1]], rtol=1e-8)
+    x = _perturbed(m, x0, seed=6)
+    J = m.jac(0.0, x)
+    assert not np.any(J.toarray()[~m.jac_sparsity.toarray()])
+    n2, nc = m.n2, m.family.size
+    for c in (3 * m.family.n + 7, n2 + 11, nc + 3, n2 + nc + 1):      # u_tangent, u_perp velocity, z2, phi2'
+        h = 1e-9 if c < n2 else 1e-6
+        xp, xm = x.copy(), x.copy()
+        xp[c] += h
+        xm[c] -= h
+        fd = (m.rhs(0.0, xp) - m.rhs(0.0, xm)) / (2 * h)
+        np.testing.assert_allclose(J[:, c].toarray().ravel(), fd, rtol=0, atol=1e-5 * np.abs(fd).max())
