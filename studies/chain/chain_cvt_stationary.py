@@ -1,6 +1,6 @@
 """The chain on two rigid sheaves at the stationary regime (3500 rpm, 200 N m, ratio 2.4) against the 6+2n band.
 
-Run:  .venv/bin/python studies/chain/chain_cvt_stationary.py [--t-end 0.005] [--window 0.002] [--model chain-S2]
+Run:  .venv/bin/python studies/chain/chain_cvt_stationary.py [--t-end 0.01] [--window 0.006] [--model chain-S2]
 1. The band-6+2n preset runs 1 s (both loops) to its stationary state: clamping forces F1, F2 and the
    span tensions of :func:`~cvtfem.machines.chain_cvt.band_span_tensions`.
 2. The reference chain (84 pins, 9 mm) with the same scene values (friction law of the band preset) and
@@ -35,7 +35,7 @@ def band_reference():
     return np.array([o["driving.clamping_force"], o["driven.clamping_force"]]), band_span_tensions(band, x), o
 
 
-def chain_run(F, t_end, window, model="chain-S2", n_out=101):
+def chain_run(F, t_end, window, model="chain-S2", n_out=241):
     """Run the chain from its quasi-static state; returns the model, the static report and the sampled outputs."""
     scene = load_scene("band-6+2n")
     m = from_scene(scene, reference_geometry(), F, model=model)
@@ -60,8 +60,8 @@ def median_s(fn, calls):
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--t-end", type=float, default=0.005)
-    ap.add_argument("--window", type=float, default=0.002)
+    ap.add_argument("--t-end", type=float, default=0.01)
+    ap.add_argument("--window", type=float, default=0.006)
     ap.add_argument("--model", default="chain-S2")
     a = ap.parse_args()
     print(f"machine: {platform.processor() or platform.machine()}, {os.cpu_count()} cores, "
