@@ -350,6 +350,9 @@ class ChainCVT(ModelBase):
         fam, nc = self.family, self._idx[0]
         _, iphi, iz, _ = self._idx
         pl = place_on_path(fam.geom.L, ratio, self.contact.centres[0, 0])
+        if not (pl.r.max() < self.contact.r_outer and pl.r.min() > fam.geom.L.max()):
+            raise InputError("ratio", ratio, f"must put both arcs between one pitch and the sheaves' outer radius "
+                             f"{self.contact.r_outer:g} m (radii {pl.r[0]:.4g}, {pl.r[1]:.4g} m)")
         speed = w1 * pl.r[0]
         n2, l = self.n2, fam.geom.l
         F2 = float(self.F_appl[1])
@@ -409,8 +412,10 @@ class ChainCVT(ModelBase):
         pins, shafts, _, (_, c) = self._contacts(q, vel, details=True)
         F1 = float(Q[iz[0]] / 2)                               # reaction that holds z_1 (Q excludes F1)
         res = float(np.abs(Q[free]).max() / F2)
-        if not np.isfinite(res):
-            raise NumericalError("ChainCVT.static_state", f"non-finite residual at ratio {ratio}")
+        if not res <= 1e-6:
+            raise NumericalError(f"the quasi-static solve at ratio {ratio} ended with a residual of {res:.3g} of the "
+                                 f"clamping force after {sol.nfev} evaluations ({sol.message})",
+                                 component="ChainCVT.static_state")
         out = fam.outputs(q[:nc], np.zeros(nc))
         v = np.zeros(n2)
         vu = fam.split(v[:nc])[0]

@@ -210,3 +210,8 @@ def test_s3_chain_on_the_sheaves(scene):
         xm[c] -= h
         fd = (m.rhs(0.0, xp) - m.rhs(0.0, xm)) / (2 * h)
         np.testing.assert_allclose(J[:, c].toarray().ravel(), fd, rtol=0, atol=1e-5 * np.abs(fd).max())
+
+
+def test_unreachable_ratio_fails_loudly(model, scene):
+    with pytest.raises(InputError, match="ratio"):
+        model.static_state(40.0, scene.cvt.regime.input_speed)

@@ -64,8 +64,8 @@ def place_on_path(L, ratio: float, L_c: float) -> Placement:
     try:
         length = brentq(closure, total, 1.02 * total, xtol=1e-13)
     except ValueError:
-        raise NumericalError("chain placement", f"the chain does not close on the path of ratio {ratio} "
-                             f"(centre distance {L_c} m, chain length {total:.4f} m)") from None
+        raise NumericalError(f"the chain does not close on the path of ratio {ratio} (centre distance {L_c} m, "
+                             f"chain length {total:.4f} m)", component="chain placement") from None
     phi = phi_of(length)
     s = _march(L, length, phi, L_c)[:-1]
     u = path_point(s, phi, length, L_c).T
