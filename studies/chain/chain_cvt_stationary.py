@@ -1,13 +1,15 @@
 """The chain on two rigid sheaves at the stationary regime (3500 rpm, 200 N m, ratio 2.4) against the 6+2n band.
 
 Run:  .venv/bin/python studies/chain/chain_cvt_stationary.py [--t-end 0.01] [--window 0.006] [--model chain-S2]
+      [--png out/studies/chain/chain_cvt_stationary.png]
 1. The band-6+2n preset runs 1 s (both loops) to its stationary state: clamping forces F1, F2 and the
    span tensions of :func:`~cvtfem.machines.chain_cvt.band_span_tensions`.
 2. The reference chain (84 pins, 9 mm) with the same scene values (friction law of the band preset) and
    F_appl = the band's (F1, F2) starts from its quasi-static state at the ratio and runs ``t_end`` (Radau,
    rtol 1e-3, atol 1e-6); means over the last ``window`` of the span tensions and of the sheave axial
    forces against the clamping forces are printed, with the wall time per simulated ms and the cost
-   of one RHS and one Jacobian (median of 200 / 10 calls), machine named.
+   of one RHS and one Jacobian (median of 200 / 10 calls), machine named.  ``--png``: the span tensions,
+   axial force balance and ratio over the whole run (outputs every 25 us).
 """
 from __future__ import annotations
 
@@ -35,18 +37,43 @@ def band_reference():
     return np.array([o["driving.clamping_force"], o["driven.clamping_force"]]), band_span_tensions(band, x), o
 
 
-def chain_run(F, t_end, window, model="chain-S2", n_out=241):
+def chain_run(F, t_end, model="chain-S2", dt_out=2.5e-5):
     """Run the chain from its quasi-static state; returns the model, the static report and the sampled outputs."""
     scene = load_scene("band-6+2n")
     m = from_scene(scene, reference_geometry(), F, model=model)
     x0, rep = m.static_state(scene.cvt.regime.ratio, scene.cvt.regime.input_speed)
-    t_eval = np.linspace(t_end - window, t_end, n_out)
+    t_eval = np.linspace(0.0, t_end, int(round(t_end / dt_out)) + 1)
     t0 = time.perf_counter()
     res = solve(m, (0.0, t_end), x0, method="Radau", rtol=1e-3, atol=1e-6, n2=m.n2, jac=m.jac,
                 jac_sparsity=m.jac_sparsity, t_eval=t_eval)
     wall = time.perf_counter() - t0
     outs = [m.outputs(t, y) for t, y in zip(res.t, res.y.T)]
     return m, x0, rep, res, outs, wall
+
+
+def plot(t, T, balance, ratio, T_band, path):
+    """Span tensions with the band's, axial force over clamping force - 1, ratio; PNG at ``path``."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(3, 1, figsize=(8, 8), sharex=True)
+    ms = 1e3 * t
+    for k, name in enumerate(("tight", "slack")):
+        ax[0].plot(ms, T[:, k], c=f"C{k}", lw=0.8, label=f"chain, {name} span")
+        ax[0].axhline(T_band[k], c=f"C{k}", ls="--", label=f"band 6+2n, {name}")
+    ax[0].set_ylabel("mean span link tension, N")
+    for k, name in enumerate(("driving", "driven")):
+        ax[1].plot(ms, 100 * balance[:, k], lw=0.8, label=name)
+    ax[1].set_ylabel("sum of pin axial forces /\nclamping force - 1, %")
+    ax[2].plot(ms, ratio, lw=0.8)
+    ax[2].set_ylabel("speed ratio w1 / w2")
+    ax[2].set_xlabel("t, ms")
+    for a in ax[:2]:
+        a.legend(fontsize=7)
+    fig.tight_layout()
+    os.makedirs(os.path.dirname(path) or ".", exist_ok=True)
+    fig.savefig(path, dpi=90)
 
 
 def median_s(fn, calls):
@@ -63,13 +90,14 @@ def main() -> None:
     ap.add_argument("--t-end", type=float, default=0.01)
     ap.add_argument("--window", type=float, default=0.006)
     ap.add_argument("--model", default="chain-S2")
+    ap.add_argument("--png", default="")
     a = ap.parse_args()
     print(f"machine: {platform.processor() or platform.machine()}, {os.cpu_count()} cores, "
           f"load {os.getloadavg()[0]:.1f}")
     F, Tb, ob = band_reference()
     print(f"band 6+2n: F1 {F[0]:.0f} N, F2 {F[1]:.0f} N, ratio {ob['ratio']:.4f}, tight {Tb[0]:.0f} N, "
           f"slack {Tb[1]:.0f} N, efficiency {ob['efficiency']:.4f}")
-    m, x0, rep, res, outs, wall = chain_run(F, a.t_end, a.window, a.model)
+    m, x0, rep, res, outs, wall = chain_run(F, a.t_end, a.model)
     print(f"static state: residual {rep['residual']:.2e} of F2, max penetration {rep['max_penetration'] * 1e6:.2f} um, "
           f"F1 to hold the ratio without torque {rep['F1']:.0f} N, mean link tension {rep['tension']:.0f} N")
     print(f"run 0..{a.t_end * 1e3:g} ms: status {res.status}, {res.stats['nsteps']} steps, wall {wall:.1f} s "
@@ -77,6 +105,11 @@ def main() -> None:
     T = np.array([o["chain.span_tension"] for o in outs])
     A = np.array([o["contact.sheave_axial_force"] for o in outs])
     Fc = np.array([[o["driving.clamping_force"], o["driven.clamping_force"]] for o in outs])
+    ratio = np.array([o["ratio"] for o in outs])
+    if a.png:
+        plot(res.t, T, A / Fc - 1, ratio, Tb, a.png)
+    last = res.t >= a.t_end - a.window - 1e-12
+    outs, T, A, Fc = [o for o, k in zip(outs, last) if k], T[last], A[last], Fc[last]
     tm, sm = np.nanmean(T, axis=0)
     print(f"chain ({a.model}), mean over the last {a.window * 1e3:g} ms: tight {tm:.0f} N ({tm / Tb[0] - 1:+.2%} vs band), "
           f"slack {sm:.0f} N ({sm / Tb[1] - 1:+.2%}), tight - slack {tm - sm:.0f} N (M1/r1 {200 / rep['placement'].r[0]:.0f} N)")
