@@ -85,13 +85,17 @@ class ChainCVT(ModelBase):
     def output_specs(self) -> tuple[OutputSpec, ...]:
         n = self.family.n
         return tuple(self.family.output_specs) + (
-            OutputSpec("contact.normal_force", "N", "Hertz force N per pin end and shaft (pin-major, driving then driven).", 2 * n),
-            OutputSpec("contact.penetration", "m", "Penetration Delta along the axis per pin end and shaft (<= 0: off).", 2 * n),
+            OutputSpec("contact.normal_force", "N",
+                       "Hertz force N per pin end and shaft (pin-major, driving then driven).", 2 * n),
+            OutputSpec("contact.penetration", "m",
+                       "Penetration Delta along the axis per pin end and shaft (<= 0: off).", 2 * n),
             OutputSpec("contact.radius", "m", "Contact radius per pin end and shaft (0 off contact).", 2 * n),
             OutputSpec("contact.slip_speed", "m/s", "Slip speed of the pin end on the sheave (0 off contact).", 2 * n),
-            OutputSpec("contact.friction_force", "N", "Friction force on one pin end, x1 x2 x3 per pin and shaft.", 6 * n),
+            OutputSpec("contact.friction_force", "N",
+                       "Friction force on one pin end, x1 x2 x3 per pin and shaft.", 6 * n),
             OutputSpec("contact.friction_power", "W", "Friction power of both sheaves of each shaft (<= 0).", 2),
-            OutputSpec("contact.sheave_axial_force", "N", "Sum of the pin axial contact forces on one sheave of each shaft.", 2),
+            OutputSpec("contact.sheave_axial_force", "N",
+                       "Sum of the pin axial contact forces on one sheave of each shaft.", 2),
             OutputSpec("chain.span_tension", "N", "Mean link tension of the tight (x2 < 0) and slack (x2 > 0) span: "
                        "links with both pins off contact.", 2),
             OutputSpec("driving.speed", "rad/s", "Angular speed of the driving shaft."),
@@ -215,7 +219,6 @@ class ChainCVT(ModelBase):
         dQ = sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))), shape=(n2, N))
         acc = self._inv_mass @ dQ
         # work rates: [M1 w1, -M2 w2, 2 Phi - P_fr, -2 F.z']
-        iw = 2 * n2 + nz
         Wr = sp.lil_matrix((4, N))
         Wr[0, n2 + iphi[0]] = M[0]
         Wr[1, in_cols] = -w[1] * G[2]
@@ -234,7 +237,6 @@ class ChainCVT(ModelBase):
         ctrl_rows = sp.csr_matrix((G[3:].ravel(), (np.repeat(np.arange(nz), 2 + nz), np.tile(in_cols, nz))),
                                   shape=(nz, N))
         top = sp.csr_matrix((np.ones(n2), (np.arange(n2), n2 + np.arange(n2))), shape=(n2, N))
-        del iw
         return sp.vstack([top, acc, ctrl_rows, Wr.tocsr()], format="csr")
 
     @cached_property
@@ -334,18 +336,18 @@ class ChainCVT(ModelBase):
         """Pins on the sheaves at ``ratio`` in quasi-static balance, and the running state around it.
 
         The pins are placed on the band path of the ratio with unstretched links
-        (:func:`~cvtfem.elements.chain.placement.place_on_path`), the driving sheave ``z_1`` is held
-        where its face meets the unloaded pin ends at ``r1``, and the chain coordinates plus ``z_2`` are
-        solved (scipy ``least_squares``) for the balance of the chain's elastic forces, the Hertz
-        forces, the clamping force ``F_appl[1]`` on the driven sheave and the centrifugal forces of
-        steady running at the driving speed ``w1`` (rad/s; chain speed ``w1 r1``) on the arcs; friction is not
-        loaded (no slip).
-        The driving clamping force that holds the ratio is the reaction on ``z_1``.
+        (:func:`~cvtfem.elements.chain.placement.place_on_path`); the driving sheave ``z_1`` is held where
+        its face meets the pin ends at ``r1`` with the wedge estimate of their Hertz penetration; the
+        chain coordinates and ``z_2`` are solved (scipy ``least_squares``) for the balance of the chain's
+        elastic forces, the Hertz forces, the clamping force ``F_appl[1]`` on the driven sheave and the
+        centrifugal forces of steady running at the driving speed ``w1`` (rad/s; chain speed ``w1 r1``)
+        on the arcs.  Friction is not loaded (no slip).  The driving clamping force that holds the
+        ratio is the reaction on ``z_1``.
 
-        Returns ``(x0, report)``: the state with the pins on the spans moving along the path at ``w1 r1``,
-        shafts at ``w1 r1 / r_k`` and the pins in contact turning with them (no slip), loops at those speeds; ``report`` with ``residual`` (largest generalized force
-        over ``F_appl[1]``), ``max_penetration`` (m), ``F1`` (N), ``tension`` (mean elastic link tension, N)
-        and the ``placement``.
+        Returns ``(x0, report)``: the state with the span pins moving along the path at ``w1 r1``, the
+        shafts at ``w1 r1 / r_k``, the pins in contact turning with their sheave (no slip) and the loops
+        at those speeds; ``report`` with ``residual`` (largest generalized force over ``F_appl[1]``),
+        ``max_penetration`` (m), ``F1`` (N), ``tension`` (mean elastic link tension, N), ``placement``.
         """
         fam, nc = self.family, self._idx[0]
         _, iphi, iz, _ = self._idx

@@ -111,8 +111,9 @@ def main() -> None:
     last = res.t >= a.t_end - a.window - 1e-12
     outs, T, A, Fc = [o for o, k in zip(outs, last) if k], T[last], A[last], Fc[last]
     tm, sm = np.nanmean(T, axis=0)
-    print(f"chain ({a.model}), mean over the last {a.window * 1e3:g} ms: tight {tm:.0f} N ({tm / Tb[0] - 1:+.2%} vs band), "
-          f"slack {sm:.0f} N ({sm / Tb[1] - 1:+.2%}), tight - slack {tm - sm:.0f} N (M1/r1 {200 / rep['placement'].r[0]:.0f} N)")
+    print(f"chain ({a.model}), mean over the last {a.window * 1e3:g} ms: tight {tm:.0f} N "
+          f"({tm / Tb[0] - 1:+.2%} vs band), slack {sm:.0f} N ({sm / Tb[1] - 1:+.2%}), tight - slack {tm - sm:.0f} N "
+          f"(M1/r1 {ob['driving.torque'] / rep['placement'].r[0]:.0f} N)")
     bal = A.mean(axis=0) / Fc.mean(axis=0) - 1
     print(f"sheave axial force / clamping force - 1: driving {bal[0]:+.2%}, driven {bal[1]:+.2%}; "
           f"ratio {np.mean([o['ratio'] for o in outs]):.4f}, efficiency {np.mean([o['efficiency'] for o in outs]):.4f}")
