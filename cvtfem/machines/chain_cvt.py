@@ -224,7 +224,7 @@ class ChainCVT(ModelBase):
         Wr[1, in_cols] = -w[1] * G[2]
         Wr[1, n2 + iphi[1]] += -M[1]
         Qd = self.family.dissipative_forces(q[:nc], v[:nc])
-        Kd = self.family.jacobian(q[:nc], v[:nc], part="dissipative")[0]
+        Kd = self.family.jacobian(q[:nc], v[:nc], part="dissipative", wrt=(0,))[0]
         d2phi = np.concatenate([-(Kd.T @ v[:nc]), -2 * Qd])
         chain_cols = np.concatenate([np.arange(nc), n2 + np.arange(nc)])
         dPf = np.zeros(N)
@@ -396,7 +396,7 @@ class ChainCVT(ModelBase):
         def jacobian(y):
             qq = q.copy()
             qq[free] = y
-            Kc = fam.jacobian(qq[:nc], vel[:nc])[0]
+            Kc = fam.jacobian(qq[:nc], vel[:nc], wrt=(0,))[0]
             pins, shafts, X, _ = self._contacts(qq, vel)
             Jl = self.contact.local_jacobian(X, shafts)
             _, _, _, dof3 = self._idx
