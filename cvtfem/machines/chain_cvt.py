@@ -332,8 +332,12 @@ class ChainCVT(ModelBase):
                          T[free & (y > 0)].mean() if (free & (y > 0)).any() else math.nan])
 
     # ----- initial state -----------------------------------------------------------------------
-    def static_state(self, ratio: float, w1: float, tol: float = 1e-10):
+    def static_state(self, ratio: float, w1: float, tension: float | None = None, tol: float = 1e-10):
         """Pins on the sheaves at ``ratio`` in quasi-static balance, and the running state around it.
+
+        With ``tension`` (N) the driven clamping force is not ``F_appl[1]`` but the one that gives that mean
+        link tension (secant steps on the affine law ``T = m' v^2 + F2 tan(gamma2) / theta2*`` of the wedge,
+        started from it, to 1e-6 relative; ``report["F2"]``).
 
         The pins are placed on the band path of the ratio with unstretched links
         (:func:`~cvtfem.elements.chain.placement.place_on_path`); the driving sheave ``z_1`` is held where
@@ -346,9 +350,32 @@ class ChainCVT(ModelBase):
 
         Returns ``(x0, report)``: the state with the span pins moving along the path at ``w1 r1``, the
         shafts at ``w1 r1 / r_k``, the pins in contact turning with their sheave (no slip) and the loops
-        at those speeds; ``report`` with ``residual`` (largest generalized force over ``F_appl[1]``),
-        ``max_penetration`` (m), ``F1`` (N), ``tension`` (mean elastic link tension, N), ``placement``.
+        at those speeds; ``report`` with ``residual`` (largest generalized force over ``F2``),
+        ``max_penetration`` (m), ``F1``, ``F2`` (N), ``tension`` (mean elastic link tension, N), ``placement``.
         """
+        if tension is None:
+            return self._static(ratio, w1, float(self.F_appl[1]), tol)
+        if not tension > 0:
+            raise InputError("tension", tension, "must be positive")
+        F2, T_c = None, None
+        for _ in range(8):
+            if F2 is None:                                    # the wedge estimate
+                pl = place_on_path(self.family.geom.L, ratio, self.contact.centres[0, 0])
+                geo = self.family.geom
+                T_c = geo.m_eff.mean() / geo.L.mean() * (w1 * pl.r[0]) ** 2
+                F2 = (tension - T_c) * (np.pi / 2 - pl.phi) / self.contact.faces[1].tan_gamma(pl.r[1])
+            else:                                             # secant through the centrifugal offset
+                F2 *= (tension - T_c) / (rep["tension"] - T_c)
+            if not F2 > 0:
+                raise InputError("tension", tension, f"must exceed the centrifugal tension {T_c:.4g} N")
+            x0, rep = self._static(ratio, w1, float(F2), tol)
+            if abs(rep["tension"] / tension - 1) < 1e-6:
+                return x0, rep
+        raise NumericalError(f"the pretension {tension} N was not reached (last {rep['tension']:.6g} N at F2 = "
+                             f"{F2:.6g} N)", component="ChainCVT.static_state")
+
+    def _static(self, ratio: float, w1: float, F2: float, tol: float):
+        """:meth:`static_state` at the driven clamping force ``F2`` (N)."""
         fam, nc = self.family, self._idx[0]
         _, iphi, iz, _ = self._idx
         pl = place_on_path(fam.geom.L, ratio, self.contact.centres[0, 0])
@@ -357,7 +384,6 @@ class ChainCVT(ModelBase):
                              f"{self.contact.r_outer:g} m (radii {pl.r[0]:.4g}, {pl.r[1]:.4g} m)")
         speed = w1 * pl.r[0]
         n2, l = self.n2, fam.geom.l
-        F2 = float(self.F_appl[1])
         faces = self.contact.faces
         # guess: wedge tension T = F2 tan(g2) / theta2*, per-pin axial forces T L / (2 r tan g), Hertz penetration
         tg = np.array([faces[k].tan_gamma(pl.r[k]) for k in range(2)])
@@ -428,7 +454,7 @@ class ChainCVT(ModelBase):
             on = pins[(shafts == k) & (c["delta"] > 0)]
             vu[on] = v[iphi[k]] * (u[on] - self.contact.centres[k]) @ np.array([[0.0, 1.0], [-1.0, 0.0]])
         x0 = np.concatenate([q, v, self.control.initial_state(*v[iphi]), np.zeros(4)])
-        report = {"residual": res, "max_penetration": float(c["delta"].max()), "F1": F1,
+        report = {"residual": res, "max_penetration": float(c["delta"].max()), "F1": F1, "F2": F2,
                   "tension": float(out[f"{fam.name}.link_tension_elastic"].mean()), "placement": pl,
                   "nfev": sol.nfev, "status": sol.status}
         return x0, report

@@ -215,3 +215,11 @@ def test_s3_chain_on_the_sheaves(scene):
 def test_unreachable_ratio_fails_loudly(model, scene):
     with pytest.raises(InputError, match="ratio"):
         model.static_state(40.0, scene.cvt.regime.input_speed)
+
+
+def test_static_state_at_a_requested_pretension(model, scene):
+    x0, rep = model.static_state(RATIO, scene.cvt.regime.input_speed, tension=3000.0)
+    assert rep["tension"] == pytest.approx(3000.0, rel=1e-6) and rep["residual"] < 1e-8
+    o = model.outputs(0.0, x0)
+    np.testing.assert_allclose(o["contact.sheave_axial_force"], [rep["F1"], rep["F2"]], rtol=1e-8)
+    assert o["chain.span_tension"] == pytest.approx([3000.0, 3000.0], rel=0.01)   # no torque yet: spans equal
