@@ -8,7 +8,7 @@ Run:  .venv/bin/python studies/chain/chain_cvt_stationary.py [--t-end 0.01] [--w
    F_appl = the band's (F1, F2) starts from its quasi-static state at the ratio and runs ``t_end`` (Radau,
    rtol 1e-3, atol 1e-6); means over the last ``window`` of the span tensions and of the sheave axial
    forces against the clamping forces are printed, with the wall time per simulated ms and the cost
-   of one RHS and one Jacobian (median of 200 / 10 calls), machine named.  ``--png``: the span tensions,
+   of one RHS and one Jacobian (median of 1000 / 20 calls), machine named.  ``--png``: the span tensions,
    axial force balance and ratio over the whole run (outputs every 25 us).
 """
 from __future__ import annotations
@@ -118,8 +118,8 @@ def main() -> None:
     print(f"sheave axial force / clamping force - 1: driving {bal[0]:+.2%}, driven {bal[1]:+.2%}; "
           f"ratio {np.mean([o['ratio'] for o in outs]):.4f}, efficiency {np.mean([o['efficiency'] for o in outs]):.4f}")
     x = res.y[:, -1]
-    t_rhs = median_s(lambda: m.rhs(0.0, x), 200)
-    t_jac = median_s(lambda: m.jac(0.0, x), 10)
+    t_rhs = median_s(lambda: m.rhs(0.0, x), 1000)
+    t_jac = median_s(lambda: m.jac(0.0, x), 20)
     print(f"one RHS {t_rhs * 1e3:.2f} ms, one Jacobian {t_jac * 1e3:.0f} ms ({t_jac / t_rhs:.0f} RHS)")
 
 
