@@ -237,17 +237,19 @@ class SymmetricChain:
         self._pin_of, self._kind_of, self._ncolour = pin_of, kind_of, k
         self.jac_sparsity = sp.csr_matrix((np.ones(len(rows), bool), (rows, cols)), shape=(self.size, self.size))
 
-    def jacobian(self, q, qd):
+    def jacobian(self, q, qd, part: str = "all", wrt: tuple = (0, 1)):
         """``(dQ/dq, dQ/dq')`` as CSR matrices (complex step over ``5..9`` pin colours: ``2 ndof k``
-        complex force evaluations, exact to round-off)."""
+        complex force evaluations, exact to round-off); ``part="dissipative"``: of ``Q^d`` alone;
+        ``wrt=(0,)`` / ``(1,)``: only ``dQ/dq`` / ``dQ/dq'``."""
         h = 1e-30
+        forces = {"all": self.forces, "dissipative": self.dissipative_forces}[part]
         out = []
-        for wrt in (0, 1):
+        for k in wrt:
             data = np.empty(len(self._rows))
             start = 0
             for key, (c, j) in enumerate(self._seeds):
                 e = ((self._pin_of % self._ncolour == c) & (self._kind_of == j)) * (1j * h)
-                Qi = self.forces(q + e, qd).imag if wrt == 0 else self.forces(q, qd + e).imag
+                Qi = forces(q + e, qd).imag if k == 0 else forces(q, qd + e).imag
                 stop = np.searchsorted(self._key, key, side="right")
                 data[start:stop] = Qi[self._rows[start:stop]] / h
                 start = stop

@@ -1,0 +1,541 @@
+"""The discrete chain on two rigid shafts as a transmission (issue 13): a symmetric chain family (S2, S3)
+in H1 contact with the rigid sheave pairs of two shafts of model 1, closed by the stabilisation loops.
+
+State ``x = [q_chain, phi_1, phi_2, z_1, z_2, velocities, control states, W]``: the chain family's
+coordinates, per shaft (1 driving, 2 driven) the spin angle ``phi_k`` (rad) and the sheave reference
+position ``z_k`` (m) of model 1 (shafts-sheaves-supports §1: ``T = J phi'^2/2 + m z'^2/2``, ``m`` the
+pair mass, ``delta W = -2 P delta z + M delta phi`` (1.229)), the states of the control family
+(:class:`~cvtfem.control.stabilisation.Stabilisation` or ``OpenLoop``) and four work integrals
+``W = [input, output, dissipated, clamping]`` (J) with ``d(T + V)/dt = M1 w1 + M2 w2 - 2 F.z' - D``.
+Frame of the chain models: driven shaft axis at the origin, driving at ``(L, 0)``, chain counter-clockwise.
+
+The contacts (:mod:`cvtfem.elements.chain.sheave_contact`) load both pin ends of every pin near a shaft
+(mirror symmetry, ``2F``); the clamping forces ``F_k`` act per sheave.  The Jacobian is assembled from
+the chain family's complex-step blocks, per-contact central differences of the local contact kernel
+(9 inputs, 6 outputs, all contacts at once) and differences of the cheap loop outputs.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+from functools import cached_property
+from typing import Any
+
+import numpy as np
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+from scipy.optimize import least_squares
+
+from cvtfem.assembly.model import Linearization, ModelBase, StateLayout
+from cvtfem.control.regimes import Regime
+from cvtfem.control.stabilisation import OpenLoop, Stabilisation, StabilisationParams
+from cvtfem.elements.band.geometry import Sheave
+from cvtfem.elements.base import Block
+from cvtfem.elements.chain.placement import place_on_path
+from cvtfem.elements.chain.sheave_contact import N_IN, SheaveContact, hertz_constant
+from cvtfem.elements.chain.symmetric import ChainS2, ChainS3, damping_from_ratio
+from cvtfem.errors import InputError, NumericalError
+from cvtfem.outputs import OutputSpec
+
+FAMILIES = {"chain-S2": ChainS2, "chain-S3": ChainS3}
+
+
+@dataclass(frozen=True, eq=False)
+class ChainCVT(ModelBase):
+    """Chain family + sheave contact + two rigid shafts + regime + control family as ``x' = rhs(t, x)``.
+
+    Attributes
+    ----------
+    family : ChainS2 or ChainS3
+    contact : SheaveContact
+    J, m_sheave : (2,) kg m^2, kg
+        Axial inertia of shaft with sheaves, mass of the sheave pair (driving, driven).
+    regime : Regime
+        Targets ``(w1d, M1, i_d)``.
+    F_appl : (2,) N
+        Prescribed clamping force per sheave (the ratio loop corrects ``F1``).
+    control : Stabilisation or OpenLoop
+    """
+
+    family: Any
+    contact: SheaveContact
+    J: np.ndarray
+    m_sheave: np.ndarray
+    regime: Regime
+    F_appl: np.ndarray
+    control: Any
+
+    # ----- layout ------------------------------------------------------------------------------
+    @cached_property
+    def layout(self) -> StateLayout:
+        return StateLayout(tuple(self.family.blocks) + (Block("shaft.phi", 2, "rad"), Block("shaft.z", 2, "m"))
+                           + tuple(self.control.blocks) + (Block("work", 4, "J", order=1),))
+
+    @cached_property
+    def _idx(self):
+        nc = self.family.size
+        return nc, nc + np.arange(2), nc + 2 + np.arange(2), self.family.dof_index[:, :3]
+
+    def split(self, x):
+        """Views ``q, v, z_control, W`` of a state vector."""
+        n, nz = self.n2, self.control.size
+        return x[:n], x[n:2 * n], x[2 * n:2 * n + nz], x[2 * n + nz:]
+
+    @cached_property
+    def output_specs(self) -> tuple[OutputSpec, ...]:
+        n = self.family.n
+        return tuple(self.family.output_specs) + (
+            OutputSpec("contact.normal_force", "N",
+                       "Hertz force N per pin end and shaft (pin-major, driving then driven).", 2 * n),
+            OutputSpec("contact.penetration", "m",
+                       "Penetration Delta along the axis per pin end and shaft (<= 0: off).", 2 * n),
+            OutputSpec("contact.radius", "m", "Contact radius per pin end and shaft (0 off contact).", 2 * n),
+            OutputSpec("contact.slip_speed", "m/s", "Slip speed of the pin end on the sheave (0 off contact).", 2 * n),
+            OutputSpec("contact.friction_force", "N",
+                       "Friction force on one pin end, x1 x2 x3 per pin and shaft.", 6 * n),
+            OutputSpec("contact.friction_power", "W", "Friction power of both sheaves of each shaft (<= 0).", 2),
+            OutputSpec("contact.sheave_axial_force", "N",
+                       "Sum of the pin axial contact forces on one sheave of each shaft.", 2),
+            OutputSpec("chain.span_tension", "N", "Mean link tension of the tight (x2 < 0) and slack (x2 > 0) span: "
+                       "links with both pins off contact.", 2),
+            OutputSpec("driving.speed", "rad/s", "Angular speed of the driving shaft."),
+            OutputSpec("driven.speed", "rad/s", "Angular speed of the driven shaft."),
+            OutputSpec("driving.torque", "N m", "External torque on the driving shaft."),
+            OutputSpec("driven.torque", "N m", "External torque on the driven shaft."),
+            OutputSpec("driving.clamping_force", "N", "Clamping force per sheave, driving pulley."),
+            OutputSpec("driven.clamping_force", "N", "Clamping force per sheave, driven pulley."),
+            OutputSpec("ratio", "-", "Speed ratio omega1 / omega2."),
+            OutputSpec("efficiency", "-", "Output over input power (instantaneous)."),
+            OutputSpec("power", "W", "Input, output, dissipated and clamping power.", 4),
+            OutputSpec("work", "J", "Input, output, dissipated and clamping work since t = 0.", 4),
+            OutputSpec("energy", "J", "Kinetic plus elastic energy (chain, shafts, Hertz contacts)."),
+        ) + tuple(self.control.output_specs)
+
+    # ----- right-hand side ---------------------------------------------------------------------
+    def _controls(self, t: float, w, z):
+        w1d, M1, i_d = self.regime.targets(t)
+        F, M2, dz, diag = self.control.outputs(w, z, i_d, w1d / i_d, M1, self.F_appl)
+        return np.asarray(F, float), np.array([M1, M2]), dz, diag
+
+    def _contacts(self, q, v, details=False):
+        """Broad phase, local inputs and outputs of the contacts."""
+        nc, iphi, iz, _ = self._idx
+        u, u3, _ = self.family.split(q[:nc])
+        ud, u3d, _ = self.family.split(v[:nc])
+        pins, shafts = self.contact.candidates(u)
+        X = self.contact.gather(pins, shafts, u, u3, ud, u3d, q[iz], v[iz], v[iphi])
+        return pins, shafts, X, self.contact.local(X, shafts, details)
+
+    def _forces(self, q, v, F, M):
+        """Generalized forces on all coordinates (N, N m) and the friction power (W)."""
+        nc, iphi, iz, dof3 = self._idx
+        Q = np.zeros(self.n2)
+        Q[:nc] = self.family.forces(q[:nc], v[:nc])
+        pins, shafts, _, Y = self._contacts(q, v)
+        Qp, Qz, Qphi, Pf = self.contact.scatter(Y, pins, shafts, self.family.n)
+        Q[dof3] += Qp
+        Q[iphi] += Qphi + M
+        Q[iz] += Qz - 2 * F
+        return Q, Pf
+
+    def solve_mass(self, Q):
+        nc, iphi, iz, _ = self._idx
+        a = np.empty_like(Q)
+        a[:nc] = self.family.solve_mass(Q[:nc])
+        a[iphi] = Q[iphi] / self.J
+        a[iz] = Q[iz] / self.m_sheave
+        return a
+
+    def evaluate(self, t: float, x):
+        """``(dx/dt, info)``: right-hand side and the loop's quantities."""
+        q, v, zc, _ = self.split(x)
+        nc, iphi, iz, _ = self._idx
+        w = v[iphi]
+        F, M, dz, diag = self._controls(t, w, zc)
+        Q, Pf = self._forces(q, v, F, M)
+        D = 2 * self.family.rayleigh(q[:nc], v[:nc]) - Pf
+        dW = np.array([M[0] * w[0], -M[1] * w[1], D, -2 * float(F @ v[iz])])
+        diag = dict(diag, F=F, M=M, w=w, friction_power=Pf)
+        return np.concatenate([v, self.solve_mass(Q), dz, dW]), diag
+
+    def rhs(self, t: float, x):
+        return self.evaluate(t, x)[0]
+
+    # ----- Jacobian ----------------------------------------------------------------------------
+    @cached_property
+    def _inv_mass(self) -> sp.csr_matrix:
+        Mc = sp.csc_matrix(self.family.mass_matrix())
+        return sp.block_diag([sp.csr_matrix(spla.inv(Mc)), sp.diags(1 / self.J), sp.diags(1 / self.m_sheave)],
+                             format="csr")
+
+    def _loop_gradient(self, t, w, zc):
+        """``d(F1, F2, M2, dz) / d(w1, w2, z_control)`` by forward differences (cheap, piecewise smooth)."""
+        nz = self.control.size
+        F, M, dz, _ = self._controls(t, w, zc)
+        u0 = np.concatenate([F, M[1:], dz])
+        G = np.zeros((3 + nz, 2 + nz))
+        for j in range(2 + nz):
+            wp, zp = w.copy(), zc.copy()
+            h = 1e-7 * max(1.0, abs(w[j] if j < 2 else zc[j - 2]))
+            if j < 2:
+                wp[j] += h
+            else:
+                zp[j - 2] += h
+            Fp, Mp, dzp, _ = self._controls(t, wp, zp)
+            G[:, j] = (np.concatenate([Fp, Mp[1:], dzp]) - u0) / h
+        return F, M, G
+
+    def _contact_columns(self, pins, shafts):
+        """State columns of the 9 local contact inputs, (m, 9)."""
+        nc, iphi, iz, dof3 = self._idx
+        n2 = self.n2
+        return np.column_stack([dof3[pins], iz[shafts], n2 + dof3[pins], n2 + iz[shafts], n2 + iphi[shafts]])
+
+    def jac(self, t: float, x) -> sp.csr_matrix:
+        """Sparse ``d rhs / dx``."""
+        q, v, zc, _ = self.split(x)
+        nc, iphi, iz, dof3 = self._idx
+        n2, nz, N = self.n2, self.control.size, self.size
+        ctrl = 2 * n2 + np.arange(nz)
+        w = v[iphi]
+        F, M, G = self._loop_gradient(t, w, zc)
+        in_cols = np.concatenate([n2 + iphi, ctrl])          # columns of the loops' inputs
+        Kc, Cc = self.family.jacobian(q[:nc], v[:nc])
+        rows, cols, vals = [], [], []
+
+        def add(r, c, d):
+            rows.append(np.ravel(r))
+            cols.append(np.ravel(c))
+            vals.append(np.ravel(d))
+        for Mx, off in ((Kc.tocoo(), 0), (Cc.tocoo(), n2)):
+            add(Mx.row, Mx.col + off, Mx.data)
+        pins, shafts, X, _ = self._contacts(q, v)
+        Jl = self.contact.local_jacobian(X, shafts)            # (m, 6, 9)
+        cin = self._contact_columns(pins, shafts)
+        out_rows = np.column_stack([dof3[pins], iz[shafts], iphi[shafts]])   # rows of outputs 0..4
+        add(np.repeat(out_rows[:, :, None], N_IN, 2), np.repeat(cin[:, None, :], 5, 1), Jl[:, :5, :])
+        add(np.repeat(iz, len(in_cols)), np.tile(in_cols, 2), -2 * G[:2].ravel())    # -2 F on z
+        add(np.full(len(in_cols), iphi[1]), in_cols, G[2])                              # M2 on phi2
+        dQ = sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))), shape=(n2, N))
+        acc = self._inv_mass @ dQ
+        # work rates: [M1 w1, -M2 w2, 2 Phi - P_fr, -2 F.z']
+        Wr = sp.lil_matrix((4, N))
+        Wr[0, n2 + iphi[0]] = M[0]
+        Wr[1, in_cols] = -w[1] * G[2]
+        Wr[1, n2 + iphi[1]] += -M[1]
+        Qd = self.family.dissipative_forces(q[:nc], v[:nc])
+        Kd = self.family.jacobian(q[:nc], v[:nc], part="dissipative", wrt=(0,))[0]
+        d2phi = np.concatenate([-(Kd.T @ v[:nc]), -2 * Qd])
+        chain_cols = np.concatenate([np.arange(nc), n2 + np.arange(nc)])
+        dPf = np.zeros(N)
+        np.add.at(dPf, cin.ravel(), Jl[:, 5, :].ravel())
+        dD = -dPf
+        dD[chain_cols] += d2phi
+        Wr[2, :] = dD
+        Wr[3, n2 + iz] = -2 * F
+        Wr[3, in_cols] = -2 * (v[iz] @ G[:2])
+        ctrl_rows = sp.csr_matrix((G[3:].ravel(), (np.repeat(np.arange(nz), 2 + nz), np.tile(in_cols, nz))),
+                                  shape=(nz, N))
+        top = sp.csr_matrix((np.ones(n2), (np.arange(n2), n2 + np.arange(n2))), shape=(n2, N))
+        return sp.vstack([top, acc, ctrl_rows, Wr.tocsr()], format="csr")
+
+    @cached_property
+    def jac_sparsity(self) -> sp.csr_matrix:
+        """Structural pattern: chain stencil (pins ``p +- 2``), every pin with every shaft (broad phase
+        may take any pin), the loops, and dense work-rate rows (all but the angles)."""
+        nc, iphi, iz, dof3 = self._idx
+        n2, nz, N, n = self.n2, self.control.size, self.size, self.family.n
+        ctrl = 2 * n2 + np.arange(nz)
+        P = sp.csr_matrix(self.family.jac_sparsity, dtype=float).tocoo()
+        rows = [P.row, P.row]
+        cols = [P.col, P.col + n2]
+        pins = np.repeat(np.arange(n), 2)
+        shafts = np.tile(np.arange(2), n)
+        cin = self._contact_columns(pins, shafts)
+        out_rows = np.column_stack([dof3[pins], iz[shafts], iphi[shafts]])
+        rows.append(np.repeat(out_rows[:, :, None], N_IN, 2).ravel())
+        cols.append(np.repeat(cin[:, None, :], 5, 1).ravel())
+        in_cols = np.concatenate([n2 + iphi, ctrl])
+        rows.append(np.repeat(np.concatenate([iz, iphi]), len(in_cols)))
+        cols.append(np.tile(in_cols, 4))
+        dQ = sp.csr_matrix((np.ones(sum(len(r) for r in rows)), (np.concatenate(rows), np.concatenate(cols))),
+                           shape=(n2, N))
+        acc = (abs(self._inv_mass) @ dQ) != 0
+        top = sp.csr_matrix((np.ones(n2), (np.arange(n2), n2 + np.arange(n2))), shape=(n2, N))
+        ctrl_rows = sp.csr_matrix((np.ones(nz * len(in_cols)), (np.repeat(np.arange(nz), len(in_cols)),
+                                                                  np.tile(in_cols, nz))), shape=(nz, N))
+        dense = np.setdiff1d(np.arange(2 * n2 + nz), iphi)
+        W = sp.csr_matrix((np.ones(4 * len(dense)), (np.repeat(np.arange(4), len(dense)), np.tile(dense, 4))),
+                          shape=(4, N))
+        return sp.vstack([top, acc.astype(float), ctrl_rows, W], format="csr").astype(bool)
+
+    def linearize(self, x0, t: float = 0.0) -> Linearization:
+        """First-order ``A = d rhs / dx`` (the loops and work integrals are first-order)."""
+        return Linearization(A=self.jac(t, x0))
+
+    # ----- energy and outputs ------------------------------------------------------------------
+    def energy(self, x) -> float:
+        """Kinetic plus elastic energy: chain, shafts and sheaves, Hertz potentials of both pin ends, J."""
+        q, v, _, _ = self.split(x)
+        nc, iphi, iz, _ = self._idx
+        _, _, _, (_, info) = self._contacts(q, v, details=True)
+        return float(self.family.energy(q[:nc], v[:nc]) + 0.5 * self.J @ v[iphi] ** 2
+                     + 0.5 * self.m_sheave @ v[iz] ** 2 + info["potential"].sum())
+
+    def power(self, t: float, x) -> np.ndarray:
+        """``[M1 w1, -M2 w2, dissipation, clamping power]``, W."""
+        return self.rhs(t, x)[-4:]
+
+    def outputs(self, t: float, x) -> dict[str, Any]:
+        """Named outputs of :attr:`output_specs` at ``(t, x)``."""
+        dx, diag = self.evaluate(t, x)
+        q, v, _, W = self.split(x)
+        nc = self._idx[0]
+        n = self.family.n
+        pins, shafts, _, (Y, c) = self._contacts(q, v, details=True)
+        on = c["delta"] > 0
+        k = 2 * pins + shafts
+
+        def per(values, width=1):
+            out = np.zeros((2 * n, width))
+            out[k] = np.reshape(values, (len(k), width))
+            return out.ravel()
+        P = dx[-4:]
+        w, M, F = diag["w"], diag["M"], diag["F"]
+        out = dict(self.family.outputs(q[:nc], v[:nc]))
+        out.update({"chain.span_tension": self.span_tensions(q, v, pins, c["delta"]),
+                    "contact.normal_force": per(c["N"]), "contact.penetration": per(c["delta"]),
+                    "contact.radius": per(np.where(on, c["radius"], 0.0)),
+                    "contact.slip_speed": per(np.where(on, np.linalg.norm(c["slip"], axis=1), 0.0)),
+                    "contact.friction_force": per(c["F_fr"], 3),
+                    "contact.friction_power": np.bincount(shafts, Y[:, 5], 2),
+                    "contact.sheave_axial_force": -np.bincount(shafts, c["F"][:, 2], 2),
+                    "driving.speed": w[0], "driven.speed": w[1], "driving.torque": M[0], "driven.torque": M[1],
+                    "driving.clamping_force": F[0], "driven.clamping_force": F[1],
+                    "ratio": w[0] / w[1] if w[1] else math.nan, "efficiency": P[1] / P[0] if P[0] else 0.0,
+                    "power": P, "work": W, "energy": self.energy(x),
+                    "control.ratio_estimate": diag["ratio_estimate"], "control.resistance": diag["resistance"]})
+        return {s.name: out[s.name] for s in self.output_specs}
+
+    def span_tensions(self, q, v, pins, delta):
+        """Mean link tension (N) of the tight and the slack span: links with both pins off contact
+        (``pins``, ``delta`` of the candidate contacts), split by the sign of the link midpoint's ``x2``."""
+        nc = self._idx[0]
+        fam = self.family
+        u = fam.split(q[:nc])[0]
+        touching = np.zeros(fam.n, bool)
+        touching[pins[delta > 0]] = True
+        free = ~touching & ~touching[fam.ip1] & (fam.on > 0)
+        y = 0.5 * (u[:, 1] + u[fam.ip1, 1])
+        T = fam.outputs(q[:nc], v[:nc])[f"{fam.name}.link_tension"]
+        return np.array([T[free & (y < 0)].mean() if (free & (y < 0)).any() else math.nan,
+                         T[free & (y > 0)].mean() if (free & (y > 0)).any() else math.nan])
+
+    # ----- initial state -----------------------------------------------------------------------
+    def static_state(self, ratio: float, w1: float, tension: float | None = None, tol: float = 1e-10):
+        """Pins on the sheaves at ``ratio`` in quasi-static balance, and the running state around it.
+
+        With ``tension`` (N) the driven clamping force is not ``F_appl[1]`` but the one that gives that mean
+        link tension (secant steps on the affine law ``T = m' v^2 + F2 tan(gamma2) / theta2*`` of the wedge,
+        started from it, to 1e-6 relative; ``report["F2"]``).
+
+        The pins are placed on the band path of the ratio with unstretched links
+        (:func:`~cvtfem.elements.chain.placement.place_on_path`); the driving sheave ``z_1`` is held where
+        its face meets the pin ends at ``r1`` with the wedge estimate of their Hertz penetration; the
+        chain coordinates and ``z_2`` are solved (scipy ``least_squares``) for the balance of the chain's
+        elastic forces, the Hertz forces, the clamping force ``F_appl[1]`` on the driven sheave and the
+        centrifugal forces of steady running at the driving speed ``w1`` (rad/s; chain speed ``w1 r1``)
+        on the arcs.  Friction is not loaded (no slip).  The driving clamping force that holds the
+        ratio is the reaction on ``z_1``.
+
+        Returns ``(x0, report)``: the state with the span pins moving along the path at ``w1 r1``, the
+        shafts at ``w1 r1 / r_k``, the pins in contact turning with their sheave (no slip) and the loops
+        at those speeds; ``report`` with ``residual`` (largest generalized force over ``F2``),
+        ``max_penetration`` (m), ``F1``, ``F2`` (N), ``tension`` (mean elastic link tension, N), ``placement``.
+        """
+        if tension is None:
+            return self._static(ratio, w1, float(self.F_appl[1]), tol)
+        if not tension > 0:
+            raise InputError("tension", tension, "must be positive")
+        F2, T_c = None, None
+        for _ in range(8):
+            if F2 is None:                                    # the wedge estimate
+                pl = place_on_path(self.family.geom.L, ratio, self.contact.centres[0, 0])
+                geo = self.family.geom
+                T_c = geo.m_eff.mean() / geo.L.mean() * (w1 * pl.r[0]) ** 2
+                F2 = (tension - T_c) * (np.pi / 2 - pl.phi) / self.contact.faces[1].tan_gamma(pl.r[1])
+            else:                                             # secant through the centrifugal offset
+                F2 *= (tension - T_c) / (rep["tension"] - T_c)
+            if not F2 > 0:
+                raise InputError("tension", tension, f"must exceed the centrifugal tension {T_c:.4g} N")
+            x0, rep = self._static(ratio, w1, float(F2), tol)
+            if abs(rep["tension"] / tension - 1) < 1e-6:
+                return x0, rep
+        raise NumericalError(f"the pretension {tension} N was not reached (last {rep['tension']:.6g} N at F2 = "
+                             f"{F2:.6g} N)", component="ChainCVT.static_state")
+
+    def _static(self, ratio: float, w1: float, F2: float, tol: float):
+        """:meth:`static_state` at the driven clamping force ``F2`` (N)."""
+        fam, nc = self.family, self._idx[0]
+        _, iphi, iz, _ = self._idx
+        pl = place_on_path(fam.geom.L, ratio, self.contact.centres[0, 0])
+        if not (pl.r.max() < self.contact.r_outer and pl.r.min() > fam.geom.L.max()):
+            raise InputError("ratio", ratio, f"must put both arcs between one pitch and the sheaves' outer radius "
+                             f"{self.contact.r_outer:g} m (radii {pl.r[0]:.4g}, {pl.r[1]:.4g} m)")
+        speed = w1 * pl.r[0]
+        n2, l = self.n2, fam.geom.l
+        faces = self.contact.faces
+        # guess: wedge tension T = F2 tan(g2) / theta2*, per-pin axial forces T L / (2 r tan g), Hertz penetration
+        tg = np.array([faces[k].tan_gamma(pl.r[k]) for k in range(2)])
+        theta2 = np.pi / 2 - pl.phi
+        T = F2 * tg[1] / theta2
+        Nk = T * fam.geom.L.mean() / (2 * pl.r * tg)
+        dk = (Nk / self.contact.c) ** (2 / 3)
+        u3 = np.full(fam.n, l / 2)
+        for k in range(2):
+            u3[pl.piece == k] -= Nk[k] / (2 * fam.geom.c_pin[pl.piece == k])
+        q = np.zeros(n2)
+        parts = [pl.u, u3] + ([np.zeros((fam.n, 2))] if fam.ndof == 5 else [])
+        q[:nc] = fam.join(*parts)
+        u3k = l / 2 - Nk / (2 * fam.geom.c_pin.mean())
+        q[iz] = [u3k[k] - faces[k].lever(pl.r[k]) - dk[k] for k in range(2)]
+        vel = np.zeros(n2)
+        a = np.zeros(nc)
+        au = fam.split(a)[0]
+        for k in range(2):
+            sel = pl.piece == k
+            au[sel] = -speed ** 2 / pl.r[k] * (pl.u[sel] - self.contact.centres[k]) / pl.r[k]
+        Q_cf = -(fam.mass_matrix() @ a)                        # d'Alembert forces of steady running
+        free = np.concatenate([np.arange(nc), iz[1:]])
+        F_stat = np.array([0.0, F2])
+
+        def forces(y):
+            qq = q.copy()
+            qq[free] = y
+            Q, _ = self._forces(qq, vel, F_stat, np.zeros(2))
+            Q[:nc] += Q_cf
+            return Q
+
+        def residual(y):
+            return forces(y)[free] / F2
+
+        def jacobian(y):
+            qq = q.copy()
+            qq[free] = y
+            Kc = fam.jacobian(qq[:nc], vel[:nc], wrt=(0,))[0]
+            pins, shafts, X, _ = self._contacts(qq, vel)
+            Jl = self.contact.local_jacobian(X, shafts)
+            _, _, _, dof3 = self._idx
+            cin = np.column_stack([dof3[pins], iz[shafts]])
+            rws = np.column_stack([dof3[pins], iz[shafts], iphi[shafts]])
+            Kc = Kc.tocoo()
+            K = sp.csr_matrix((Kc.data, (Kc.row, Kc.col)), shape=(n2, n2)) + sp.csr_matrix(
+                (Jl[:, :5, :4].ravel(), (np.repeat(rws[:, :, None], 4, 2).ravel(),
+                                         np.repeat(cin[:, None, :], 5, 1).ravel())), shape=(n2, n2))
+            return (K[free][:, free] / F2).toarray()
+        sol = least_squares(residual, q[free], jac=jacobian, method="lm", xtol=tol, ftol=tol, gtol=tol,
+                            x_scale=1e-5, max_nfev=200)
+        q[free] = sol.x
+        Q = forces(sol.x)
+        pins, shafts, _, (_, c) = self._contacts(q, vel, details=True)
+        F1 = float(Q[iz[0]] / 2)                               # reaction that holds z_1 (Q excludes F1)
+        res = float(np.abs(Q[free]).max() / F2)
+        if not res <= 1e-6:
+            raise NumericalError(f"the quasi-static solve at ratio {ratio} ended with a residual of {res:.3g} of the "
+                                 f"clamping force after {sol.nfev} evaluations ({sol.message})",
+                                 component="ChainCVT.static_state")
+        out = fam.outputs(q[:nc], np.zeros(nc))
+        v = np.zeros(n2)
+        vu = fam.split(v[:nc])[0]
+        vu[:] = speed * pl.tangent
+        v[iphi] = speed / pl.r
+        u = fam.split(q[:nc])[0]
+        for k in (0, 1):                                        # pins in contact turn with their sheave
+            on = pins[(shafts == k) & (c["delta"] > 0)]
+            vu[on] = v[iphi[k]] * (u[on] - self.contact.centres[k]) @ np.array([[0.0, 1.0], [-1.0, 0.0]])
+        x0 = np.concatenate([q, v, self.control.initial_state(*v[iphi]), np.zeros(4)])
+        report = {"residual": res, "max_penetration": float(c["delta"].max()), "F1": F1, "F2": F2,
+                  "tension": float(out[f"{fam.name}.link_tension_elastic"].mean()), "placement": pl,
+                  "nfev": sol.nfev, "status": sol.status}
+        return x0, report
+
+    def initial_state(self) -> np.ndarray:
+        """The quasi-static state (:meth:`static_state`) at the regime's ratio and driving speed at ``t = 0``."""
+        w1, _, i = self.regime.targets(0.0)
+        return self.static_state(i, w1)[0]
+
+    def with_clamping(self, F_appl) -> "ChainCVT":
+        """The same model with other prescribed clamping forces (N per sheave)."""
+        return replace(self, F_appl=np.asarray(F_appl, float))
+
+    # ----- construction ------------------------------------------------------------------------
+    @classmethod
+    def from_parameters(cls, geom, *, model: str = "chain-S2", centre_distance: float, face: Sheave,
+                        r_outer: float, J, m_sheave, f0: float, v0: float, law: str = "linear-saturated",
+                        regime: Regime, F_appl, control: StabilisationParams | None = None,
+                        damping_ratio: float = 0.05, b_joint: float = 0.0, face_radius: float = 0.02,
+                        E: float = 2.1e11, poisson: float = 0.3, r_hertz: float | None = None) -> "ChainCVT":
+        """Build the model from plain parameters (SI units).
+
+        ``geom`` a :class:`~cvtfem.elements.chain.geometry.ChainGeometry`; ``model`` ``chain-S2`` or
+        ``chain-S3``; ``face`` the sheave face (its ``w`` is replaced by half the pin length); ``J``,
+        ``m_sheave`` per shaft (driving, driven); ``F_appl`` clamping forces per sheave; ``control``
+        the loop parameters (None: open loop, ``M2 = -b20 w2``).  The Hertz stiffness is held
+        constant (digest §4.3) for a pin end crowned with ``face_radius`` at the contact radius
+        ``r_hertz`` (default: the mean radius of ratio 1, ``(l - 2 L) / (2 pi)``).
+        """
+        if model not in FAMILIES:
+            raise InputError("cvt.model", model, "must be one of " + ", ".join(FAMILIES))
+        family = FAMILIES[model](geom, damping_from_ratio(geom, damping_ratio, b_joint))
+        face = Sheave(face.profile, face.gamma, face.R, face.y, geom.l / 2)
+        r_h = (geom.length - 2 * centre_distance) / (2 * np.pi) if r_hertz is None else r_hertz
+        c = hertz_constant(face, r_h, face_radius, E, poisson)
+        contact = SheaveContact(np.array([[centre_distance, 0.0], [0.0, 0.0]]), (face, face), np.array([c, c]),
+                                r_outer, f0, v0, law)
+        loop = OpenLoop() if control is None else Stabilisation(control)
+        return cls(family, contact, np.asarray(J, float), np.asarray(m_sheave, float), regime,
+                   np.asarray(F_appl, float), loop)
+
+
+def from_scene(scene, geom, F_appl, model: str = "chain-S2", **overrides) -> ChainCVT:
+    """:meth:`ChainCVT.from_parameters` with the values of a CVT scene's existing keys (geometry, shafts,
+    friction, control, regime, ``chain.damping_ratio``) for the chain ``geom`` and clamping forces
+    ``F_appl`` (N per sheave); ``overrides`` replace keyword arguments (e.g. ``law``)."""
+    from cvtfem.elements.band.geometry import phi_for_ratio, radii
+
+    cvt = scene.cvt
+    g, rg, c = cvt.geometry, cvt.regime, cvt.control
+    shafts = (cvt.driving, cvt.driven)
+    r2 = radii(phi_for_ratio(rg.ratio, geom.length, g.centre_distance), geom.length, g.centre_distance)[0][1]
+    J = tuple(s.inertia for s in shafts)
+    loop = StabilisationParams(c.tau_omega, c.eps, c.i_min, c.i_max, c.k_sat, c.c_f0, c.c_f1, c.c_sat, c.tau, c.nu,
+                               J[0] * rg.ratio ** 2 + J[1] + cvt.chain.mass * r2 ** 2)
+    kw = dict(model=model, centre_distance=g.centre_distance,
+              face=Sheave(g.sheave_profile, g.flank_angle, g.torus_radius, g.torus_offset),
+              r_outer=g.sheave_outer_radius, J=J, m_sheave=tuple(s.sheave_mass for s in shafts),
+              f0=cvt.friction.f0, v0=cvt.friction.v0, law=cvt.friction.law,
+              regime=Regime(rg.kind, rg.input_speed, rg.torque, rg.ratio, rg.end_value, rg.ramp_time),
+              F_appl=F_appl, control=loop if cvt.effects.stabilisation else None,
+              damping_ratio=cvt.chain.damping_ratio, E=cvt.young_modulus)
+    kw.update(overrides)
+    return ChainCVT.from_parameters(geom, **kw)
+
+
+def band_span_tensions(band, x) -> np.ndarray:
+    """Tight and slack span tension (N) of a compressible band CVT (6+2n, :class:`~cvtfem.machines.band_cvt.BandCVT`)
+    at state ``x``: the radial balance of a band element ``T = rho v^2 + 2 r N sin(gamma)`` (``N`` per sheave
+    and unit length; no radial slip in steady running) at the arc ends, extrapolated to ``xi = +-1`` by a
+    parabola through the three end Gauss nodes.  The band runs counter-clockwise: the tight span leaves
+    the driven arc at ``xi = +1`` and enters the driving arc at ``xi = -1``."""
+    from cvtfem.elements.band.geometry import radii
+    from cvtfem.elements.band.params import gauss_nodes
+
+    p = band.model.p
+    q, v, _, _ = band.split(x)
+    r = radii(q[0], p.length, p.L)[0]
+    N = np.asarray(band.outputs(0.0, x)["band.normal_force"]).reshape(2, -1)
+    sg = np.array([np.sin(p.sheaves[k].gamma_at(r[k])) for k in range(2)])
+    T = p.rho * v[1] ** 2 + 2 * r[:, None] * N * sg[:, None]
+    xi = gauss_nodes(N.shape[1])[0]
+    end = lambda k, s: np.polyval(np.polyfit(xi[::s][:3], T[k][::s][:3], 2), -s)  # noqa: E731  s=1: xi=-1
+    return np.array([0.5 * (end(0, 1) + end(1, -1)), 0.5 * (end(0, -1) + end(1, 1))])
