@@ -1,5 +1,8 @@
-"""A free discrete chain as a :class:`~cvtfem.assembly.model.Model`: one chain family (S1, S2 or S3 of
-:mod:`cvtfem.elements.chain.symmetric`) without sheaves, in the protocol every analysis uses.
+"""A free discrete chain as a :class:`~cvtfem.assembly.model.Model`: one chain family without sheaves, in
+the protocol every analysis uses.  :class:`FreeChain` carries the symmetric families S1, S2, S3
+(:mod:`cvtfem.elements.chain.symmetric`), :class:`FreeChainA` the whole-pin asymmetric ones: A1
+(:class:`~cvtfem.elements.chain.asymmetric.ChainA1`, plates as an elastic layer) and A3/A4
+(:class:`~cvtfem.elements.chain.per_plate.ChainPerPlate`, per-plate plates).
 
 The first step of the chain into the machine (issue 13): time runs (``integrate.solve(model, ...)``),
 modal analysis of the linearised chain (``linearize``), outputs and energy through the same interface
@@ -15,6 +18,7 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
+from cvtfem.assembly.colouring import color_columns, coloured_difference
 from cvtfem.assembly.model import Linearization, ModelBase, StateLayout
 from cvtfem.outputs import OutputSpec
 
@@ -97,3 +101,66 @@ class FreeChain(ModelBase):
         (``dE/dt = input - dissipated``)."""
         q, v = self._split(x)
         return {"input": 0.0, "dissipated": 2.0 * float(self.family.rayleigh(q, v))}
+
+
+@dataclass(frozen=True, eq=False)
+class FreeChainA(FreeChain):
+    """``M q'' = Q(q, q')`` of an A-family chain (A1, A3, A4: 10 coordinates per pin), state ``x = [q, q']``.
+
+    Parameters
+    ----------
+    family : ChainA1 | ChainPerPlate
+        Offers ``accel`` (per-pin mass solve), ``forces``, ``dissipative_forces``, ``stiffness_matrix``,
+        ``damping_matrix``, ``jac_sparsity``, ``mass_matrix``, ``kinetic_energy``, ``potential_energy``,
+        ``rayleigh``, ``outputs``.
+    q0, v0 : arrays (10 n,)
+        Start coordinates and velocities (layout of ``ChainA1``).
+
+    The Jacobian is the family's exact ``dQ/dq`` of the elastic forces and ``dQ/dq'`` of the dissipative
+    ones, with the plates of A3/A4 differentiated within their current states (their damping forces jump
+    with the state, a difference across a boundary would not be a derivative), plus the small, smooth
+    ``d(Q_d)/dq`` of A1's damping terms at ``q' != 0`` by coloured forward differences over the pattern.
+    """
+
+    def rhs(self, t: float, x: np.ndarray) -> np.ndarray:
+        """``[q', M^-1 Q(q, q')]``."""
+        q, v = self._split(x)
+        return np.concatenate([v, self.family.accel(q, v)])
+
+    @cached_property
+    def _inv_mass(self) -> sp.csr_matrix:
+        M = self.family.mass_matrix.tocsc()
+        return sp.csr_matrix(spla.inv(M))
+
+    @cached_property
+    def _family_colouring(self) -> tuple[sp.coo_matrix, np.ndarray]:
+        pattern = sp.csr_matrix(self.family.jac_sparsity, dtype=bool)
+        return pattern.tocoo(), color_columns(pattern)
+
+    def _blocks(self, q: np.ndarray, v: np.ndarray) -> tuple[sp.csr_matrix, sp.csr_matrix]:
+        """``(dQ/dq, dQ/dq')`` of the family's total forces."""
+        smooth = getattr(self.family, "base", self.family)          # the ChainA1 part (A3/A4: without plates)
+        dq = self.family.stiffness_matrix(q) if smooth is self.family else self.family.stiffness_matrix(q, v)
+        if np.any(v):
+            pattern, colors = self._family_colouring
+            fun = lambda t, qq: smooth.dissipative_forces(qq, v)           # noqa: E731
+            dq = dq + coloured_difference(fun, 0.0, q, fun(0.0, q), pattern, colors)
+        return sp.csr_matrix(dq), self.family.damping_matrix(q)
+
+    def jac(self, t: float, x: np.ndarray) -> sp.csr_matrix:
+        """Sparse ``[[0, I], [M^-1 dQ/dq, M^-1 dQ/dq']]``."""
+        q, v = self._split(x)
+        dq, dv = self._blocks(q, v)
+        eye = sp.identity(self.n2, format="csr")
+        return sp.bmat([[None, eye], [self._inv_mass @ dq, self._inv_mass @ dv]], format="csr")
+
+    def linearize(self, x0: np.ndarray) -> Linearization:
+        """``M du'' + C du' + K du = 0`` about ``x0``: ``K = -dQ/dq``, ``C = -dQ/dq'``, ``G = 0``."""
+        q, v = self._split(x0)
+        dq, dv = self._blocks(q, v)
+        return Linearization(M=self.family.mass_matrix, C=-dv, G=sp.csr_matrix(dq.shape), K=-dq)
+
+    def energy(self, x: np.ndarray) -> float:
+        """Kinetic plus elastic energy of the chain, J."""
+        q, v = self._split(x)
+        return self.family.kinetic_energy(v) + self.family.potential_energy(q)
