@@ -96,9 +96,9 @@ def _cross(a0, a1, a2, b0, b1, b2):
 
 
 @njit(cache=True)
-def _rotate(t0, t1, t2, v0, v1, v2, sign):
-    """``P(theta) v`` (``sign = 1``) or ``P(theta)^T v`` (``sign = -1``), Rodrigues as :func:`.sheave.rotate`."""
-    s1, s2, _ = _coefficients(t0 * t0 + t1 * t1 + t2 * t2)
+def _rotate(t0, t1, t2, s1, s2, v0, v1, v2, sign):
+    """``P(theta) v`` (``sign = 1``) or ``P(theta)^T v`` (``sign = -1``), Rodrigues as :func:`.sheave.rotate`
+    with the first two :func:`_coefficients` ``s1, s2`` of ``theta``."""
     c0, c1, c2 = _cross(t0, t1, t2, v0, v1, v2)
     d0, d1, d2 = _cross(t0, t1, t2, c0, c1, c2)
     return v0 + sign * s1 * c0 + s2 * d0, v1 + sign * s1 * c1 + s2 * d1, v2 + sign * s1 * c2 + s2 * d2
@@ -139,19 +139,19 @@ def _slip_and_friction(i, w0, w1, w2, n0, n1, n2, N, f0, v0, law, eps, slip, fri
 
 
 @njit(cache=True)
-def _sheave_loads(i, t0, t1, t2, a0, a1, a2, force, sheave_force, sheave_tilt, sheave_spin):
-    """Sheave loads of the pin force ``force[i]`` at ``R_c + arm`` (:func:`.sheave.sheave_generalized`)."""
+def _sheave_loads(i, t0, t1, t2, s1, s2, s3, a0, a1, a2, force, sheave_force, sheave_tilt, sheave_spin):
+    """Sheave loads of the pin force ``force[i]`` at ``R_c + arm`` (:func:`.sheave.sheave_generalized`);
+    ``s1, s2, s3`` the :func:`_coefficients` of ``theta``."""
     F0, F1, F2 = force[i, 0], force[i, 1], force[i, 2]
     m0, m1, m2 = _cross(a0, a1, a2, F0, F1, F2)
     m0, m1, m2 = -m0, -m1, -m2
     sheave_force[i, 0], sheave_force[i, 1], sheave_force[i, 2] = -F0, -F1, -F2
-    _, s2, s3 = _coefficients(t0 * t0 + t1 * t1 + t2 * t2)
     c0, c1, c2 = _cross(t0, t1, t2, m0, m1, m2)
     d0, d1, d2 = _cross(t0, t1, t2, c0, c1, c2)
     sheave_tilt[i, 0] = m0 - s2 * c0 + s3 * d0
     sheave_tilt[i, 1] = m1 - s2 * c1 + s3 * d1
     sheave_tilt[i, 2] = m2 - s2 * c2 + s3 * d2
-    k0, k1, k2 = _rotate(t0, t1, t2, 0.0, 0.0, 1.0, 1.0)
+    k0, k1, k2 = _rotate(t0, t1, t2, s1, s2, 0.0, 0.0, 1.0, 1.0)
     sheave_spin[i] = k0 * m0 + k1 * m1 + k2 * m2
 
 
@@ -162,13 +162,14 @@ def h1_kernel(R_pin, v_pin, R_c, v_c, theta, omega, side, c, prof, f0, v0, law, 
     """H1 contacts (pin-axis point, (1.317)-(1.329)), outputs written in place; arguments as :func:`h1_contacts`."""
     for i in range(R_pin.shape[0]):
         t0, t1, t2 = theta[i, 0], theta[i, 1], theta[i, 2]
+        s1, s2, s3 = _coefficients(t0 * t0 + t1 * t1 + t2 * t2)
         a0, a1, a2 = R_pin[i, 0] - R_c[i, 0], R_pin[i, 1] - R_c[i, 1], R_pin[i, 2] - R_c[i, 2]
-        d0, d1, d2 = _rotate(t0, t1, t2, a0, a1, a2, -1.0)
+        d0, d1, d2 = _rotate(t0, t1, t2, s1, s2, a0, a1, a2, -1.0)
         r = np.hypot(d0, d1)
         f, fp, _ = evaluate(prof, r)
         rr = r if r > 0 else 1.0
         s = side[i]
-        g0, g1, g2 = _rotate(t0, t1, t2, fp * d0 / rr, fp * d1 / rr, -s, 1.0)      # dDelta/dR_pin
+        g0, g1, g2 = _rotate(t0, t1, t2, s1, s2, fp * d0 / rr, fp * d1 / rr, -s, 1.0)   # dDelta/dR_pin
         gn = np.sqrt(g0 * g0 + g1 * g1 + g2 * g2)
         dl = f - s * d2
         dd = max(dl, 0.0)
@@ -181,7 +182,7 @@ def h1_kernel(R_pin, v_pin, R_c, v_c, theta, omega, side, c, prof, f0, v0, law, 
         force[i, 1] = -N * g1 + friction[i, 1]
         force[i, 2] = -N * g2 + friction[i, 2]
         normal[i], delta[i], radius[i] = N, dl, r
-        _sheave_loads(i, t0, t1, t2, a0, a1, a2, force, sheave_force, sheave_tilt, sheave_spin)
+        _sheave_loads(i, t0, t1, t2, s1, s2, s3, a0, a1, a2, force, sheave_force, sheave_tilt, sheave_spin)
 
 
 def h1_reference(R_pin, v_pin, R_c, v_c, theta, omega, side, c, meridian, f0, v0, law="smooth", eps=0.1) -> ContactLoads:
@@ -275,9 +276,10 @@ def h2_kernel(R_pin, v_pin, omega_pin, slope, tau, beta0, beta, Bcal, H, R_c, v_
         pin_moment[i, 0], pin_moment[i, 1], pin_moment[i, 2] = m1, -m0, 0.0
         l0, l1, l2 = _cross(slope[i, 0], slope[i, 1], 1.0, rho0, rho1, rho2)
         pin_spin[i] = F0 * (l0 - H[i] * p1) + F1 * (l1 + H[i] * p0) + F2 * l2
-        d0, d1, _ = _rotate(t0, t1, t2, ar0, ar1, ar2, -1.0)
+        s1, s2, s3 = _coefficients(t0 * t0 + t1 * t1 + t2 * t2)
+        d0, d1, _ = _rotate(t0, t1, t2, s1, s2, ar0, ar1, ar2, -1.0)
         radius[i] = np.hypot(d0, d1)
-        _sheave_loads(i, t0, t1, t2, ar0, ar1, ar2, force, sheave_force, sheave_tilt, sheave_spin)
+        _sheave_loads(i, t0, t1, t2, s1, s2, s3, ar0, ar1, ar2, force, sheave_force, sheave_tilt, sheave_spin)
     return bad
 
 
