@@ -8,6 +8,7 @@ from cvtfem.assembly.model import Model
 from cvtfem.elements.chain.asymmetric import ChainA1
 from cvtfem.elements.chain.geometry import REFERENCE_SECTION, chain_geometry, ring_positions
 from cvtfem.elements.chain.per_plate import ChainPerPlate
+from cvtfem.errors import InputError
 from cvtfem.elements.chain.symmetric import ChainDamping, ChainS1, ChainS2, ChainS3
 from cvtfem.integrate import solve
 from cvtfem.machines.chain import FreeChain, FreeChainA
@@ -106,7 +107,7 @@ def _a_family(kind, n, closed, xi, damping=None, **over):
     args.update(over)
     if kind == "A1":
         return ChainA1(**args)
-    return ChainPerPlate(model=kind, plate_thickness=1.5e-3, **args)
+    return ChainPerPlate(**{"model": kind, "plate_thickness": 1.5e-3, **args})
 
 
 def _spinning_ring(kind, n=8, damping=None, stretch=1e-3, spread=0.05, tilt=0.0):
@@ -239,3 +240,12 @@ def test_per_plate_family_forces_are_gradients_and_backends_agree(kind):
     Qd = fam.dissipative_forces(q, v)
     gd = np.array([(fam.rayleigh(q, v + 1e-6 * e) - fam.rayleigh(q, v - 1e-6 * e)) / 2e-6 for e in eye])
     assert np.abs(Qd + gd).max() <= 1e-6 * np.abs(Qd).max()
+
+
+def test_per_plate_family_refuses_bad_input():
+    with pytest.raises(InputError, match="model"):
+        _a_family("A5", 6, True, np.array([0.0]))
+    with pytest.raises(InputError, match="plate_thickness"):
+        _a_family("A4", 6, True, np.array([0.0]), plate_thickness=0.0)
+    with pytest.raises(InputError, match="plate_bending_stiffness"):
+        _a_family("A3", 6, True, np.array([0.0]), plate_bending_stiffness=0.0)

@@ -8,7 +8,7 @@ from cvtfem.elements.contact.friction import LAWS
 from cvtfem.elements.contact.hertz import hertz_potential
 from cvtfem.elements.contact.kernels import h1_contacts, h1_reference, h2_contacts, h2_reference
 from cvtfem.elements.contact.meridian import Meridian
-from cvtfem.errors import NumericalError
+from cvtfem.errors import InputError, NumericalError
 
 from .conftest import RT, TAN_GAMMA, Y, cone, torus
 
@@ -178,3 +178,14 @@ def test_h2_kernel_forces_are_minus_the_hertz_potential_gradient(name):
         g = _potential_gradient(lambda x: pi(**{body: x}), s[body], 1e-9)
         assert np.abs(F[:, 2] + g[:, 2]).max() <= 1e-6 * scale
         assert np.all(np.linalg.norm(F[:, :2] + g[:, :2], axis=1) <= bound + 1e-6 * scale)
+
+
+def test_bad_meridians_and_laws_are_input_errors():
+    with pytest.raises(InputError, match="kind"):
+        Meridian("sphere")
+    with pytest.raises(InputError, match="R"):
+        Meridian("torus", R=0.0)
+    s = _h1_set(MERIDIANS["cone"], m=8)
+    with pytest.raises(InputError, match="law"):
+        h1_contacts(s["R_pin"], s["v_pin"], s["R_c"], s["v_c"], s["theta"], s["omega"], s["side"], C,
+                    MERIDIANS["cone"], F0, V0, "coulomb")
