@@ -249,3 +249,16 @@ def test_per_plate_family_refuses_bad_input():
         _a_family("A4", 6, True, np.array([0.0]), plate_thickness=0.0)
     with pytest.raises(InputError, match="plate_bending_stiffness"):
         _a_family("A3", 6, True, np.array([0.0]), plate_bending_stiffness=0.0)
+
+
+@pytest.mark.parametrize("kind", A_KINDS)
+def test_a_family_outputs_match_their_specs(kind):
+    """Every declared output comes back with its declared size; A3/A4 link tension = sum of plate tensions,
+    which on the spinning ring is the centripetal 2 T sin(pi/n) = m v^2 / R to the ring's 1e-3 stretch."""
+    fam, model = _spinning_ring(kind, spread=0.0)
+    out = model.outputs(0.0, model.initial_state())
+    assert sorted(out) == sorted(s.name for s in model.output_specs)
+    for spec in model.output_specs:
+        assert np.size(out[spec.name]) == spec.size, spec.name
+    T = 4 * A_STIFF["plate_stiffness"] * 1e-3 * PITCH
+    assert np.allclose(out["chain.link_tension"], T, rtol=2e-3)
