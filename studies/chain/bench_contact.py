@@ -20,6 +20,7 @@ from cvtfem.elements.chain.asymmetric import ChainA1
 from cvtfem.elements.chain.per_plate import ChainPerPlate
 from cvtfem.elements.contact.kernels import LAW_CODES, h1_contacts, h1_kernel, h2_contacts, h2_kernel
 from cvtfem.elements.contact.meridian import Meridian
+from cvtfem.machines.chain import FreeChainA
 
 OUT = Path("out/studies/chain")
 N_PINS, N_PLATES, PITCH, PIN_L = 84, 12, 0.009, 0.033
@@ -135,6 +136,12 @@ def main() -> None:
     lines.append(f"  A4 + contacts estimate (A1 accel + A4 plates - A1 forces + contacts): "
                  f"{t['A1 accel (forces + per-pin mass solve)'] + t['A4 chain forces (numba, 1008 plates)'] - t['A1 chain forces (numba, with damping)'] + glue:8.1f} us")
     lines.append("  target of issue 13 for A5 with refined contact: < 300 us per RHS (source C++: ~760 us)")
+    lines.append("Model protocol (FreeChainA, no contacts), median of 20 jac calls at a moving damped state:")
+    for name, fam in (("A1", a1), ("A4", a4)):
+        model = FreeChainA(fam, q, v)
+        x = model.initial_state()
+        t_rhs, t_jac = median_us(lambda: model.rhs(0.0, x)), median_us(lambda: model.jac(0.0, x), 20)
+        lines.append(f"  {name}: rhs {t_rhs:8.1f} us, jac {t_jac / 1e3:7.2f} ms = {t_jac / t_rhs:5.0f} RHS-equivalents")
     lines.append(f"machine after: {machine()}")
     print("\n".join(lines))
     OUT.mkdir(parents=True, exist_ok=True)

@@ -163,25 +163,32 @@ class ChainPerPlate:
         return self.base.momentum(q, v)
 
     # ------------------------------------------------------------------ Jacobian blocks
-    def _plate_blocks(self, q: np.ndarray, v: np.ndarray | None = None) -> tuple[sp.csr_matrix, sp.csr_matrix]:
+    def _plate_blocks(self, q: np.ndarray, v: np.ndarray | None) -> tuple[sp.csr_matrix, sp.csr_matrix]:
         """``dQ/dq`` and ``dQ/dv`` of the plate forces at ``(q, v)`` (elastic only for ``v = None``), within the
-        current states."""
+        current states; summed per link before assembly."""
         local = self._local(q)
         st, _, J = self._plates_numpy(q)
         H = P.strain_hessians(*local, self.xi, self.l, self.pitch)
         vl = np.zeros((self.n_plates, 20)) if v is None else v[self.plate_dofs]
-        dq, dv = P.force_jacobians(st, J, H, vl, self.c, self.c1, self.c2, self.beta_ext, self.beta_shear)
-        rows = np.repeat(self.plate_dofs[:, :, None], 20, 2).ravel()
-        cols = np.repeat(self.plate_dofs[:, None, :], 20, 1).ravel()
+        blocks = P.force_jacobians(st, J, H, vl, self.c, self.c1, self.c2, self.beta_ext, self.beta_shear)
+        first = np.unique(self.plate_link, return_index=True)[1]          # plates are sorted by link
+        dofs = self.plate_dofs[first]
+        rows = np.repeat(dofs[:, :, None], 20, 2).ravel()
+        cols = np.repeat(dofs[:, None, :], 20, 1).ravel()
         shape = (self.n2, self.n2)
-        return (sp.csr_matrix((dq.ravel(), (rows, cols)), shape=shape),
-                sp.csr_matrix((dv.ravel(), (rows, cols)), shape=shape))
+        return tuple(sp.csr_matrix((np.add.reduceat(b, first, axis=0).ravel(), (rows, cols)), shape=shape)
+                     for b in blocks)
 
-    def stiffness_matrix(self, q: np.ndarray, v: np.ndarray | None = None) -> sp.csr_matrix:
-        """``dQ/dq`` of the elastic forces (the base's exact blocks plus the plates', which jump with a plate
-        state); with ``v`` also of the plates' damping forces (the base's are not included)."""
-        return (self.base.stiffness_matrix(q) + self._plate_blocks(q, v)[0]).tocsr()
+    def jacobians(self, q: np.ndarray, v: np.ndarray | None = None) -> tuple[sp.csr_matrix, sp.csr_matrix]:
+        """``(dQ/dq, dQ/dv)``: the base's exact elastic and damping blocks plus the plates' (which jump with a
+        plate state); ``dQ/dq`` includes the plates' damping forces at ``v`` but not the base's."""
+        dq, dv = self._plate_blocks(q, v)
+        return (self.base.stiffness_matrix(q) + dq).tocsr(), (self.base.damping_matrix(q) + dv).tocsr()
+
+    def stiffness_matrix(self, q: np.ndarray) -> sp.csr_matrix:
+        """``dQ/dq`` of the elastic forces (within the current plate states)."""
+        return self.jacobians(q)[0]
 
     def damping_matrix(self, q: np.ndarray) -> sp.csr_matrix:
         """``dQ/dv`` of the dissipative forces (linear in ``v``)."""
-        return (self.base.damping_matrix(q) + self._plate_blocks(q)[1]).tocsr()
+        return self.jacobians(q)[1]
