@@ -17,6 +17,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from cvtfem.elements.chain import plates as P
+from cvtfem.elements.chain import per_plate_kernel as PJK
 from cvtfem.elements.chain import plates_kernel as PK
 from cvtfem.elements.chain.asymmetric import ChainA1
 from cvtfem.errors import InputError
@@ -165,19 +166,26 @@ class ChainPerPlate:
     # ------------------------------------------------------------------ Jacobian blocks
     def _plate_blocks(self, q: np.ndarray, v: np.ndarray | None) -> tuple[sp.csr_matrix, sp.csr_matrix]:
         """``dQ/dq`` and ``dQ/dv`` of the plate forces at ``(q, v)`` (elastic only for ``v = None``), within the
-        current states; summed per link before assembly."""
-        local = self._local(q)
-        st, _, J = self._plates_numpy(q)
-        H = P.strain_hessians(*local, self.xi, self.l, self.pitch)
-        vl = np.zeros((self.n_plates, 20)) if v is None else v[self.plate_dofs]
-        blocks = P.force_jacobians(st, J, H, vl, self.c, self.c1, self.c2, self.beta_ext, self.beta_shear)
+        current states, summed per link: compiled (:mod:`.per_plate_kernel`) or numpy (``force_jacobians``)."""
         first = np.unique(self.plate_link, return_index=True)[1]          # plates are sorted by link
+        vl = np.zeros((self.n_plates, 20)) if v is None else v[self.plate_dofs]
+        if self.backend == "numba":
+            n_links = self.base.n_links
+            blocks = (np.zeros((n_links, 20, 20)), np.zeros((n_links, 20, 20)))
+            PJK.plate_jacobians_kernel(np.ascontiguousarray(q[self.plate_dofs]), np.ascontiguousarray(vl),
+                                       self.plate_link, self.xi, self._l, self.pitch, self.c, self.c1, self.c2,
+                                       self.h, self.beta_ext, self.beta_shear, self._code, *blocks)
+            blocks = tuple(b[self.plate_link[first]] for b in blocks)
+        else:
+            st, _, J = self._plates_numpy(q)
+            H = P.strain_hessians(*self._local(q), self.xi, self.l, self.pitch)
+            blocks = P.force_jacobians(st, J, H, vl, self.c, self.c1, self.c2, self.beta_ext, self.beta_shear)
+            blocks = tuple(np.add.reduceat(b, first, axis=0) for b in blocks)
         dofs = self.plate_dofs[first]
         rows = np.repeat(dofs[:, :, None], 20, 2).ravel()
         cols = np.repeat(dofs[:, None, :], 20, 1).ravel()
         shape = (self.n2, self.n2)
-        return tuple(sp.csr_matrix((np.add.reduceat(b, first, axis=0).ravel(), (rows, cols)), shape=shape)
-                     for b in blocks)
+        return tuple(sp.csr_matrix((b.ravel(), (rows, cols)), shape=shape) for b in blocks)
 
     def jacobians(self, q: np.ndarray, v: np.ndarray | None = None) -> tuple[sp.csr_matrix, sp.csr_matrix]:
         """``(dQ/dq, dQ/dv)``: the base's exact elastic and damping blocks plus the plates' (which jump with a
