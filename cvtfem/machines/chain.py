@@ -127,7 +127,7 @@ class FreeChainA(FreeChain):
     family : ChainA1 | ChainPerPlate
         Offers ``accel`` (per-pin mass solve), ``forces``, ``dissipative_forces``, ``stiffness_matrix``,
         ``damping_matrix``, ``jac_sparsity``, ``mass_matrix``, ``kinetic_energy``, ``potential_energy``,
-        ``rayleigh``, ``outputs``.
+        ``rayleigh``, ``outputs``; ``ChainPerPlate`` also its ``base`` (the ChainA1 part) and ``jacobians(q, v)``.
     q0, v0 : arrays (10 n,)
         Start coordinates and velocities (layout of ``ChainA1``).
 

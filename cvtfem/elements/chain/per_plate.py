@@ -7,9 +7,9 @@ bending stiffness in the base) and replaced by the forces of every plate of :mod
 (section 4: "only Pi^link,ext, Pi^link,shear, Phi^link,ext, Phi^link,shear are replaced").  A4 bounds
 the plate end moments by ``T h/2`` (ten contact states), A3 clamps the plates to the pins.
 
-Plate forces come from the compiled :func:`.plates_kernel.plate_forces_kernel` or from the numpy
-functions of :mod:`.plates` (its reference twin, ``use_numba=False``).  The Jacobian blocks are the
-plates' ``force_jacobians`` within the current plate states plus the base's exact ones.
+Plate forces come from the compiled :func:`.plates_kernel.plate_forces_kernel`, plate Jacobians (within
+the current plate states) from :func:`.per_plate_kernel.plate_jacobians_kernel`, or both from the numpy
+functions of :mod:`.plates` (their reference twin, ``use_numba=False``); the base adds its exact blocks.
 """
 from __future__ import annotations
 
