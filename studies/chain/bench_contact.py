@@ -16,6 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
+from cvtfem.elements.chain.a_loads_kernel import axis_points_kernel, point_loads_kernel
 from cvtfem.elements.chain.asymmetric import ChainA1
 from cvtfem.elements.chain.per_plate import ChainPerPlate
 from cvtfem.elements.contact.kernels import LAW_CODES, h1_contacts, h1_kernel, h2_contacts, h2_kernel
@@ -119,22 +120,29 @@ def main() -> None:
     xi = np.tile(np.r_[-np.ones(N_PINS), np.ones(N_PINS)], 2)
     force = np.asarray(h2_contacts(*h2, C, MERIDIAN, F0, V0).force)
     moment = rng.normal(size=(m, 2))
+    pts, Q = np.empty((m, 3)), np.zeros(a1.n2)
     parts = {
         "A1 chain forces (numba, with damping)": lambda: a1.forces(q, v),
         "A4 chain forces (numba, 1008 plates)": lambda: a4.forces(q, v),
-        "gather contact points (axis_points)": lambda: a1.axis_points(q, pins, xi),
+        "gather contact points (numpy axis_points)": lambda: a1.axis_points(q, pins, xi),
+        "gather contact points (numba kernel)": lambda: axis_points_kernel(q, N_PINS, PIN_L, pins, xi, pts),
         "H2 contact kernel (336, preallocated)": lambda: h2_kernel(*h2, c, MERIDIAN.params, F0, V0, law, 0.2, *out2),
-        "scatter loads (point_loads, np.add.at)": lambda: a1.point_loads(pins, xi, force, moment),
+        "scatter loads (numpy point_loads, np.add.at)": lambda: a1.point_loads(pins, xi, force, moment),
+        "scatter loads (numba kernel)": lambda: point_loads_kernel(N_PINS, PIN_L, pins, xi, force, moment, Q),
         "A1 accel (forces + per-pin mass solve)": lambda: a1.accel(q, v),
     }
-    lines.append("RHS of an 84-pin chain with 336 H2 contacts, by part (numba kernels, numpy glue):")
+    lines.append("RHS of an 84-pin chain with 336 H2 contacts, by part:")
     for name, fun in parts.items():
         t[name] = median_us(fun)
-        lines.append(f"  {name:<42} {t[name]:8.1f} us")
-    glue = t["gather contact points (axis_points)"] + t["H2 contact kernel (336, preallocated)"] + t["scatter loads (point_loads, np.add.at)"]
-    lines.append(f"  A1 + contacts estimate (accel + gather + kernel + scatter): {t['A1 accel (forces + per-pin mass solve)'] + glue:8.1f} us")
-    lines.append(f"  A4 + contacts estimate (A1 accel + A4 plates - A1 forces + contacts): "
-                 f"{t['A1 accel (forces + per-pin mass solve)'] + t['A4 chain forces (numba, 1008 plates)'] - t['A1 chain forces (numba, with damping)'] + glue:8.1f} us")
+        lines.append(f"  {name:<46} {t[name]:8.1f} us")
+    for glue_kind in ("numpy", "numba kernel"):
+        glue = (t[f"gather contact points ({'numpy axis_points' if glue_kind == 'numpy' else glue_kind})"]
+                + t["H2 contact kernel (336, preallocated)"]
+                + t[f"scatter loads ({'numpy point_loads, np.add.at' if glue_kind == 'numpy' else glue_kind})"])
+        a1_rhs = t["A1 accel (forces + per-pin mass solve)"] + glue
+        a4_rhs = a1_rhs + t["A4 chain forces (numba, 1008 plates)"] - t["A1 chain forces (numba, with damping)"]
+        lines.append(f"  estimate with {glue_kind} gather/scatter: A1 + contacts {a1_rhs:7.1f} us, "
+                     f"A4 + contacts {a4_rhs:7.1f} us")
     lines.append("  target of issue 13 for A5 with refined contact: < 300 us per RHS (source C++: ~760 us)")
     lines.append("Model protocol (FreeChainA, no contacts), median of 20 jac calls at a moving damped state:")
     for name, fam in (("A1", a1), ("A4", a4)):
