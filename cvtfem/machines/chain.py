@@ -1,5 +1,8 @@
-"""A free discrete chain as a :class:`~cvtfem.assembly.model.Model`: one chain family (S1, S2 or S3 of
-:mod:`cvtfem.elements.chain.symmetric`) without sheaves, in the protocol every analysis uses.
+"""A free discrete chain as a :class:`~cvtfem.assembly.model.Model`: one chain family without sheaves, in
+the protocol every analysis uses.  :class:`FreeChain` carries the symmetric families S1, S2, S3
+(:mod:`cvtfem.elements.chain.symmetric`), :class:`FreeChainA` the whole-pin asymmetric ones: A1
+(:class:`~cvtfem.elements.chain.asymmetric.ChainA1`, plates as an elastic layer) and A3/A4
+(:class:`~cvtfem.elements.chain.per_plate.ChainPerPlate`, per-plate plates).
 
 The first step of the chain into the machine (issue 13): time runs (``integrate.solve(model, ...)``),
 modal analysis of the linearised chain (``linearize``), outputs and energy through the same interface
@@ -15,8 +18,26 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
+from cvtfem.assembly.colouring import color_columns
 from cvtfem.assembly.model import Linearization, ModelBase, StateLayout
 from cvtfem.outputs import OutputSpec
+
+
+def _first_order(dq: sp.csr_matrix, dv: sp.csr_matrix) -> sp.csr_matrix:
+    """CSR ``[[0, I], [dq, dv]]`` of ``x = [q, q']`` from the accelerations' blocks (n x n each), built directly
+    (``sp.bmat`` passes through COO and costs as much as the blocks themselves here)."""
+    dq, dv = sp.csr_matrix(dq), sp.csr_matrix(dv)
+    n = dq.shape[0]
+    a, b = np.diff(dq.indptr), np.diff(dv.indptr)
+    indptr = np.concatenate([np.arange(n + 1), n + np.cumsum(a + b)])
+    start = indptr[n:-1]
+    pos_q = np.repeat(start - dq.indptr[:-1], a) + np.arange(dq.nnz)
+    pos_v = np.repeat(start + a - dv.indptr[:-1], b) + np.arange(dv.nnz)
+    indices, data = np.empty(indptr[-1], np.int64), np.empty(indptr[-1])
+    indices[:n], data[:n] = n + np.arange(n), 1.0
+    indices[pos_q], data[pos_q] = dq.indices, dq.data
+    indices[pos_v], data[pos_v] = n + dv.indices, dv.data
+    return sp.csr_matrix((data, indices, indptr), shape=(2 * n, 2 * n))
 
 
 @dataclass(frozen=True, eq=False)
@@ -67,9 +88,7 @@ class FreeChain(ModelBase):
         """Sparse ``[[0, I], [M^-1 dQ/dq, M^-1 dQ/dq']]`` from the family's Jacobian blocks."""
         q, v = self._split(x)
         dq, dv = self.family.jacobian(q, v)
-        n = self.n2
-        eye = sp.identity(n, format="csr")
-        return sp.bmat([[None, eye], [self._inv_mass @ dq, self._inv_mass @ dv]], format="csr")
+        return _first_order(self._inv_mass @ dq, self._inv_mass @ dv)
 
     @cached_property
     def jac_sparsity(self) -> sp.csr_matrix:
@@ -97,3 +116,90 @@ class FreeChain(ModelBase):
         (``dE/dt = input - dissipated``)."""
         q, v = self._split(x)
         return {"input": 0.0, "dissipated": 2.0 * float(self.family.rayleigh(q, v))}
+
+
+@dataclass(frozen=True, eq=False)
+class FreeChainA(FreeChain):
+    """``M q'' = Q(q, q')`` of an A-family chain (A1, A3, A4: 10 coordinates per pin), state ``x = [q, q']``.
+
+    Parameters
+    ----------
+    family : ChainA1 | ChainPerPlate
+        Offers ``accel`` (per-pin mass solve), ``forces``, ``dissipative_forces``, ``stiffness_matrix``,
+        ``damping_matrix``, ``jac_sparsity``, ``mass_matrix``, ``kinetic_energy``, ``potential_energy``,
+        ``rayleigh``, ``outputs``; ``ChainPerPlate`` also its ``base`` (the ChainA1 part) and ``jacobians(q, v)``.
+    q0, v0 : arrays (10 n,)
+        Start coordinates and velocities (layout of ``ChainA1``).
+
+    The Jacobian is the family's exact ``dQ/dq`` of the elastic forces and ``dQ/dq'`` of the dissipative
+    ones, with the plates of A3/A4 differentiated within their current states (their damping forces jump
+    with the state, a difference across a boundary would not be a derivative), plus the small, smooth
+    ``d(Q_d)/dq`` of A1's damping terms at ``q' != 0`` by coloured forward differences over the pattern.
+    """
+
+    def rhs(self, t: float, x: np.ndarray) -> np.ndarray:
+        """``[q', M^-1 Q(q, q')]``."""
+        q, v = self._split(x)
+        return np.concatenate([v, self.family.accel(q, v)])
+
+    @cached_property
+    def _inv_mass(self) -> sp.csr_matrix:
+        M = self.family.mass_matrix.tocsc()
+        return sp.csr_matrix(spla.inv(M))
+
+    @cached_property
+    def _difference_plan(self) -> tuple[sp.csr_matrix, list]:
+        """Pattern (CSR) of the family and, per colour of :func:`color_columns`, its columns and the
+        ``(positions in the CSR data, rows, columns)`` of its entries: one forward difference per colour
+        without re-deriving these masks each call (``coloured_difference`` does, which is most of its cost)."""
+        pattern = sp.csr_matrix(self.family.jac_sparsity, dtype=bool)
+        pattern.sort_indices()
+        colors = color_columns(pattern)
+        rows = np.repeat(np.arange(pattern.shape[0]), np.diff(pattern.indptr))
+        plan = []
+        for c in range(int(colors.max()) + 1):
+            pos = np.flatnonzero(colors[pattern.indices] == c)
+            plan.append((np.flatnonzero(colors == c), pos, rows[pos], pattern.indices[pos]))
+        return pattern, plan
+
+    def _dissipative_dq(self, smooth, q: np.ndarray, v: np.ndarray) -> sp.csr_matrix:
+        """``d(Q_d)/dq`` of ``smooth.dissipative_forces(q, v)`` by coloured forward differences (steps
+        ``sqrt(eps) max(|q|, 1)``, as ``coloured_difference``)."""
+        pattern, plan = self._difference_plan
+        delta = np.sqrt(np.finfo(float).eps) * np.maximum(np.abs(q), 1.0)
+        delta = (q + delta) - q
+        f0 = smooth.dissipative_forces(q, v)
+        data = np.empty(pattern.nnz)
+        for cols, pos, r, c in plan:
+            qp = q.copy()
+            qp[cols] += delta[cols]
+            data[pos] = (smooth.dissipative_forces(qp, v) - f0)[r] / delta[c]
+        return sp.csr_matrix((data, pattern.indices, pattern.indptr), shape=pattern.shape)
+
+    def _blocks(self, q: np.ndarray, v: np.ndarray) -> tuple[sp.csr_matrix, sp.csr_matrix]:
+        """``(dQ/dq, dQ/dq')`` of the family's total forces."""
+        smooth = getattr(self.family, "base", None)                  # A3/A4: the ChainA1 part, without plates
+        if smooth is None:
+            smooth, dq, dv = self.family, self.family.stiffness_matrix(q), self.family.damping_matrix(q)
+        else:
+            dq, dv = self.family.jacobians(q, v)
+        if np.any(v):
+            dq = dq + self._dissipative_dq(smooth, q, v)
+        return sp.csr_matrix(dq), dv
+
+    def jac(self, t: float, x: np.ndarray) -> sp.csr_matrix:
+        """Sparse ``[[0, I], [M^-1 dQ/dq, M^-1 dQ/dq']]``."""
+        q, v = self._split(x)
+        dq, dv = self._blocks(q, v)
+        return _first_order(self._inv_mass @ dq, self._inv_mass @ dv)
+
+    def linearize(self, x0: np.ndarray) -> Linearization:
+        """``M du'' + C du' + K du = 0`` about ``x0``: ``K = -dQ/dq``, ``C = -dQ/dq'``, ``G = 0``."""
+        q, v = self._split(x0)
+        dq, dv = self._blocks(q, v)
+        return Linearization(M=self.family.mass_matrix, C=-dv, G=sp.csr_matrix(dq.shape), K=-dq)
+
+    def energy(self, x: np.ndarray) -> float:
+        """Kinetic plus elastic energy of the chain, J."""
+        q, v = self._split(x)
+        return self.family.kinetic_energy(v) + self.family.potential_energy(q)
