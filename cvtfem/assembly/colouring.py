@@ -21,7 +21,7 @@ def color_columns(pattern: sp.spmatrix, order: str = "largest_first") -> np.ndar
     Returns ``colors`` (n,) with ``colors[j]`` the group of column ``j``; columns in one group
     have disjoint row supports. ``order``: ``"largest_first"`` (by degree) or ``"natural"``.
     """
-    S = sp.csc_matrix(pattern, dtype=bool).astype(np.int8)
+    S = sp.csc_matrix(pattern, dtype=bool).astype(np.int32)  # int8 counts wrap: 256 shared rows look like none
     G = (S.T @ S).tocsr()
     n = G.shape[0]
     degree = np.diff(G.indptr)
