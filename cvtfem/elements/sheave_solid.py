@@ -1,0 +1,368 @@
+"""Solid sheave discs with scikit-fem: the axisymmetric-harmonic model and its 3D reference (issue 20).
+
+A sheave is a body of revolution about the shaft axis ``z``; its section in the ``(r, z)`` half-plane
+(:class:`SheaveSection`) is a hub at the bore, a web whose thickness falls linearly towards the rim (the
+conical contact face at the flank angle) and a flat back face at ``z = 0``.
+
+*Axisymmetric-harmonic model* (:class:`HarmonicSheave`).  For the nodal-diameter number ``n`` the
+displacement is ``u_r = U_r(r, z) cos n theta``, ``u_theta = U_theta(r, z) sin n theta``,
+``u_z = U_z(r, z) cos n theta`` (family ``"cos"``), or the same with sine and cosine swapped
+(``"sin"``: for ``n >= 1`` the twin of each mode; for ``n = 0`` the torsional modes).  Strain energy and
+kinetic energy integrated over ``theta`` in closed form leave a 2D problem on the section, solved with
+quadratic triangles; the amplitudes are 3-vectors ``(U_r, U_theta, U_z)`` (m).  The integrals over
+``theta`` give ``pi`` per squared cosine or sine (``2 pi`` and ``0`` at ``n = 0``), so the matrices are those
+of the whole disc.
+
+*3D model* (:class:`SolidSheave`): quadratic tetrahedra of the same body (a structured ``(r, theta, z)``
+grid, each cell split into six tetrahedra), the reference the harmonic model is checked against.
+
+Units SI: m, Pa, kg/m^3; frequencies in Hz.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import cached_property
+
+import numpy as np
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+from cvtfem.errors import InputError, NumericalError
+
+
+@dataclass(frozen=True)
+class SheaveSection:
+    """The section of a sheave disc in the ``(r, z)`` half-plane, back face at ``z = 0`` (SI units).
+
+    Attributes
+    ----------
+    bore_radius, hub_radius, outer_radius : m
+        Radius of the bore (the shaft seat), of the hub's outer surface and of the rim.
+    hub_length : m
+        Axial length of the hub (its thickness at ``r <= hub_radius``).
+    rim_thickness : m
+        Thickness at the rim; the contact face rises towards the hub at the flank angle.
+    flank_angle : rad
+        Angle of the conical contact face to the radial plane (0: a flat annular plate).
+    E, nu, rho : Pa, -, kg/m^3
+        Young's modulus, Poisson's ratio and density (steel by default).
+    """
+
+    bore_radius: float
+    hub_radius: float
+    outer_radius: float
+    hub_length: float
+    rim_thickness: float
+    flank_angle: float = 0.0
+    E: float = 2.1e11
+    nu: float = 0.3
+    rho: float = 7850.0
+
+    def __post_init__(self):
+        if not 0.0 < self.bore_radius <= self.hub_radius < self.outer_radius:
+            raise InputError("sheave.radii", (self.bore_radius, self.hub_radius, self.outer_radius),
+                             "0 < bore_radius <= hub_radius < outer_radius")
+        if not 0.0 < self.rim_thickness <= self.web_root <= self.hub_length:
+            raise InputError("sheave.thickness", (self.rim_thickness, self.hub_length),
+                             "0 < rim_thickness, and the face (rim_thickness + (outer_radius - r) tan(flank_angle)) "
+                             "must stay within the hub length at the hub radius")
+        if not (0.0 < self.E and -1.0 < self.nu < 0.5 and 0.0 < self.rho):
+            raise InputError("sheave.material", (self.E, self.nu, self.rho), "E > 0, -1 < nu < 0.5, rho > 0")
+
+    @property
+    def web_root(self) -> float:
+        """Thickness of the web at the hub radius, m."""
+        return self.rim_thickness + (self.outer_radius - self.hub_radius) * np.tan(self.flank_angle)
+
+    @property
+    def fillet_radius(self) -> float:
+        """Radius where the 45-degree fillet from the hub meets the web, m."""
+        return min(self.hub_radius + (self.hub_length - self.web_root), 0.5 * (self.hub_radius + self.outer_radius))
+
+    def thickness(self, r: np.ndarray) -> np.ndarray:
+        """Axial thickness ``t(r)`` of the section (the contact face is ``z = t(r)``), m."""
+        r = np.asarray(r, float)
+        web = self.rim_thickness + (self.outer_radius - r) * np.tan(self.flank_angle)
+        rf = self.fillet_radius
+        t_f = self.rim_thickness + (self.outer_radius - rf) * np.tan(self.flank_angle)
+        fillet = self.hub_length + (t_f - self.hub_length) * (r - self.hub_radius) / max(rf - self.hub_radius, 1e-300)
+        return np.where(r <= self.hub_radius, self.hub_length, np.where(r <= rf, fillet, web))
+
+    def radial_stations(self, n_r: int) -> np.ndarray:
+        """Radii of a grid with about ``n_r`` cells that has nodes at every kink of the outline, m."""
+        kinks = np.unique([self.bore_radius, self.hub_radius, self.fillet_radius, self.outer_radius])
+        span = self.outer_radius - self.bore_radius
+        pieces = [np.linspace(a, b, max(1, int(round(n_r * (b - a) / span))) + 1)[:-1]
+                  for a, b in zip(kinks[:-1], kinks[1:]) if b > a]
+        return np.concatenate(pieces + [[self.outer_radius]])
+
+    @property
+    def lame(self) -> tuple[float, float]:
+        """Lame constants ``lambda, mu``, Pa."""
+        lam = self.E * self.nu / ((1 + self.nu) * (1 - 2 * self.nu))
+        return lam, self.E / (2 * (1 + self.nu))
+
+
+def section_mesh(section: SheaveSection, n_r: int = 24, n_z: int = 2):  # noqa: ANN201 - skfem mesh
+    """Structured triangle mesh of the section (``MeshTri1``): radii of :meth:`SheaveSection.radial_stations`,
+    ``n_z`` layers through the local thickness."""
+    from skfem import MeshTri1
+
+    if n_r < 2 or n_z < 1:
+        raise InputError("section_mesh", (n_r, n_z), "n_r >= 2 and n_z >= 1")
+    r = section.radial_stations(n_r)
+    eta = np.linspace(0.0, 1.0, n_z + 1)
+    m = MeshTri1.init_tensor(r, eta)
+    p = m.p.copy()
+    p[1] = section.thickness(p[0]) * p[1]
+    return MeshTri1(p, m.t)
+
+
+def _theta_weights(n: int, family: str) -> tuple[float, float]:
+    """``int cos^2``, ``int sin^2`` over a revolution, assigned to (r, z terms, theta terms) of ``family``."""
+    c, s = (2 * np.pi, 0.0) if n == 0 else (np.pi, np.pi)
+    return (c, s) if family == "cos" else (s, c)
+
+
+@dataclass(frozen=True, eq=False)
+class HarmonicSheave:
+    """Quadratic-triangle model of a sheave section for one nodal-diameter number and family.
+
+    Parameters
+    ----------
+    section : SheaveSection
+    n : int
+        Nodal diameters (``>= 0``).
+    family : {"cos", "sin"}
+        ``u_r, u_z ~ cos n theta`` (and ``u_theta ~ sin``) or the swapped family (torsion at ``n = 0``).
+    n_r, n_z : int
+        Mesh density (:func:`section_mesh`).
+    """
+
+    section: SheaveSection
+    n: int
+    family: str = "cos"
+    n_r: int = 24
+    n_z: int = 2
+
+    def __post_init__(self):
+        if self.family not in ("cos", "sin"):
+            raise InputError("family", self.family, "'cos' or 'sin'")
+        if self.n < 0:
+            raise InputError("n", self.n, "a number of nodal diameters >= 0")
+
+    @cached_property
+    def basis(self):  # noqa: ANN201 - skfem Basis
+        from skfem import Basis, ElementTriP2, ElementVector
+
+        return Basis(section_mesh(self.section, self.n_r, self.n_z), ElementVector(ElementTriP2(), 3))
+
+    @cached_property
+    def matrices(self) -> tuple[sp.csr_matrix, sp.csr_matrix]:
+        """Stiffness ``K`` (N/m) and mass ``M`` (kg) of the whole disc in this harmonic, over all section DOFs."""
+        from skfem import BilinearForm, asm
+
+        lam, mu = self.section.lame
+        rho = self.section.rho
+        w_a, w_t = _theta_weights(self.n, self.family)
+        k = self.n if self.family == "cos" else -self.n
+
+        def parts(u, r):  # noqa: ANN001, ANN202
+            (ur, ut, uz), g = u, u.grad
+            e_rr, e_zz = g[0][0], g[2][1]
+            e_tt = (ur + k * ut) / r
+            g_rz = g[0][1] + g[2][0]
+            g_rt = g[1][0] - ut / r - k * ur / r
+            g_tz = g[1][1] - k * uz / r
+            return e_rr, e_tt, e_zz, g_rz, g_rt, g_tz
+
+        @BilinearForm
+        def stiffness(u, v, w):  # noqa: ANN001, ANN202
+            r = w.x[0]
+            a, b = parts(u, r), parts(v, r)
+            normal = lam * (a[0] + a[1] + a[2]) * (b[0] + b[1] + b[2]) + 2 * mu * (a[0] * b[0] + a[1] * b[1] + a[2] * b[2])
+            return (w_a * (normal + mu * a[3] * b[3]) + w_t * mu * (a[4] * b[4] + a[5] * b[5])) * r
+
+        @BilinearForm
+        def mass(u, v, w):  # noqa: ANN001, ANN202
+            (ur, ut, uz), (vr, vt, vz) = u, v
+            return rho * (w_a * (ur * vr + uz * vz) + w_t * ut * vt) * w.x[0]
+
+        return asm(stiffness, self.basis).tocsr(), asm(mass, self.basis).tocsr()
+
+    def bore_dofs(self) -> np.ndarray:
+        """All DOFs on the bore surface ``r = bore_radius`` (a sheave clamped to its shaft)."""
+        b = self.section.bore_radius
+        return self.basis.get_dofs(lambda x: np.isclose(x[0], b, rtol=0, atol=1e-9 * b)).flatten()
+
+    def free_dofs(self, clamped: bool = True) -> np.ndarray:
+        """DOFs left after clamping the bore (or none) and dropping those this harmonic leaves without
+        stiffness and mass (``u_theta`` of family ``cos`` at ``n = 0``, ``u_r, u_z`` of ``sin``)."""
+        K, M = self.matrices
+        keep = M.diagonal() > 0
+        if clamped:
+            keep[self.bore_dofs()] = False
+        return np.flatnonzero(keep)
+
+    def rim_load(self, force: float, component: int = 2) -> np.ndarray:
+        """Load vector (N) of a total ``force`` (N) spread evenly over the rim surface ``r = outer_radius``
+        along ``component`` (0 radial, 1 circumferential, 2 axial), for ``n = 0`` (a ring load)."""
+        from skfem import FacetBasis, LinearForm, asm
+
+        if self.n != 0:
+            raise InputError("rim_load", self.n, "a ring load excites only the n = 0 harmonic")
+        sec = self.section
+        mesh = self.basis.mesh
+        facets = mesh.facets_satisfying(lambda x: np.isclose(x[0], sec.outer_radius, rtol=0,
+                                                             atol=1e-9 * sec.outer_radius))
+        fb = FacetBasis(mesh, self.basis.elem, facets=facets)
+        traction = force / (2 * np.pi * sec.outer_radius * sec.rim_thickness)
+        w_a, w_t = _theta_weights(0, self.family)
+        weight = w_t if component == 1 else w_a
+
+        @LinearForm
+        def load(v, w):  # noqa: ANN001, ANN202
+            return traction * weight * v[component] * w.x[0]
+
+        return asm(load, fb)
+
+    def static(self, load: np.ndarray) -> np.ndarray:
+        """Displacement amplitudes (m) under ``load`` with the bore clamped."""
+        K, _ = self.matrices
+        free = self.free_dofs()
+        u = np.zeros(K.shape[0])
+        u[free] = spla.spsolve(K[free][:, free].tocsc(), load[free])
+        return u
+
+    def modes(self, count: int = 6, clamped: bool = True) -> tuple[np.ndarray, np.ndarray]:
+        """The ``count`` lowest natural frequencies (Hz) and mode shapes (columns over all DOFs) of this
+        harmonic, bore clamped or the disc free (then rigid-body modes come first, near 0 Hz)."""
+        return _lowest_modes(*self.matrices, self.free_dofs(clamped), count, clamped)
+
+    def field(self, u: np.ndarray, component: int) -> np.ndarray:
+        """Values of one displacement component at the section's mesh vertices, m."""
+        return u[self.basis.nodal_dofs[component]]
+
+
+def _lowest_modes(K, M, free, count, definite):  # noqa: ANN001, ANN202
+    """Lowest modes of ``K x = w^2 M x`` on ``free`` DOFs by shift-invert Lanczos (scipy ARPACK)."""
+    Kf, Mf = K[free][:, free].tocsc(), M[free][:, free].tocsc()
+    if count >= len(free):
+        raise InputError("count", count, f"fewer than the {len(free)} free DOFs")
+    # a clamped disc is definite: shift at 0; a free one has rigid modes: shift slightly below 0
+    scale = abs(Kf.diagonal()).max() / abs(Mf.diagonal()).max()
+    sigma = 0.0 if definite else -1e-6 * scale
+    try:
+        lam, vec = spla.eigsh(Kf, k=count, M=Mf, sigma=sigma, which="LM")
+    except (spla.ArpackNoConvergence, RuntimeError) as exc:
+        raise NumericalError(f"sheave modes: ARPACK did not converge ({exc})") from None
+    order = np.argsort(lam)
+    shapes = np.zeros((K.shape[0], count))
+    shapes[free] = vec[:, order]
+    return np.sqrt(np.maximum(lam[order], 0.0)) / (2 * np.pi), shapes
+
+
+def solid_mesh(section: SheaveSection, n_r: int = 12, n_z: int = 2, n_theta: int = 72):  # noqa: ANN201
+    """The revolved section as linear tetrahedra (``MeshTet1``): a periodic ``(r, theta, z)`` grid, every
+    cell split into six tetrahedra along its main diagonal (conforming for any grid)."""
+    from skfem import MeshTet1
+
+    if n_theta < 8:
+        raise InputError("solid_mesh.n_theta", n_theta, ">= 8 cells around")
+    r = section.radial_stations(n_r)
+    eta = np.linspace(0.0, 1.0, n_z + 1)
+    th = 2 * np.pi * np.arange(n_theta) / n_theta
+    R, T, H = np.meshgrid(r, th, eta, indexing="ij")
+    p = np.array([(R * np.cos(T)).ravel(), (R * np.sin(T)).ravel(), (section.thickness(R) * H).ravel()])
+    idx = np.arange(R.size).reshape(R.shape)
+    i, j, k = np.meshgrid(np.arange(len(r) - 1), np.arange(n_theta), np.arange(n_z), indexing="ij")
+    i, j, k = i.ravel(), j.ravel(), k.ravel()
+
+    def vertex(di, dj, dk):  # noqa: ANN001, ANN202
+        return idx[i + di, (j + dj) % n_theta, k + dk]
+
+    unit = np.eye(3, dtype=int)
+    tets = []
+    for perm in ((0, 1, 2), (0, 2, 1), (1, 0, 2), (1, 2, 0), (2, 0, 1), (2, 1, 0)):
+        a = unit[perm[0]]
+        b = a + unit[perm[1]]
+        tets.append(np.array([vertex(0, 0, 0), vertex(*a), vertex(*b), vertex(1, 1, 1)]))
+    t = np.concatenate(tets, axis=1)
+    # orient every tetrahedron positively
+    d = p[:, t[1:]] - p[:, t[0]][:, None, :]
+    neg = np.einsum("ij,ij->j", d[:, 0], np.cross(d[:, 1], d[:, 2], axis=0)) < 0
+    t[1:3, neg] = t[2:0:-1, neg]
+    return MeshTet1(p, t)
+
+
+@dataclass(frozen=True, eq=False)
+class SolidSheave:
+    """Quadratic-tetrahedron model of the whole sheave (the reference of :class:`HarmonicSheave`)."""
+
+    section: SheaveSection
+    n_r: int = 12
+    n_z: int = 2
+    n_theta: int = 72
+
+    @cached_property
+    def basis(self):  # noqa: ANN201 - skfem Basis
+        from skfem import Basis, ElementTetP2, ElementVector
+
+        return Basis(solid_mesh(self.section, self.n_r, self.n_z, self.n_theta), ElementVector(ElementTetP2()))
+
+    @cached_property
+    def matrices(self) -> tuple[sp.csr_matrix, sp.csr_matrix]:
+        """Stiffness (N/m) and mass (kg) matrices."""
+        from skfem import BilinearForm, asm
+        from skfem.helpers import dot
+        from skfem.models.elasticity import linear_elasticity
+
+        lam, mu = self.section.lame
+        rho = self.section.rho
+
+        @BilinearForm
+        def mass(u, v, w):  # noqa: ANN001, ANN202
+            return rho * dot(u, v)
+
+        return asm(linear_elasticity(lam, mu), self.basis).tocsr(), asm(mass, self.basis).tocsr()
+
+    def _radius(self, x: np.ndarray) -> np.ndarray:
+        return np.hypot(x[0], x[1])
+
+    def bore_dofs(self) -> np.ndarray:
+        """All DOFs on the (polygonal) bore surface: nothing of the body lies nearer the axis."""
+        b = self.section.bore_radius
+        return self.basis.get_dofs(lambda x: self._radius(x) < b * (1 + 1e-9)).flatten()
+
+    def rim_load(self, force: float) -> np.ndarray:
+        """Load vector (N): a total axial ``force`` (N) spread evenly over the rim surface."""
+        from skfem import FacetBasis, LinearForm, asm
+
+        sec = self.section
+        mesh = self.basis.mesh
+        # chords of the polygonal rim: select facets by their vertices' radius
+        facets = mesh.facets_satisfying(lambda x: self._radius(x) > sec.outer_radius * np.cos(np.pi / self.n_theta)
+                                        * (1 - 1e-9))
+        fb = FacetBasis(mesh, self.basis.elem, facets=facets)
+        area = asm(LinearForm(lambda v, w: v[2]), fb).sum()  # = rim area (sum of the shape functions = 1)
+        traction = force / area
+
+        @LinearForm
+        def load(v, w):  # noqa: ANN001, ANN202
+            return traction * v[2]
+
+        return asm(load, fb)
+
+    def static(self, load: np.ndarray) -> np.ndarray:
+        """Displacements (m) under ``load``, bore clamped."""
+        K, _ = self.matrices
+        free = np.setdiff1d(np.arange(K.shape[0]), self.bore_dofs())
+        u = np.zeros(K.shape[0])
+        u[free] = spla.spsolve(K[free][:, free].tocsc(), load[free])
+        return u
+
+    def modes(self, count: int = 12, clamped: bool = True) -> tuple[np.ndarray, np.ndarray]:
+        """The ``count`` lowest natural frequencies (Hz) and mode shapes."""
+        K, M = self.matrices
+        free = np.setdiff1d(np.arange(K.shape[0]), self.bore_dofs()) if clamped else np.arange(K.shape[0])
+        return _lowest_modes(K, M, free, count, clamped)
