@@ -190,6 +190,84 @@ class HarmonicSheave:
 
         return asm(stiffness, self.basis).tocsr(), asm(mass, self.basis).tocsr()
 
+    @cached_property
+    def spin_softening(self) -> sp.csr_matrix:
+        """``M_c`` (kg): the centrifugal force of a displacement in the plane of the disc is ``Omega^2 M_c u``."""
+        from skfem import BilinearForm, asm
+
+        rho = self.section.rho
+        w_a, w_t = _theta_weights(self.n, self.family)
+
+        @BilinearForm
+        def form(u, v, w):  # noqa: ANN001, ANN202
+            return rho * (w_a * u[0] * v[0] + w_t * u[1] * v[1]) * w.x[0]
+
+        return asm(form, self.basis).tocsr()
+
+    def centrifugal_displacement(self, omega: float) -> np.ndarray:
+        """Steady displacement (m) of the disc spinning at ``omega`` (rad/s), bore clamped: ``K u = f_c`` with
+        ``f_c`` the centrifugal body force ``rho omega^2 r`` (linear prestress: the stress is proportional to
+        ``omega^2``; this model must be ``n = 0``, family ``cos``)."""
+        from skfem import LinearForm, asm
+
+        if (self.n, self.family) != (0, "cos"):
+            raise InputError("centrifugal_displacement", (self.n, self.family), "the n = 0 'cos' model")
+        rho = self.section.rho
+
+        @LinearForm
+        def body(v, w):  # noqa: ANN001, ANN202
+            return 2 * np.pi * rho * omega ** 2 * w.x[0] * v[0] * w.x[0]
+
+        K, _ = self.matrices
+        free = self.free_dofs()
+        u = np.zeros(K.shape[0])
+        u[free] = spla.spsolve(K[free][:, free].tocsc(), asm(body, self.basis)[free])
+        return u
+
+    def stress(self, u0: np.ndarray):  # noqa: ANN201 - tuple of skfem fields
+        """Stresses ``(s_rr, s_tt, s_zz, s_rz)`` (Pa) at the quadrature points of an axisymmetric displacement
+        ``u0`` of the ``n = 0`` 'cos' model on the same mesh."""
+        lam, mu = self.section.lame
+        f = self.basis.interpolate(u0)
+        g, r = f.grad, self.basis.global_coordinates()[0]
+        e_rr, e_tt, e_zz, g_rz = g[0][0], f[0] / r, g[2][1], g[0][1] + g[2][0]
+        tr = e_rr + e_tt + e_zz
+        return lam * tr + 2 * mu * e_rr, lam * tr + 2 * mu * e_tt, lam * tr + 2 * mu * e_zz, mu * g_rz
+
+    def geometric_stiffness(self, prestress) -> sp.csr_matrix:  # noqa: ANN001 - tuple of arrays
+        """``K_sigma`` (N/m) of an axisymmetric prestress ``(s_rr, s_tt, s_zz, s_rz)`` (:meth:`stress`):
+        ``int sigma_ij u_k,i v_k,j dV`` with the cylindrical displacement gradient of this harmonic."""
+        from skfem import BilinearForm, asm
+
+        w_a, w_t = _theta_weights(self.n, self.family)
+        k = self.n if self.family == "cos" else -self.n
+        s_rr, s_tt, s_zz, s_rz = prestress
+
+        def rows(u, r):  # noqa: ANN001, ANN202 - (d/dr, (1/r) d/dtheta, d/dz) of u_r, u_theta, u_z
+            (ur, ut, uz), g = u, u.grad
+            return ((g[0][0], (-k * ur - ut) / r, g[0][1]), (g[1][0], (k * ut + ur) / r, g[1][1]),
+                    (g[2][0], -k * uz / r, g[2][1]))
+
+        @BilinearForm
+        def form(u, v, w):  # noqa: ANN001, ANN202
+            r = w.x[0]
+            total = 0.0
+            for row, (a, b) in enumerate(zip(rows(u, r), rows(v, r))):
+                plane, hoop = (w_t, w_a) if row == 1 else (w_a, w_t)   # the u_theta row has the other parity
+                total = total + plane * (w.s_rr * a[0] * b[0] + w.s_zz * a[2] * b[2]
+                                         + w.s_rz * (a[0] * b[2] + a[2] * b[0])) + hoop * w.s_tt * a[1] * b[1]
+            return total * r
+
+        return asm(form, self.basis, s_rr=s_rr, s_tt=s_tt, s_zz=s_zz, s_rz=s_rz).tocsr()
+
+    def spinning_modes(self, omega: float, prestress, count: int = 6) -> tuple[np.ndarray, np.ndarray]:
+        """Natural frequencies (Hz, in the rotating frame) and shapes of the disc spinning at ``omega`` (rad/s),
+        bore clamped: ``K + K_sigma - omega^2 M_c`` with ``prestress`` the stress at ``omega`` (:meth:`stress`).
+        Coriolis coupling of the two families is left out (it acts on in-plane motion only)."""
+        K, M = self.matrices
+        Kt = K + self.geometric_stiffness(prestress) - omega ** 2 * self.spin_softening
+        return _lowest_modes(Kt.tocsr(), M, self.free_dofs(), count, True)
+
     def bore_dofs(self) -> np.ndarray:
         """All DOFs on the bore surface ``r = bore_radius`` (a sheave clamped to its shaft)."""
         b = self.section.bore_radius
