@@ -20,7 +20,7 @@ Units SI: m, Pa, kg/m^3; frequencies in Hz.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import cached_property
 
 import numpy as np
@@ -32,18 +32,21 @@ from cvtfem.errors import InputError, NumericalError
 
 @dataclass(frozen=True)
 class SheaveSection:
-    """The section of a sheave disc in the ``(r, z)`` half-plane, back face at ``z = 0`` (SI units).
+    """The section of a sheave in the ``(r, z)`` half-plane, as :func:`cvtfem.elements.disk.sheave_profile`
+    draws it: a disc from the back face ``z = 0`` to the contact face, and a hub sleeve behind the back face.
 
     Attributes
     ----------
     bore_radius, hub_radius, outer_radius : m
-        Radius of the bore (the shaft seat), of the hub's outer surface and of the rim.
+        Radius of the bore (the shaft seat), of the hub sleeve and of the rim (``bore = hub`` without a sleeve).
     hub_length : m
-        Axial length of the hub (its thickness at ``r <= hub_radius``).
+        Axial length of the hub sleeve behind the back face, ``z`` in ``[-hub_length, 0]`` (0: none).
     rim_thickness : m
-        Thickness at the rim; the contact face rises towards the hub at the flank angle.
+        Thickness of the disc at the rim; the face rises towards the hub at the flank angle.
     flank_angle : rad
-        Angle of the conical contact face to the radial plane (0: a flat annular plate).
+        Angle of the contact face to the radial plane between rim and hub (0: a flat annular plate).
+    face : {"conical", "toroidal"}
+        Straight face, or the convex arc of ``torus_radius`` (m) through the same end points.
     E, nu, rho : Pa, -, kg/m^3
         Young's modulus, Poisson's ratio and density (steel by default).
     """
@@ -54,6 +57,8 @@ class SheaveSection:
     hub_length: float
     rim_thickness: float
     flank_angle: float = 0.0
+    face: str = "conical"
+    torus_radius: float = 0.0
     E: float = 2.1e11
     nu: float = 0.3
     rho: float = 7850.0
@@ -62,39 +67,33 @@ class SheaveSection:
         if not 0.0 < self.bore_radius <= self.hub_radius < self.outer_radius:
             raise InputError("sheave.radii", (self.bore_radius, self.hub_radius, self.outer_radius),
                              "0 < bore_radius <= hub_radius < outer_radius")
-        if not 0.0 < self.rim_thickness <= self.web_root <= self.hub_length:
-            raise InputError("sheave.thickness", (self.rim_thickness, self.hub_length),
-                             "0 < rim_thickness, and the face (rim_thickness + (outer_radius - r) tan(flank_angle)) "
-                             "must stay within the hub length at the hub radius")
+        if self.hub_length < 0.0 or (self.hub_length > 0.0 and self.hub_radius == self.bore_radius):
+            raise InputError("sheave.hub_length", self.hub_length, ">= 0, and 0 when hub_radius = bore_radius")
+        if not (self.rim_thickness > 0.0 and 0.0 <= self.flank_angle < np.pi / 2):
+            raise InputError("sheave.rim_thickness/flank_angle", (self.rim_thickness, self.flank_angle),
+                             "rim_thickness > 0 and 0 <= flank_angle < pi/2")
+        if self.face not in ("conical", "toroidal"):
+            raise InputError("sheave.face", self.face, "'conical' or 'toroidal'")
+        chord = np.hypot(self.outer_radius - self.hub_radius, self.hub_face - self.rim_thickness)
+        if self.face == "toroidal" and not self.torus_radius > chord / 2:
+            raise InputError("sheave.torus_radius", self.torus_radius, f"> half the face chord, {chord / 2:g} m")
         if not (0.0 < self.E and -1.0 < self.nu < 0.5 and 0.0 < self.rho):
             raise InputError("sheave.material", (self.E, self.nu, self.rho), "E > 0, -1 < nu < 0.5, rho > 0")
 
     @property
-    def web_root(self) -> float:
-        """Thickness of the web at the hub radius, m."""
+    def hub_face(self) -> float:
+        """Height of the face at the hub radius, m."""
         return self.rim_thickness + (self.outer_radius - self.hub_radius) * np.tan(self.flank_angle)
 
-    @property
-    def fillet_radius(self) -> float:
-        """Radius where the 45-degree fillet from the hub meets the web, m."""
-        return min(self.hub_radius + (self.hub_length - self.web_root), 0.5 * (self.hub_radius + self.outer_radius))
+    def face_height(self, r: np.ndarray) -> np.ndarray:
+        """Axial position ``z`` (m) of the contact face at radius ``r`` (flat at ``hub_face`` inside the hub)."""
+        r = np.clip(np.asarray(r, float), self.hub_radius, self.outer_radius)
+        if self.face == "conical":
+            return self.rim_thickness + (self.outer_radius - r) * np.tan(self.flank_angle)
+        from cvtfem.elements.disk import face_arc_centre
 
-    def thickness(self, r: np.ndarray) -> np.ndarray:
-        """Axial thickness ``t(r)`` of the section (the contact face is ``z = t(r)``), m."""
-        r = np.asarray(r, float)
-        web = self.rim_thickness + (self.outer_radius - r) * np.tan(self.flank_angle)
-        rf = self.fillet_radius
-        t_f = self.rim_thickness + (self.outer_radius - rf) * np.tan(self.flank_angle)
-        fillet = self.hub_length + (t_f - self.hub_length) * (r - self.hub_radius) / max(rf - self.hub_radius, 1e-300)
-        return np.where(r <= self.hub_radius, self.hub_length, np.where(r <= rf, fillet, web))
-
-    def radial_stations(self, n_r: int) -> np.ndarray:
-        """Radii of a grid with about ``n_r`` cells that has nodes at every kink of the outline, m."""
-        kinks = np.unique([self.bore_radius, self.hub_radius, self.fillet_radius, self.outer_radius])
-        span = self.outer_radius - self.bore_radius
-        pieces = [np.linspace(a, b, max(1, int(round(n_r * (b - a) / span))) + 1)[:-1]
-                  for a, b in zip(kinks[:-1], kinks[1:]) if b > a]
-        return np.concatenate(pieces + [[self.outer_radius]])
+        c = face_arc_centre(self.outer_radius, self.rim_thickness, self.hub_radius, self.hub_face, self.torus_radius)
+        return c[1] + np.sqrt(np.maximum(self.torus_radius ** 2 - (r - c[0]) ** 2, 0.0))
 
     @property
     def lame(self) -> tuple[float, float]:
@@ -104,18 +103,49 @@ class SheaveSection:
 
 
 def section_mesh(section: SheaveSection, n_r: int = 24, n_z: int = 2):  # noqa: ANN201 - skfem mesh
-    """Structured triangle mesh of the section (``MeshTri1``): radii of :meth:`SheaveSection.radial_stations`,
-    ``n_z`` layers through the local thickness."""
+    """Quadratic triangle mesh of the section (``MeshTri2``): columns at about ``n_r`` radii (nodes at the hub
+    radius), ``n_z`` layers from the back face to the contact face, the hub sleeve with layers of the same
+    height.  Mid-edge nodes of the disc sit at the midpoints of the map ``z = eta * face_height(r)``, so a
+    toroidal face is curved, not a polygon."""
+    from skfem import MeshTri2
+
+    m = _linear_section_mesh(section, n_r, n_z)
+    M = MeshTri2.from_mesh(m)
+    ends = m.p[:, m.facets]                              # (2, 2 ends, n_edges)
+    face = section.face_height(ends[0])
+    eta = np.where(ends[1] >= 0.0, ends[1] / face, np.nan)
+    r_mid = ends[0].mean(axis=0)
+    z_mid = np.where(np.isnan(eta).any(axis=0), ends[1].mean(axis=0), eta.mean(axis=0) * section.face_height(r_mid))
+    doflocs = M.doflocs.copy()
+    doflocs[:, m.p.shape[1]:] = np.array([r_mid, z_mid])
+    return replace(M, doflocs=doflocs)
+
+
+def _linear_section_mesh(section: SheaveSection, n_r: int, n_z: int):  # noqa: ANN202 - skfem MeshTri1
+    """The straight-edged triangles of :func:`section_mesh`."""
     from skfem import MeshTri1
 
     if n_r < 2 or n_z < 1:
         raise InputError("section_mesh", (n_r, n_z), "n_r >= 2 and n_z >= 1")
-    r = section.radial_stations(n_r)
-    eta = np.linspace(0.0, 1.0, n_z + 1)
-    m = MeshTri1.init_tensor(r, eta)
-    p = m.p.copy()
-    p[1] = section.thickness(p[0]) * p[1]
-    return MeshTri1(p, m.t)
+    s = section
+    span = s.outer_radius - s.bore_radius
+    n_hub = max(1, int(round(n_r * (s.hub_radius - s.bore_radius) / span))) if s.hub_radius > s.bore_radius else 0
+    r = np.concatenate([np.linspace(s.bore_radius, s.hub_radius, n_hub + 1)[:-1],
+                        np.linspace(s.hub_radius, s.outer_radius, max(1, n_r - n_hub) + 1)])
+    n_sleeve = max(1, int(round(n_z * s.hub_length / s.hub_face))) if s.hub_length > 0 else 0
+    points, columns = [], []
+    for ri in r:
+        sleeve = -s.hub_length * (1 - np.arange(n_sleeve) / n_sleeve) if ri <= s.hub_radius else np.zeros(0)
+        z = np.concatenate([sleeve, s.face_height(ri) * np.linspace(0.0, 1.0, n_z + 1)])
+        columns.append((len(sleeve), len(points) + np.arange(len(z))))
+        points += [(ri, zi) for zi in z]
+    quads = []
+    for (na, a), (nb, b) in zip(columns[:-1], columns[1:]):
+        shared = min(na, nb)                           # sleeve layers on both columns, then the disc layers
+        a, b = a[na - shared:], b[nb - shared:]
+        quads += [(a[k], b[k], b[k + 1], a[k + 1]) for k in range(len(a) - 1)]
+    q = np.array(quads).T
+    return MeshTri1(np.array(points).T, np.hstack([q[[0, 1, 2]], q[[0, 2, 3]]]))
 
 
 def _theta_weights(n: int, family: str) -> tuple[float, float]:
@@ -317,9 +347,11 @@ class HarmonicSheave:
         harmonic, bore clamped or the disc free (then rigid-body modes come first, near 0 Hz)."""
         return _lowest_modes(*self.matrices, self.free_dofs(clamped), count, clamped)
 
-    def field(self, u: np.ndarray, component: int) -> np.ndarray:
-        """Values of one displacement component at the section's mesh vertices, m."""
-        return u[self.basis.nodal_dofs[component]]
+    def rim_mean(self, u: np.ndarray, component: int = 2) -> float:
+        """Mean of one displacement component (m) over the nodes of the rim surface ``r = outer_radius``."""
+        idx = self.basis.split_indices()[component]
+        r = self.basis.doflocs[0, idx]
+        return float(u[idx][np.isclose(r, self.section.outer_radius, rtol=0, atol=1e-9 * r.max())].mean())
 
 
 def _lowest_modes(K, M, free, count, definite):  # noqa: ANN001, ANN202
@@ -341,35 +373,27 @@ def _lowest_modes(K, M, free, count, definite):  # noqa: ANN001, ANN202
 
 
 def solid_mesh(section: SheaveSection, n_r: int = 12, n_z: int = 2, n_theta: int = 72):  # noqa: ANN201
-    """The revolved section as linear tetrahedra (``MeshTet1``): a periodic ``(r, theta, z)`` grid, every
-    cell split into six tetrahedra along its main diagonal (conforming for any grid)."""
+    """The section mesh revolved in ``n_theta`` steps into linear tetrahedra (``MeshTet1``): every prism split
+    into three with its triangle's vertices in global order, which makes neighbouring splits conform."""
     from skfem import MeshTet1
 
     if n_theta < 8:
         raise InputError("solid_mesh.n_theta", n_theta, ">= 8 cells around")
-    r = section.radial_stations(n_r)
-    eta = np.linspace(0.0, 1.0, n_z + 1)
+    m = _linear_section_mesh(section, n_r, n_z)
+    n2 = m.p.shape[1]
     th = 2 * np.pi * np.arange(n_theta) / n_theta
-    R, T, H = np.meshgrid(r, th, eta, indexing="ij")
-    p = np.array([(R * np.cos(T)).ravel(), (R * np.sin(T)).ravel(), (section.thickness(R) * H).ravel()])
-    idx = np.arange(R.size).reshape(R.shape)
-    i, j, k = np.meshgrid(np.arange(len(r) - 1), np.arange(n_theta), np.arange(n_z), indexing="ij")
-    i, j, k = i.ravel(), j.ravel(), k.ravel()
-
-    def vertex(di, dj, dk):  # noqa: ANN001, ANN202
-        return idx[i + di, (j + dj) % n_theta, k + dk]
-
-    unit = np.eye(3, dtype=int)
-    tets = []
-    for perm in ((0, 1, 2), (0, 2, 1), (1, 0, 2), (1, 2, 0), (2, 0, 1), (2, 1, 0)):
-        a = unit[perm[0]]
-        b = a + unit[perm[1]]
-        tets.append(np.array([vertex(0, 0, 0), vertex(*a), vertex(*b), vertex(1, 1, 1)]))
-    t = np.concatenate(tets, axis=1)
-    # orient every tetrahedron positively
+    p = np.vstack([np.outer(np.cos(th), m.p[0]).ravel(), np.outer(np.sin(th), m.p[0]).ravel(),
+                   np.tile(m.p[1], n_theta)])
+    a, b, c = np.sort(m.t, axis=0)
+    layer = np.arange(n_theta)[:, None] * n2
+    up = ((np.arange(n_theta) + 1) % n_theta)[:, None] * n2
+    lo = [(layer + v).ravel() for v in (a, b, c)]
+    hi = [(up + v).ravel() for v in (a, b, c)]
+    t = np.hstack([np.array([lo[0], lo[1], lo[2], hi[2]]), np.array([lo[0], lo[1], hi[1], hi[2]]),
+                   np.array([lo[0], hi[0], hi[1], hi[2]])])
     d = p[:, t[1:]] - p[:, t[0]][:, None, :]
     neg = np.einsum("ij,ij->j", d[:, 0], np.cross(d[:, 1], d[:, 2], axis=0)) < 0
-    t[1:3, neg] = t[2:0:-1, neg]
+    t[1:3, neg] = t[2:0:-1, neg]                        # orient every tetrahedron positively
     return MeshTet1(p, t)
 
 
