@@ -86,6 +86,16 @@ def disc_profile(width: float, inner_diameter: float, outer_diameter: float) -> 
     return np.array([ri, ro, ro, ri]), np.array([-h, -h, h, h])
 
 
+def face_arc_centre(r_rim: float, z_rim: float, r_hub: float, z_hub: float, radius: float) -> np.ndarray:
+    """``(r, z)`` centre of the convex toroidal face: the arc of ``radius`` (m) through the rim point and the
+    hub point of the face, bulging away from the material (towards ``+z``)."""
+    chord = np.hypot(r_rim - r_hub, z_hub - z_rim)
+    mid = np.array([(r_rim + r_hub) / 2, (z_rim + z_hub) / 2])
+    d = np.array([r_hub - r_rim, z_hub - z_rim]) / chord
+    normal = np.array([d[1], -d[0]])           # points away from the material (outward, +z side)
+    return mid - normal * np.sqrt(radius ** 2 - (chord / 2) ** 2)
+
+
 def sheave_profile(inner_diameter: float, outer_diameter: float, hub_diameter: float, hub_length: float,
                    rim_thickness: float, cone_angle: float, face: str = "conical",
                    torus_radius: float = 0.0, n_arc: int = 64) -> tuple[np.ndarray, np.ndarray]:
@@ -116,10 +126,7 @@ def sheave_profile(inner_diameter: float, outer_diameter: float, hub_diameter: f
         chord = np.hypot(ro - rh, zh - rim_thickness)
         if not torus_radius >= chord / 2:
             raise InputError("torus_radius", torus_radius, f"must be >= half the face chord, {chord / 2:g} m")
-        mid = np.array([(ro + rh) / 2, (rim_thickness + zh) / 2])
-        d = np.array([rh - ro, zh - rim_thickness]) / chord
-        normal = np.array([d[1], -d[0]])           # points away from the material (outward, +z side)
-        centre = mid - normal * np.sqrt(torus_radius**2 - (chord / 2) ** 2)
+        centre = face_arc_centre(ro, rim_thickness, rh, zh, torus_radius)
         a0 = np.arctan2(rim_thickness - centre[1], ro - centre[0])
         a1 = np.arctan2(zh - centre[1], rh - centre[0])
         a = np.linspace(a0, a1 if a1 > a0 else a1 + 2 * np.pi, n_arc + 1)

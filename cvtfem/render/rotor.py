@@ -106,7 +106,7 @@ def _revolved(profile: tuple[np.ndarray, np.ndarray], centre: np.ndarray, axis: 
 _COLORS = {"shaft": "lightsteelblue", "disk": "goldenrod", "bearing": "dimgray"}
 
 
-def _plotter(size: tuple[int, int]):  # noqa: ANN202
+def plotter(size: tuple[int, int]):  # noqa: ANN202
     import pyvista as pv
     from vtkmodules.vtkCommonCore import vtkLogger
 
@@ -119,7 +119,7 @@ def _plotter(size: tuple[int, int]):  # noqa: ANN202
 
 def render_rotor(model: RotorModel, path: str | Path, size: tuple[int, int] = (1200, 600)) -> Path:
     """PNG of the undeformed rotor: shaft, disks, bearings."""
-    p = _plotter(size)
+    p = plotter(size)
     for kind, mesh in _scene_meshes(model, None, 0.0, 0.0):
         p.add_mesh(mesh, color=_COLORS[kind], smooth_shading=True)
     p.view_isometric()
@@ -160,7 +160,7 @@ def _draw_mode(p, model: RotorModel, modes: Modes, k: int, phase: float, scale: 
 def render_mode(model: RotorModel, modes: Modes, k: int, path: str | Path, scale: float | None = None,
                 phase: float = 0.0, size: tuple[int, int] = (1200, 700)) -> Path:
     """PNG of mode ``k``: deformed (red) over the undeformed rotor (faint), with node orbits."""
-    p = _plotter(size)
+    p = plotter(size)
     s = mode_scale(model, modes.shapes[:, k]) if scale is None else scale
     _draw_mode(p, model, modes, k, phase, s)
     p.view_isometric()
@@ -178,7 +178,7 @@ def write_mode_gif(model: RotorModel, modes: Modes, k: int, path: str | Path, fr
     s = mode_scale(model, modes.shapes[:, k]) if scale is None else scale
     images = []
     for phase in np.linspace(0, 2 * np.pi, frames, endpoint=False):
-        p = _plotter(size)
+        p = plotter(size)
         _draw_mode(p, model, modes, k, phase, s)
         p.view_isometric()
         p.camera.zoom(1.6)

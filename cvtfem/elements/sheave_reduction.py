@@ -1,0 +1,122 @@
+"""Craig–Bampton reduction of a solid sheave harmonic to the shaft node, the contact ring and a few modes.
+
+The bore is bonded to the shaft, whose section stays rigid: the bore moves as a rigid body of the shaft
+node's motion.  In the harmonic ``n`` only some rigid motions exist (:data:`INTERFACE`): axial
+translation (``n = 0``, family ``cos``), rotation about the axis (``n = 0``, ``sin``), sideways
+translation and tilt (``n = 1``); for ``n >= 2`` the bore is clamped and the sheave has only its own
+modes.  The contact ring (a node of the contact face) keeps its three displacement amplitudes as
+boundary coordinates, so ring loads are represented exactly.  Coordinates of the reduced model:
+``[interface (rigid), ring (3), fixed-interface modes]``; units m and rad, modal coordinates of unit
+modal mass.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse.linalg as spla
+
+from cvtfem.elements.sheave_solid import HarmonicSheave
+from cvtfem.errors import InputError, NumericalError
+
+
+def _rigid(n: int, family: str, z_c: float) -> tuple[tuple[str, callable], ...]:
+    """Rigid motions of harmonic ``n``: ``(name, (r, z) -> (U_r, U_theta, U_z))`` per unit coordinate."""
+    one, zero = (lambda r, z: np.ones_like(r)), (lambda r, z: np.zeros_like(r))
+    table = {
+        (0, "cos"): (("axial", lambda r, z: (zero(r, z), zero(r, z), one(r, z))),),
+        (0, "sin"): (("spin", lambda r, z: (zero(r, z), r, zero(r, z))),),
+        (1, "cos"): (("x", lambda r, z: (one(r, z), -one(r, z), zero(r, z))),
+                     ("tilt_y", lambda r, z: (z - z_c, -(z - z_c), -r))),
+        (1, "sin"): (("y", lambda r, z: (one(r, z), one(r, z), zero(r, z))),
+                     ("tilt_x", lambda r, z: (-(z - z_c), -(z - z_c), r))),
+    }
+    return table.get((n, family), ())
+
+
+@dataclass(frozen=True)
+class ReducedSheave:
+    """A sheave harmonic in Craig–Bampton coordinates.
+
+    Attributes
+    ----------
+    labels : tuple of str
+        Names of the reduced coordinates (rigid interface, ``ring_r``, ``ring_theta``, ``ring_z``, ``mode_k``).
+    M, K : (m, m) arrays
+        Reduced mass (kg, kg m, kg m^2) and stiffness matrices.
+    basis : (ndof, m) array
+        Full section DOFs of each reduced coordinate (recovers the displacement field).
+    fixed_interface_hz : array
+        Frequencies of the kept fixed-interface modes, Hz.
+    """
+
+    labels: tuple[str, ...]
+    M: np.ndarray
+    K: np.ndarray
+    basis: np.ndarray
+    fixed_interface_hz: np.ndarray
+
+    def index(self, label: str) -> int:
+        """Position of the reduced coordinate ``label``."""
+        return self.labels.index(label)
+
+
+def ring_dofs(model: HarmonicSheave, radius: float) -> np.ndarray:
+    """The three DOFs (r, theta, z) of the contact-face vertex nearest ``radius`` (m)."""
+    sec = model.section
+    if not sec.hub_radius <= radius <= sec.outer_radius:
+        raise InputError("ring_radius", radius, f"a radius on the contact face, {sec.hub_radius:g}..{sec.outer_radius:g} m")
+    locs = model.basis.doflocs
+    on_face = np.isclose(locs[1], sec.face_height(locs[0]), rtol=0, atol=1e-9 * sec.outer_radius)
+    target = np.flatnonzero(on_face)[np.argmin(abs(locs[0, on_face] - radius))]
+    same = np.flatnonzero(np.all(np.isclose(locs, locs[:, [target]], rtol=0, atol=1e-12), axis=0))
+    comp = np.empty(locs.shape[1], int)
+    for c, idx in enumerate(model.basis.split_indices()):
+        comp[idx] = c
+    return same[np.argsort(comp[same])]
+
+
+def craig_bampton(model: HarmonicSheave, n_modes: int, ring_radius: float | None = None,
+                  tilt_centre: float = 0.0) -> ReducedSheave:
+    """Reduce ``model`` to its rigid bore motions, the contact ring (if ``ring_radius``, m) and ``n_modes``
+    fixed-interface modes; tilts turn about the axis point ``z = tilt_centre`` (m, the shaft node)."""
+    K, M = model.matrices
+    keep = model.free_dofs(clamped=False)
+    locs = model.basis.doflocs
+    comp = np.empty(K.shape[0], int)
+    for c, idx in enumerate(model.basis.split_indices()):
+        comp[idx] = c
+    bore = np.intersect1d(model.bore_dofs(), keep)
+    ring = np.intersect1d(ring_dofs(model, ring_radius), keep) if ring_radius is not None else np.array([], int)
+    boundary = np.union1d(bore, ring)
+    interior = np.setdiff1d(keep, boundary)
+    rigid = _rigid(model.n, model.family, tilt_centre)
+    labels = [name for name, _ in rigid] + [("ring_r", "ring_theta", "ring_z")[comp[d]] for d in ring]
+    T = np.zeros((K.shape[0], len(labels)))
+    for j, (_, shape) in enumerate(rigid):
+        values = np.array(shape(locs[0, bore], locs[1, bore]))
+        T[bore, j] = values[comp[bore], np.arange(len(bore))]
+    for j, d in enumerate(ring):
+        T[d, len(rigid) + j] = 1.0
+    Kii, Mii = K[interior][:, interior].tocsc(), M[interior][:, interior].tocsc()
+    lu = spla.splu(Kii)
+    static = -lu.solve(np.asarray((K[interior][:, boundary] @ T[boundary]), float)) if labels else \
+        np.zeros((len(interior), 0))
+    if n_modes > 0:
+        if n_modes >= len(interior):
+            raise InputError("n_modes", n_modes, f"fewer than the {len(interior)} interior DOFs")
+        try:
+            lam, phi = spla.eigsh(Kii, k=n_modes, M=Mii, sigma=0.0, which="LM")
+        except (spla.ArpackNoConvergence, RuntimeError) as exc:
+            raise NumericalError(f"Craig-Bampton: fixed-interface modes did not converge ({exc})") from None
+        order = np.argsort(lam)
+        lam, phi = lam[order], phi[:, order]
+    else:
+        lam, phi = np.zeros(0), np.zeros((len(interior), 0))
+    basis = np.zeros((K.shape[0], len(labels) + n_modes))
+    basis[boundary, :len(labels)] = T[boundary]
+    basis[interior, :len(labels)] = static
+    basis[interior, len(labels):] = phi
+    Kr, Mr = basis.T @ (K @ basis), basis.T @ (M @ basis)
+    return ReducedSheave(tuple(labels) + tuple(f"mode_{k}" for k in range(n_modes)), 0.5 * (Mr + Mr.T),
+                         0.5 * (Kr + Kr.T), basis, np.sqrt(np.maximum(lam, 0.0)) / (2 * np.pi))
