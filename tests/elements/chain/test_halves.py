@@ -199,35 +199,37 @@ def test_open_segment_under_end_tension_carries_it_in_every_link():
     assert np.allclose(out["chain.roll_force"][[0, n - 1]], T / 2, rtol=1e-6)  # end pins: the free half's share
 
 
-def _ring_run(periods, n=12):
-    ch = chain(n=n, K=2, hole_clearance=6e-4, hole_radius=0.0032, stopper_play=0.0, plate_model="A3-keep")
+def _ring_run(periods, rtol, n=6):
+    """A free 6-pin ring (soft parameters: highest frequency ~7x the lowest link mode), DOP853."""
+    soft = dict(plate_stiffness=1e8, plate_bending_stiffness=0.03, plate_torsion_stiffness=5.0,
+                pin_axial_stiffness=2e6, half_bending_tau=0.05, half_bending_n=0.1, roll_stiffness=1e9, hole_stiffness=1e9, hole_clearance=1.2e-3,
+                hole_radius=0.0038, stopper_play=0.0, plate_model="A3-keep")
+    ch = chain(n=n, K=2, **soft)
     q0 = ring_state(ch, stretch=2e-6, overlap=2e-6)
-    rng = np.random.default_rng(8)
-    v0 = 0.02 * rng.standard_normal(ch.n2)
-    y0 = np.r_[q0, v0]
+    v0 = 0.02 * np.random.default_rng(8).standard_normal(ch.n2)
     m = ch.n2
 
     def rhs(t, y):
         return np.r_[y[m:], ch.accel(y[:m], y[m:])]
 
-    omega = 2 * np.sqrt(2 * PARAMS["plate_stiffness"] / (0.5 * 0.012 + 0.01)) * np.sin(np.pi / n)
-    t1 = periods * 2 * np.pi / omega
-    sol = solve_ivp(rhs, (0, t1), y0, method="DOP853", rtol=1e-10, atol=1e-14, dense_output=False)
+    omega = 2 * np.sqrt(2 * soft["plate_stiffness"] / (0.012 + 0.01)) * np.sin(np.pi / n)   # lowest link mode
+    sol = solve_ivp(rhs, (0, periods * 2 * np.pi / omega), np.r_[q0, v0], method="DOP853", rtol=rtol, atol=1e-4 * rtol)
     assert sol.success
-    E = [ch.kinetic_energy(y[m:]) + ch.potential_energy(y[:m]) for y in sol.y.T[:: max(1, sol.y.shape[1] // 50)]]
-    P = np.array([ch.momentum(y[m:]) for y in sol.y.T[:: max(1, sol.y.shape[1] // 50)]])
-    return np.array(E), P, ch.momentum(v0)
+    ys = sol.y.T[:: max(1, sol.y.shape[1] // 50)]
+    E = np.array([ch.kinetic_energy(y[m:]) + ch.potential_energy(y[:m]) for y in ys])
+    P = np.array([ch.momentum(y[m:]) for y in ys])
+    return E, P, ch.momentum(v0), sol.t.size
 
 
 def test_free_ring_conserves_momentum_and_energy():
-    E, P, P0 = _ring_run(periods=2)
+    E, P, P0, _ = _ring_run(periods=1, rtol=1e-8)
     assert np.abs(E - E[0]).max() < 1e-6 * E[0]
     assert np.abs(P - P0).max() < 1e-12 * max(np.abs(P0).max(), 1e-3)
 
 
 @pytest.mark.slow
 def test_free_ring_conserves_energy_over_many_periods():
-    E, P, P0 = _ring_run(periods=30)
+    E, P, P0, _ = _ring_run(periods=10, rtol=1e-9)
     assert np.abs(E - E[0]).max() < 1e-6 * E[0]
     assert np.abs(P - P0).max() < 1e-12 * max(np.abs(P0).max(), 1e-3)
 
