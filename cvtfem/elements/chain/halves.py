@@ -87,8 +87,8 @@ class ChainA5:
         ``c^k`` and the out-of-plane bending stiffness ``a^k`` (``c_1 = 4a/L``, ``c_2 = 2a/L``).
     plate_thickness : m
         ``h`` of the A4 moment bound ``|M| <= T h/2``.
-    plate_torsion_stiffness : (n,) N m/rad
-        Twist stiffness of each link (1.146).
+    plate_torsion_stiffness : (n, Kmax) N m/rad
+        Torsion stiffness of each plate; a link twists with their sum (1.146).
     plate_mass : (n,) kg
         Plate mass of each link (1.213).
     pin_length : m
@@ -181,7 +181,7 @@ class ChainA5:
         self.plate_c1, self.plate_c2 = P.bending_stiffnesses(a, L[:, None])
         self.plate_h = float(plate_thickness)
         self.plate_model = plate_model
-        self.c_twist = np.broadcast_to(np.asarray(plate_torsion_stiffness, float), (n,)) * link_w
+        self.c_twist = np.sum(np.broadcast_to(np.asarray(plate_torsion_stiffness, float), d.shape) * mask, 1) * link_w
         mpl = np.broadcast_to(np.asarray(plate_mass, float), (n,)) * link_w
         self.m_half = np.stack([0.5 * m + 0.5 * mpl, 0.5 * m + 0.5 * mpl[self._prev]])     # m-, m+ (1.213)
         self.m_axial = 0.5 * m
@@ -640,11 +640,13 @@ class ChainA5:
         pat.sort_indices()
         return pat
 
-    def jacobian(self, q: np.ndarray, v: np.ndarray, step: float = 1e-7) -> tuple[sp.csr_matrix, sp.csr_matrix]:
+    def jacobian(self, q: np.ndarray, v: np.ndarray, step: float = 1e-7,
+                 damping: bool = True) -> tuple[sp.csr_matrix, sp.csr_matrix | None]:
         """``(dQ/dq, dQ/dv)`` of :meth:`forces` by central differences over pin colours, on :attr:`jac_sparsity`.
 
         Pins five or more apart share a colour (the stencil is ``p-2..p+2``), so ``2 x 21 x colours``
-        force evaluations per matrix (6 colours for 84 pins).  ``step`` is relative to ``max(|x|, 1e-2 l)``.
+        force evaluations per matrix (6 colours for 84 pins).  ``step`` is relative to ``max(|x|, 1e-2 l)``;
+        ``damping=False`` skips ``dQ/dv`` (returned as None).
         """
         n = self.n_pins
         k = 5 if not self.closed else next((k for k in range(5, n + 1) if n % k == 0 or n % k >= 5), n)
@@ -652,11 +654,11 @@ class ChainA5:
         pat = self.jac_sparsity.tocoo()
         pin_of_row = np.empty(self.n2, int)
         pin_of_row[self.dof_index.ravel()] = np.repeat(np.arange(n), 21)
-        out = []
-        for wrt in (0, 1):
+        out = [None, None]
+        for wrt in (0, 1) if damping else (0,):
             x0 = (q, v)[wrt]
             data = np.zeros(pat.nnz)
-            for c in range(k):
+            for c in range(min(k, n)):
                 for j in range(21):
                     cols = self.dof_index[colour == c, j]
                     hcol = step * np.maximum(np.abs(x0[cols]), 1e-2 * self.l)
@@ -670,7 +672,7 @@ class ChainA5:
                     hh[cols] = hcol
                     # column of the perturbed coordinate whose pin is within reach of the row's pin
                     data[sel] = dQ[pat.row[sel]] / (2 * hh[pat.col[sel]])
-            out.append(sp.csr_matrix((data, (pat.row, pat.col)), shape=(self.n2, self.n2)))
+            out[wrt] = sp.csr_matrix((data, (pat.row, pat.col)), shape=(self.n2, self.n2))
         return out[0], out[1]
 
 

@@ -3,6 +3,7 @@ function, mass against quadrature, Jacobian against differences, a tensioned ope
 and the A2 half contact points over A1."""
 import numpy as np
 import pytest
+import scipy.linalg as sl
 from scipy.integrate import solve_ivp
 
 from cvtfem.elements.chain.asymmetric import ChainA1, shape_functions
@@ -19,7 +20,7 @@ DAMP = dict(beta_plate_ext=1e-6, beta_plate_shear=2e-6, beta_twist=1e-5, beta_be
             roll_damping=1e3, joint_damping=0.01)
 
 
-def chain(n=12, K=3, closed=True, seed=0, **over):
+def chain(n=8, K=2, closed=True, seed=0, **over):
     """An A5 chain with a lacing of ``K`` plates per link shifted by the link number (period 3)."""
     rng = np.random.default_rng(seed)
     d = np.tile(np.linspace(-0.01, 0.01, K), (n, 1)) + 1e-3 * (np.arange(n) % 3)[:, None]
@@ -50,12 +51,12 @@ def random_state(ch, rng, amp=3e-6):
 
 
 def grad(fun, x, h):
-    """Fourth-order central differences (truncation ~h^4, round-off ~eps |fun| / h)."""
+    """Central differences (exact for the quadratic Rayleigh function up to round-off)."""
     out = np.empty(x.size)
     for i in range(x.size):
         e = np.zeros(x.size)
         e[i] = h
-        out[i] = (8 * (fun(x + e) - fun(x - e)) - fun(x + 2 * e) + fun(x - 2 * e)) / (12 * h)
+        out[i] = (fun(x + e) - fun(x - e)) / (2 * h)
     return out
 
 
@@ -63,21 +64,23 @@ def relative_error(a, b):
     return np.abs(a - b).max() / np.abs(a).max()
 
 
-@pytest.mark.parametrize("term", TERMS)
-@pytest.mark.parametrize("model,closed", [("A4", True), ("A4", False), ("A3", True), ("A3-keep", True)])
+CASES = [("A4", closed, term) for closed in (True, False) for term in TERMS] + [("A3", True, "plates"),
+                                                                              ("A3-keep", True, "plates")]
+
+
+@pytest.mark.parametrize("model,closed,term", CASES)
 def test_elastic_forces_are_minus_energy_gradient(model, closed, term):
-    """One energy term at a time, so that a small term is not hidden by a large one."""
-    if term != "plates" and model != "A4":
-        pytest.skip("the plate law only changes the plate term")
+    """One energy term at a time, so that a small term is not hidden by a large one (the plate law only
+    changes the plate term)."""
     ch = chain(plate_model=model, closed=closed, stopper_play=1e-6)
     q = random_state(ch, np.random.default_rng(1))
     Q = ch.elastic_forces(q, (term,))
     assert np.abs(Q).max() > 0
-    assert relative_error(Q, -grad(lambda x: ch.potential_energy(x, (term,)), q, 1e-8)) < 1e-6
+    assert relative_error(Q, -grad(lambda x: ch.potential_energy(x, (term,)), q, 1e-9)) < 1e-6
 
 
 def test_every_contact_and_stopper_force_is_a_gradient():
-    """Hole contacts closed (zero clearance, ring of 8 at 45 degrees) and stoppers engaged (no play)."""
+    """Hole contacts closed (zero clearance, ring of 8 at 45 degrees), stoppers engaged (no play), rolling tie on."""
     ch = chain(hole_clearance=0.0, stopper_play=0.0, roll_tie=1e9)
     rng = np.random.default_rng(2)
     q = ring_state(ch, overlap=1e-6) + 2e-6 * rng.standard_normal(ch.n2)
@@ -86,7 +89,7 @@ def test_every_contact_and_stopper_force_is_a_gradient():
     assert parts["contacts"] > 0 and parts["stoppers"] > 0
     for term in ("contacts", "stoppers"):
         Q = ch.elastic_forces(q, (term,))
-        assert relative_error(Q, -grad(lambda x: ch.potential_energy(x, (term,)), q, 1e-8)) < 1e-6
+        assert relative_error(Q, -grad(lambda x: ch.potential_energy(x, (term,)), q, 1e-9)) < 1e-6
 
 
 @pytest.mark.parametrize("closed", [True, False])
@@ -151,9 +154,8 @@ def test_translations_and_rotation_about_k_leave_energy_unchanged():
     assert abs(Qw[:, 0].sum() + Qq.sum()) < 1e-9 * scale
 
 
-@pytest.mark.parametrize("closed", [True, False])
-def test_jacobian_equals_differences_and_stays_in_its_pattern(closed):
-    ch = chain(n=10, closed=closed, **DAMP)
+def test_jacobian_equals_differences_and_stays_in_its_pattern():
+    ch = chain(n=10, **DAMP)
     rng = np.random.default_rng(7)
     q, v = random_state(ch, rng), 0.01 * rng.standard_normal(ch.n2)
     K, C = ch.jacobian(q, v)
@@ -173,7 +175,7 @@ def test_jacobian_equals_differences_and_stays_in_its_pattern(closed):
 
 def test_open_segment_under_end_tension_carries_it_in_every_link():
     """Newton on all 21 n coordinates, end pins pulled by -+T (a quarter at each end of each half)."""
-    T, n = 2000.0, 5
+    T, n = 2000.0, 4
     ch = chain(n=n, closed=False, stopper_play=0.0)
     q = straight(ch)
     pins = np.repeat([0, n - 1], 4)
@@ -187,7 +189,7 @@ def test_open_segment_under_end_tension_carries_it_in_every_link():
         R = ch.forces(q, v) + Qext
         if np.abs(R).max() < 1e-9 * T:
             break
-        K, _ = ch.jacobian(q, v)
+        K, _ = ch.jacobian(q, v, damping=False)
         q = q + np.linalg.lstsq(-K.toarray(), R, rcond=1e-12)[0]
     assert np.abs(ch.forces(q, v) + Qext).max() < 1e-9 * T
     out = ch.outputs(q)
@@ -222,14 +224,14 @@ def _ring_run(periods, rtol, n=6):
 
 
 def test_free_ring_conserves_momentum_and_energy():
-    E, P, P0, _ = _ring_run(periods=1, rtol=1e-8)
+    E, P, P0, _ = _ring_run(periods=0.5, rtol=1e-8)
     assert np.abs(E - E[0]).max() < 1e-6 * E[0]
     assert np.abs(P - P0).max() < 1e-12 * max(np.abs(P0).max(), 1e-3)
 
 
 @pytest.mark.slow
 def test_free_ring_conserves_energy_over_many_periods():
-    E, P, P0, _ = _ring_run(periods=10, rtol=1e-9)
+    E, P, P0, _ = _ring_run(periods=5, rtol=1e-9)
     assert np.abs(E - E[0]).max() < 1e-6 * E[0]
     assert np.abs(P - P0).max() < 1e-12 * max(np.abs(P0).max(), 1e-3)
 
@@ -286,3 +288,36 @@ def test_bad_input_is_reported():
         chain(pitch=np.full(3, PITCH))
     with pytest.raises(InputError, match="h_pin"):
         CoupledHalvesA2(a1_chain(), 0.0)
+
+
+@pytest.mark.slow
+def test_locked_halves_approach_a1_lowest_frequencies():
+    """Stiff rolling contact with a no-slip tie, stiff stoppers without play: the lowest six nonzero frequencies
+    of an 8-pin ring (twist family; plate out-of-plane bending off, which A1 homogenises differently) agree with
+    A1's.  The A1 ring's joint mechanisms have zero frequency; in A5 the contact prestress of the linearisation
+    state (1e-10 m overlap) lifts them to a few hundred rad/s, below the compared band (> 3000 rad/s)."""
+    n, K, P = 8, 3, PITCH - 2 * H_PIN
+    xi = np.tile(np.linspace(-0.6, 0.6, K), (n, 1))
+    common = dict(n_plates=np.full(n, K), plate_stiffness=1e8, plate_bending_stiffness=0.0,
+                  plate_torsion_stiffness=50.0, pin_length=PIN_L, pin_axial_stiffness=2e8)
+    a1 = ChainA1(pitch=np.full(n, P), plate_xi=xi, pin_mass=np.full(n, 0.022), pin_bending_tau=2.8,
+                 pin_bending_n=17.2, use_numba=False, **common)
+    ang = 2 * np.pi * np.arange(n) / n
+    q1 = a1.rest_state(P / (2 * np.sin(np.pi / n)) * np.column_stack([np.cos(ang), np.sin(ang)]))
+    a5 = ChainA5(pitch=np.full(n, PITCH), plate_offset=PIN_L / 2 * xi, plate_thickness=1.5e-3,
+                 plate_mass=np.full(n, 0.01), pin_mass=np.full(n, 0.012), half_bending_tau=1.4, half_bending_n=8.6,
+                 h_pin=H_PIN, roll_radius=(0.004, 0.004), roll_stiffness=1e13, roll_tie=1e13, hole_radius=0.0045,
+                 back_radius=0.0024, back_extent=0.0025, hole_clearance=1.9e-3, hole_stiffness=1e9,
+                 stopper_stiffness=1e9, stopper_play=0.0, plate_model="A3-keep", **common)
+    q5 = ring_state(a5, overlap=1e-10)
+    K5, _ = a5.jacobian(q5, np.zeros(a5.n2), step=1e-9)
+
+    def omegas(K, M):
+        w2 = sl.eigh(-0.5 * (K + K.T), M, eigvals_only=True)
+        w = np.sqrt(np.abs(w2))
+        return np.sort(w[(w2 > 0) & (w > 3000.0)])[:6]
+
+    w1 = omegas(a1.stiffness_matrix(q1).toarray(), a1.mass_matrix.toarray())
+    w5 = omegas(K5.toarray(), a5.mass_matrix.toarray())
+    assert w1[0] > 6000
+    assert np.allclose(w5, w1, rtol=1e-2)
