@@ -4,9 +4,10 @@
 
 The reference chain of :func:`cvtfem.elements.chain.geometry.reference_geometry` with halves (contact and
 stopper parameters assumed, as in docs/chain.md) on a perturbed ring, friction and all damping on.  Prints
-the machine and its load with the medians of 1,000 calls of ``elastic_forces``, ``forces`` (elastic,
-damping, friction) and ``accel`` (plus the mass solve), and of 3 calls of the coloured-difference
-``jacobian`` (both matrices).  A5 has no compiled kernel yet: numpy only.
+the machine and its load with the medians of 1,000 calls of ``forces`` (elastic, damping, friction) and
+``accel`` (plus the mass solve) with the plate pass compiled (numba, ``plates_kernel``) and in numpy (the
+twin; everything else is numpy in both), and of 3 calls of the coloured-difference ``jacobian`` (both
+matrices, numba plate pass).
 """
 import os
 import platform
@@ -27,7 +28,7 @@ def machine() -> str:
             f"load {os.getloadavg()[0]:.1f}, Python {platform.python_version()}, numpy {np.__version__}")
 
 
-def build() -> ChainA5:
+def build(use_numba: bool) -> ChainA5:
     """The reference chain (84 pins, l = 33 mm, 12 plates/link, 1.4e9 N/m per link) split into halves."""
     g = reference_geometry()
     n = g.n
@@ -39,7 +40,8 @@ def build() -> ChainA5:
                    hole_radius=0.0031, back_radius=0.0024, back_extent=0.0025, hole_clearance=5e-4,
                    hole_stiffness=1e11, stopper_stiffness=1e6, stopper_play=5e-4, friction_coefficient=0.1,
                    friction_speed=1e-3, friction_law="smooth", half_axial_damping=2.0, beta_plate_ext=1e-6,
-                   beta_plate_shear=1e-6, beta_twist=1e-6, beta_bend=1e-7, joint_damping=1e-4)
+                   beta_plate_shear=1e-6, beta_twist=1e-6, beta_bend=1e-7, joint_damping=1e-4,
+                   use_numba=use_numba)
 
 
 def median_us(fun, calls: int = 1000) -> float:
@@ -52,22 +54,21 @@ def median_us(fun, calls: int = 1000) -> float:
 
 
 def main() -> None:
-    ch = build()
+    ch = build(True)
     rng = np.random.default_rng(0)
     q = ring_state(ch, stretch=2e-6, overlap=1e-6) + 1e-7 * rng.standard_normal(ch.n2)
     v = 0.01 * rng.standard_normal(ch.n2)
     lines = [f"machine: {machine()}",
              f"A5 chain: {ch.n_pins} pins x 21 = {ch.n2} coordinates, {ch.kmax} plates/link, plate model {ch.plate_model}"]
     rhs = None
-    for name, fun in (("elastic_forces", lambda: ch.elastic_forces(q)), ("forces (damping, friction)", lambda: ch.forces(q, v)),
-                      ("accel", lambda: ch.accel(q, v))):
-        fun()
-        t = median_us(fun)
-        rhs = t if rhs is None or name.startswith("forces") else rhs
-        lines.append(f"numpy  {name:<28} median of 1000: {t:9.1f} us")
+    for c in (ch, build(False)):
+        for name, fun in (("forces (damping, friction)", lambda: c.forces(q, v)), ("accel", lambda: c.accel(q, v))):
+            fun()
+            t = median_us(fun)
+            rhs = t if rhs is None else rhs
+            lines.append(f"{c.backend:<6} {name:<28} median of 1000: {t:9.1f} us")
     t = median_us(lambda: ch.jacobian(q, v), 3)
-    lines.append(f"numpy  {'jacobian (dQ/dq, dQ/dv)':<28} median of 3:    {t:9.1f} us = {t / rhs:.0f} force evaluations")
-    lines.append("numba  no compiled A5 kernel yet")
+    lines.append(f"numba  {'jacobian (dQ/dq, dQ/dv)':<28} median of 3:    {t:9.1f} us = {t / rhs:.0f} force evaluations")
     lines.append(f"machine after: {machine()}")
     print("\n".join(lines))
     OUT.mkdir(parents=True, exist_ok=True)

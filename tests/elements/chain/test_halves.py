@@ -321,3 +321,18 @@ def test_locked_halves_approach_a1_lowest_frequencies():
     w5 = omegas(K5.toarray(), a5.mass_matrix.toarray())
     assert w1[0] > 6000
     assert np.allclose(w5, w1, rtol=1e-2)
+
+
+@pytest.mark.parametrize("model,closed", [("A4", True), ("A4", False), ("A3", True), ("A3-keep", True)])
+def test_compiled_plate_pass_equals_numpy_twin(model, closed):
+    kw = dict(plate_model=model, closed=closed, friction_coefficient=0.1, **DAMP)
+    fast, ref = chain(**kw), chain(use_numba=False, **kw)
+    rng = np.random.default_rng(12)
+    q, v = random_state(ref, rng, amp=2e-5), 0.05 * rng.standard_normal(ref.n2)
+    Qf, Qr = fast.forces(q, v), ref.forces(q, v)
+    assert relative_error(Qr, Qf) < 1e-11
+    of, orf = fast._evaluate(q, v, fast=True)["out"], ref.outputs(q, v)
+    for key in ("chain.plate_tension", "chain.plate_state", "chain.link_tension"):
+        assert np.allclose(of[key], orf[key], rtol=1e-11, atol=1e-9)
+    if model == "A4":
+        assert len(set(orf["chain.plate_state"])) > 2                       # several plate states met
