@@ -256,7 +256,8 @@ class ChainA5:
         return (OutputSpec("chain.link_tension", "N", "Sum of the plate tensions of each link.", n),
                 OutputSpec("chain.plate_tension", "N", "Plate tension T = c Delta~, links x Kmax.", n * k),
                 OutputSpec("chain.plate_state", "1", "Plate contact state 1..10 (10 slack), links x Kmax.", n * k),
-                OutputSpec("chain.pin_half_axial_force", "N", "Half axial force c_p/2 Delta (1.214), half -, half +.", 2 * n),
+                OutputSpec("chain.pin_half_axial_force", "N", "Half axial force c_p/2 Delta (1.214), half -, half +.",
+                           2 * n),
                 OutputSpec("chain.roll_force", "N", "Normal force of the half-half rolling contact of each pin.", n),
                 OutputSpec("chain.half_slip", "m/s", "Axial slip w_0+' - w_0-' of the halves (1.221).", n),
                 OutputSpec("chain.half_pack_slip", "m/s", "Axial slip w_0' - q' of half -, half + on the pack.", 2 * n),
@@ -674,7 +675,8 @@ class ChainA5:
 
     def point_loads(self, pins: np.ndarray, half: np.ndarray, xi: np.ndarray, force: np.ndarray,
                     moment: np.ndarray | None = None) -> np.ndarray:
-        """Generalized forces of forces ``(m, 3)`` N and in-plane moments ``(m, 2)`` N m at half-axis points (spec 2.7 per half)."""
+        """Generalized forces of forces ``(m, 3)`` N and in-plane moments ``(m, 2)`` N m at half-axis points
+        (spec 2.7 per half)."""
         n, view = self.n_pins, self._half_view()
         pins, half, xi = np.asarray(pins), np.asarray(half), np.asarray(xi, float)
         force = np.asarray(force, float).reshape(-1, 3)

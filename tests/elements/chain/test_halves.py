@@ -204,8 +204,8 @@ def test_open_segment_under_end_tension_carries_it_in_every_link():
 def _ring_run(periods, rtol, n=6):
     """A free 6-pin ring (soft parameters: highest frequency ~7x the lowest link mode), DOP853."""
     soft = dict(plate_stiffness=1e8, plate_bending_stiffness=0.03, plate_torsion_stiffness=5.0,
-                pin_axial_stiffness=2e6, half_bending_tau=0.05, half_bending_n=0.1, roll_stiffness=1e9, hole_stiffness=1e9, hole_clearance=1.2e-3,
-                hole_radius=0.0038, stopper_play=0.0, plate_model="A3-keep")
+                pin_axial_stiffness=2e6, half_bending_tau=0.05, half_bending_n=0.1, roll_stiffness=1e9,
+                hole_stiffness=1e9, hole_clearance=1.2e-3, hole_radius=0.0038, stopper_play=0.0, plate_model="A3-keep")
     ch = chain(n=n, K=2, **soft)
     q0 = ring_state(ch, stretch=2e-6, overlap=2e-6)
     v0 = 0.02 * np.random.default_rng(8).standard_normal(ch.n2)
@@ -250,8 +250,9 @@ def test_point_loads_are_the_virtual_work_at_half_axis_points():
 
 def a1_chain(n=8, closed=True):
     rng = np.random.default_rng(10)
-    return ChainA1(pitch=np.full(n if closed else n - 1, PITCH), plate_xi=np.tile(np.linspace(-0.8, 0.8, 4), (n if closed else n - 1, 1)),
-                   n_plates=np.full(n if closed else n - 1, 4), plate_stiffness=1e8, plate_bending_stiffness=0.3,
+    e = n if closed else n - 1
+    return ChainA1(pitch=np.full(e, PITCH), plate_xi=np.tile(np.linspace(-0.8, 0.8, 4), (e, 1)),
+                   n_plates=np.full(e, 4), plate_stiffness=1e8, plate_bending_stiffness=0.3,
                    plate_torsion_stiffness=50.0, pin_length=PIN_L, pin_mass=0.02 * (1 + 0.1 * rng.random(n)),
                    pin_axial_stiffness=2e8, pin_bending_tau=2.8, pin_bending_n=17.2, closed=closed, use_numba=False)
 
