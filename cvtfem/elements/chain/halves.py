@@ -178,7 +178,11 @@ class ChainA5:
             lm[n - 1], lp[0] = n - 2, 0
         self.axis_link = np.stack([lm, lp])
         self.plate_w = mask * link_w[:, None]
-        fill = lambda a: np.where(mask, a, a[:, :1])          # padded plates copy plate 0 (weight 0, no NaN)
+
+        def fill(a):
+            """Padded plates copy plate 0 (weight 0; keeps the plate law free of 0/0)."""
+            return np.where(mask, a, a[:, :1])
+
         self.plate_d = fill(d)
         self.plate_c = fill(np.broadcast_to(np.asarray(plate_stiffness, float), d.shape))
         a = fill(np.broadcast_to(np.asarray(plate_bending_stiffness, float), d.shape))
@@ -717,8 +721,6 @@ class ChainA5:
         k = 5 if not self.closed else next((k for k in range(5, n + 1) if n % k == 0 or n % k >= 5), n)
         colour = np.arange(n) % k
         pat = self.jac_sparsity.tocoo()
-        pin_of_row = np.empty(self.n2, int)
-        pin_of_row[self.dof_index.ravel()] = np.repeat(np.arange(n), 21)
         out = [None, None]
         for wrt in (0, 1) if damping else (0,):
             x0 = (q, v)[wrt]
@@ -732,11 +734,8 @@ class ChainA5:
                     args_p = (q + e, v) if wrt == 0 else (q, v + e)
                     args_m = (q - e, v) if wrt == 0 else (q, v - e)
                     dQ = self.forces(*args_p) - self.forces(*args_m)
-                    sel = np.isin(pat.col, cols)
-                    hh = np.zeros(self.n2)
-                    hh[cols] = hcol
-                    # column of the perturbed coordinate whose pin is within reach of the row's pin
-                    data[sel] = dQ[pat.row[sel]] / (2 * hh[pat.col[sel]])
+                    sel = np.isin(pat.col, cols)       # a row sees at most one perturbed pin of the colour
+                    data[sel] = dQ[pat.row[sel]] / (2 * e[pat.col[sel]])
             out[wrt] = sp.csr_matrix((data, (pat.row, pat.col)), shape=(self.n2, self.n2))
         return out[0], out[1]
 
