@@ -32,6 +32,10 @@ twist, joint damping (1.80) with the exact gradient, contact normal damping whil
 tension proxies, and regularised Coulomb on the rolling slip of every contact (digest proposal), all
 through :mod:`cvtfem.elements.contact.friction`.
 
+**Backends.** With ``use_numba`` the plate pass of :meth:`ChainA5.forces` runs in the compiled
+``plates_kernel`` (plate ends as virtual whole pins); the numpy pass here is its tested twin.  The
+Jacobian is coloured central differences of the forces on the 5-pin stencil.
+
 **A2** (:class:`CoupledHalvesA2`): the whole pins of :class:`ChainA1` with two half-pin end points
 per pin end, ``U(xi_e) +- h_pin tau_p`` (1.210), and the exact virtual work of a force there.
 """
