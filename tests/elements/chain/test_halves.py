@@ -231,7 +231,7 @@ def test_free_ring_conserves_momentum_and_energy():
 
 @pytest.mark.slow
 def test_free_ring_conserves_energy_over_many_periods():
-    E, P, P0, _ = _ring_run(periods=5, rtol=1e-9)
+    E, P, P0, _ = _ring_run(periods=20, rtol=1e-9)
     assert np.abs(E - E[0]).max() < 1e-6 * E[0]
     assert np.abs(P - P0).max() < 1e-12 * max(np.abs(P0).max(), 1e-3)
 
