@@ -201,32 +201,51 @@ def test_open_segment_under_end_tension_carries_it_in_every_link():
     assert np.allclose(out["chain.roll_force"][[0, n - 1]], T / 2, rtol=1e-6)  # end pins: the free half's share
 
 
-def _ring_run(periods, rtol, n=6):
-    """A free 6-pin ring (soft parameters: highest frequency ~7x the lowest link mode), DOP853."""
+def _ring_run(periods, rtol, n=6, lossy=False):
+    """A free 6-pin ring (soft parameters: highest frequency ~7x the lowest link mode), DOP853.
+
+    ``lossy``: damping and friction on, and the state carries the dissipated energy ``D' = 2 Phi - P_friction``;
+    returns ``E + D`` then."""
     soft = dict(plate_stiffness=1e8, plate_bending_stiffness=0.03, plate_torsion_stiffness=5.0,
                 pin_axial_stiffness=2e6, half_bending_tau=0.05, half_bending_n=0.1, roll_stiffness=1e9,
                 hole_stiffness=1e9, hole_clearance=1.2e-3, hole_radius=0.0038, stopper_play=0.0, plate_model="A3-keep")
+    if lossy:
+        soft.update(friction_coefficient=0.1, friction_speed=0.05, friction_law="smooth", **DAMP)
     ch = chain(n=n, K=2, **soft)
     q0 = ring_state(ch, stretch=2e-6, overlap=2e-6)
     v0 = 0.02 * np.random.default_rng(8).standard_normal(ch.n2)
     m = ch.n2
 
     def rhs(t, y):
-        return np.r_[y[m:], ch.accel(y[:m], y[m:])]
+        q, v = y[:m], y[m:2 * m]
+        if not lossy:
+            return np.r_[v, ch.accel(q, v)]
+        r = ch._evaluate(q, v)                                   # one pass: forces, Phi and friction together
+        Q = r["friction"] - r["grad"] - r["gradv"]
+        return np.r_[v, ch._lu.solve(Q), 2 * sum(r["Phi"].values()) - v @ r["friction"]]
 
     omega = 2 * np.sqrt(2 * soft["plate_stiffness"] / (0.012 + 0.01)) * np.sin(np.pi / n)   # lowest link mode
-    sol = solve_ivp(rhs, (0, periods * 2 * np.pi / omega), np.r_[q0, v0], method="DOP853", rtol=rtol, atol=1e-4 * rtol)
+    y0 = np.r_[q0, v0, [0.0] if lossy else []]
+    sol = solve_ivp(rhs, (0, periods * 2 * np.pi / omega), y0, method="DOP853", rtol=rtol, atol=1e-4 * rtol)
     assert sol.success
     ys = sol.y.T[:: max(1, sol.y.shape[1] // 50)]
-    E = np.array([ch.kinetic_energy(y[m:]) + ch.potential_energy(y[:m]) for y in ys])
-    P = np.array([ch.momentum(y[m:]) for y in ys])
-    return E, P, ch.momentum(v0), sol.t.size
+    E = np.array([ch.kinetic_energy(y[m:2 * m]) + ch.potential_energy(y[:m]) + (y[-1] if lossy else 0.0) for y in ys])
+    P = np.array([ch.momentum(y[m:2 * m]) for y in ys])
+    return E, P, ch.momentum(v0), sol.y[-1, -1] if lossy else 0.0
 
 
 def test_free_ring_conserves_momentum_and_energy():
     E, P, P0, _ = _ring_run(periods=0.5, rtol=1e-8)
     assert np.abs(E - E[0]).max() < 1e-6 * E[0]
     assert np.abs(P - P0).max() < 1e-12 * max(np.abs(P0).max(), 1e-3)
+
+
+def test_damped_ring_with_friction_loses_exactly_its_dissipated_energy():
+    """E + int (2 Phi - Q_friction . v) dt stays constant while a good part of E is dissipated."""
+    E, P, P0, lost = _ring_run(periods=0.2, rtol=1e-8, lossy=True)
+    assert lost > 0.05 * E[0]
+    assert np.abs(E - E[0]).max() < 1e-6 * lost
+    assert np.abs(P - P0).max() < 1e-12 * np.abs(P0).max()               # internal forces, friction included
 
 
 @pytest.mark.slow
