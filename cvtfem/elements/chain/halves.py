@@ -725,6 +725,10 @@ class ChainA5:
         k = 5 if not self.closed else next((k for k in range(5, n + 1) if n % k == 0 or n % k >= 5), n)
         colour = np.arange(n) % k
         pat = self.jac_sparsity.tocoo()
+        group = np.empty(self.n2, int)                    # (colour, slot) of every coordinate
+        group[self.dof_index] = colour[:, None] * 21 + np.arange(21)[None, :]
+        order = np.argsort(group[pat.col], kind="stable")
+        bounds = np.searchsorted(group[pat.col][order], np.arange(21 * k + 1))
         out = [None, None]
         for wrt in (0, 1) if damping else (0,):
             x0 = (q, v)[wrt]
@@ -732,13 +736,13 @@ class ChainA5:
             for c in range(min(k, n)):
                 for j in range(21):
                     cols = self.dof_index[colour == c, j]
-                    hcol = step * np.maximum(np.abs(x0[cols]), 1e-2 * self.l)
                     e = np.zeros(self.n2)
-                    e[cols] = hcol
+                    e[cols] = step * np.maximum(np.abs(x0[cols]), 1e-2 * self.l)
                     args_p = (q + e, v) if wrt == 0 else (q, v + e)
                     args_m = (q - e, v) if wrt == 0 else (q, v - e)
                     dQ = self.forces(*args_p) - self.forces(*args_m)
-                    sel = np.isin(pat.col, cols)       # a row sees at most one perturbed pin of the colour
+                    g = 21 * c + j
+                    sel = order[bounds[g]:bounds[g + 1]]  # a row sees at most one perturbed pin of the colour
                     data[sel] = dQ[pat.row[sel]] / (2 * e[pat.col[sel]])
             out[wrt] = sp.csr_matrix((data, (pat.row, pat.col)), shape=(self.n2, self.n2))
         return out[0], out[1]
