@@ -51,9 +51,9 @@ def write_csv(result, probe: int, path: str) -> None:
                     "peak_moment_backlash_Nm", "peak_moment_no_backlash_Nm"] + [f"amplitude_{n}_m" for n in net.names])
         for k, f in enumerate(result.omega):
             fm = result.floquet_max[k]
-            w.writerow([repr(f / (2 * np.pi)), repr(f), int(result.requested[k]), int(result.turning[k]),
-                        "" if np.isnan(fm) else int(fm < 1), "" if np.isnan(fm) else repr(fm),
-                        repr(pk_nl[k]), repr(pk_lin[k])] + [repr(x) for x in amp[k]])
+            w.writerow([float(f / (2 * np.pi)), float(f), int(result.requested[k]), int(result.turning[k]),
+                        "" if np.isnan(fm) else int(fm < 1), "" if np.isnan(fm) else float(fm),
+                        float(pk_nl[k]), float(pk_lin[k])] + amp[k].tolist())
 
 
 def run(args: argparse.Namespace) -> int:
