@@ -25,7 +25,7 @@ from cvtfem.periodic.hb import (PeriodicSolution, _symmetrize, default_samples, 
                                 newton, prepare, single_thread_blas, solve_periodic)
 
 #: Corrector iterations the step control aims at: ``ds *= clip(TARGET_ITERATIONS / its, 1/2, 2)``.
-TARGET_ITERATIONS = 3
+TARGET_ITERATIONS = 4
 #: Fold location: at most this many regula-falsi steps, stopping when ``|d omega / ds| <= FOLD_TOL``
 #: (scaled: ``omega`` by the start frequency).
 FOLD_ITERATIONS, FOLD_TOL = 8, 1e-6

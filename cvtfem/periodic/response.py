@@ -18,10 +18,13 @@ from cvtfem.elements.torsional import LINEAR, TorsionalNetwork
 from cvtfem.errors import NumericalError
 from cvtfem.periodic.continuation import Branch, continuation
 from cvtfem.periodic.hb import PeriodicSolution, solve_linear, solve_periodic
-from cvtfem.periodic.stability import floquet
+from cvtfem.periodic.stability import evaluations_estimate, floquet
 
 #: Samples per period for peaks and RMS values.
 SAMPLES = 2048
+#: Largest estimated right-hand-side evaluations of one Floquet integration a sweep spends (about 15 s
+#: for the 29-disk engine train); stiffer networks get no stability and a warning.
+FLOQUET_BUDGET = 2e5
 
 
 @dataclass(frozen=True)
@@ -146,6 +149,12 @@ def response_sweep(net: TorsionalNetwork, omegas: np.ndarray, N: int, samples: i
     sols = tuple(branch.solutions[k] for k in keep)
     omega = np.array([s.omega for s in sols])
     warnings = _fold_warnings(nl_net, branch, first, sols[-1], w0, w1, N, samples, tol)
+    cost = evaluations_estimate(nl_net, float(omega.min()))
+    if stability and cost > FLOQUET_BUDGET:
+        stability = False
+        warnings += (f"Floquet stability skipped: the variational equations would need about {cost:.2g} "
+                     f"right-hand-side evaluations per point (budget {FLOQUET_BUDGET:.0e}; stiff links "
+                     f"against a period of {2 * np.pi / omega.min():.3g} s)",)
     fmax = np.array([floquet(s, rtol=floquet_rtol).spectral_radius if stability else np.nan for s in sols])
     lin = tuple(solve_linear(net, w, N) for w in omega)
     return ResponseSweep(omega, sols, lin, wall, np.isin(keep, branch.targets), np.isin(keep, branch.turning_points),

@@ -200,3 +200,21 @@ def test_cli_warns_once_when_the_sweep_starts_inside_the_fold_range(cli, scene):
     assert len(lines) == 1 and "warning" in lines[0] and "11 Hz" in lines[0] and "multi-valued" in lines[0]
     clean = cli("periodic", str(scene), "--sweep", "6:9:4", "--no-stability")
     assert clean.returncode == 0 and clean.stderr == ""
+
+
+@pytest.mark.slow
+def test_time_integration_settles_on_the_stable_branches_and_leaves_the_unstable_one(up):
+    from cvtfem.periodic.transient import steady_state
+
+    net = stop_oscillator()
+    at = np.flatnonzero(np.isclose(up.omega, 1.1, atol=1e-12))      # upper, middle, lower
+    amp = up.amplitudes()[at, 0]
+
+    def settle(k, factor=1.0):
+        ss = steady_state(net, 1.1, rtol=1e-9, atol=1e-12, tol=1e-7, y0=up.nonlinear[k].state() * factor)
+        return float(np.ptp(ss.x) / 2)
+
+    assert settle(at[0]) == pytest.approx(amp[0], rel=1e-4)         # HB truncation N = 16: 1.2e-5 seen
+    assert settle(at[2]) == pytest.approx(amp[2], rel=1e-4)
+    assert settle(at[1], 1.01) == pytest.approx(amp[0], rel=1e-4)   # a 1 % push off the middle branch
+    assert settle(at[1], 0.99) == pytest.approx(amp[2], rel=1e-4)   # falls to either stable one
