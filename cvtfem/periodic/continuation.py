@@ -3,8 +3,8 @@
 Follows the branch ``r(a, omega) = 0`` through turning points (where sweeps up
 and down jump), with the bordered (Keller) corrector: two block-sweep solves
 per iteration, ``J z1 = -r`` and ``J z2 = -dr/domega``.  Variables are scaled
-(harmonics by the start's RMS amplitude, ``omega`` by its start value) so the
-arclength mixes comparable numbers.  The tangent at every accepted point is the
+(harmonics by the largest RMS amplitude met so far, ``omega`` by its start value)
+so the arclength mixes comparable numbers on the way up a resonance and down.  The tangent at every accepted point is the
 null vector of ``[J, dr/domega]`` (one more solve), oriented along the previous
 one: its ``omega`` component changes sign exactly at a fold, which is then located
 by regula falsi on that component.  The step adapts to
@@ -117,11 +117,11 @@ def continuation(net: TorsionalNetwork, omega_start: float, omega_stop: float, N
         D = net.incidence()
         p = load_harmonics(net, N)
         scale_p = max(np.linalg.norm(p), 1e-300)
-        A = max(np.linalg.norm(first.a) / np.sqrt(first.a.size), 1e-300)
+        scale = [max(np.linalg.norm(first.a) / np.sqrt(first.a.size), 1e-300)]  # grows with the response
         W = omega_start
 
         def dot(ua, uw, va, vw):
-            return float(np.vdot(ua, va).real / A ** 2 + uw * vw / W ** 2)
+            return float(np.vdot(ua, va).real / scale[0] ** 2 + uw * vw / W ** 2)
 
         def jacobian(w, a):
             r, Nd, Ld, dense, Ldense = linearize_mixed(net, w, a, p, M, D)
@@ -211,31 +211,36 @@ def continuation(net: TorsionalNetwork, omega_start: float, omega_stop: float, N
                 continue
             steps += 1
             length = np.sqrt(dot(a_c - a, w_c - omega, a_c - a, w_c - omega))
-            extra = []  # (solution, kind) inside this step
-            inside = (goals - omega) * (w_c - goals) > 0
-            for goal in sorted(goals[inside], key=lambda g: abs(g - omega)):
-                hit = land(goal, a, omega, a_c, w_c, length)
-                if hit is not None:
-                    extra.append((hit, "target"))
-                else:  # ill-conditioned next to a fold: the nearer branch point stands for it
-                    hits.append(base if abs(omega - goal) <= abs(w_c - goal) else -1)
-            if new_tw * tw < 0:
-                fold = refine_fold(a, omega, ta, tw, ds, new_tw)
-                if fold is not None:
-                    extra.append((fold, "fold"))
-                else:
-                    turns.append(base if abs(tw) <= abs(new_tw) else -1)
-            for sol, kind in sorted(extra, key=lambda e: dot(e[0].a - a, e[0].omega - omega, e[0].a - a,
-                                                              e[0].omega - omega)):
-                sols.append(sol)
-                (hits if kind == "target" else turns).append(len(sols) - 1)
-            sols.append(PeriodicSolution(net, w_c, a_c, True, its - 1, (), "sweep", "converged", M))
+            fold = refine_fold(a, omega, ta, tw, ds, new_tw) if new_tw * tw < 0 else None
+            new = PeriodicSolution(net, w_c, a_c, True, its - 1, (), "sweep", "converged", M)
+            if new_tw * tw < 0 and fold is None:  # not located: the nearer step point stands for the fold
+                turns.append(base if abs(tw) <= abs(new_tw) else -1)
+            ends = [sols[base]] + ([fold] if fold is not None else []) + [new]
+            start_index = base
+            for first_end, end in zip(ends[:-1], ends[1:]):  # a fold splits the step: omega monotonic in each part
+                w0, w1 = first_end.omega, end.omega
+                for goal in sorted(goals[(goals - w0) * (w1 - goals) > 0], key=lambda g: abs(g - w0)):
+                    hit = land(goal, first_end.a, w0, end.a, w1, length)
+                    if hit is not None:
+                        sols.append(hit)
+                        hits.append(len(sols) - 1)
+                    else:  # ill-conditioned next to a fold: the nearer end stands for it (-1: ``end``)
+                        hits.append(start_index if abs(w0 - goal) <= abs(w1 - goal) else -1)
+                sols.append(end)
+                start_index = len(sols) - 1
+                hits = [start_index if h == -1 else h for h in hits]
+                if end is fold:
+                    turns.append(len(sols) - 1)
             base = len(sols) - 1
-            hits = [base if h == -1 else h for h in hits]
             turns = [base if t == -1 else t for t in turns]
             if np.any(goals == w_c):
                 hits.append(base)
             a, omega, ta, tw = a_c, w_c, new_ta, new_tw
+            rms = np.linalg.norm(a) / np.sqrt(a.size)
+            if rms > scale[0]:  # rescale to the largest response so far; the tangent keeps unit length
+                scale[0] = rms
+                norm = np.sqrt(dot(ta, tw, ta, tw))
+                ta, tw = ta / norm, tw / norm
             ds = float(np.clip(ds * np.clip(TARGET_ITERATIONS / max(its - 1, 1), 0.5, 2.0), ds_min, ds_max))
     folds = tuple(float(sols[t].omega) for t in turns)
     return Branch(tuple(sols), tuple(turns), folds, tuple(hits), steps, rejected, message,
