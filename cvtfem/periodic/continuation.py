@@ -161,8 +161,9 @@ def continuation(net: TorsionalNetwork, omega_start: float, omega_stop: float, N
             return PeriodicSolution(net, goal, a_g, True, len(hist) - 1, tuple(hist), "sweep", "converged", M)
 
         def refine_fold(a0_, w0, ta0, tw0, h, tw1):
-            """The fold inside a step of length ``h`` from ``(a0_, w0)``: regula falsi (Illinois) on the
-            tangent's ``omega`` component along the step; None if a corrector fails."""
+            """The fold inside a step of length ``h`` from ``(a0_, w0)``: regula falsi on the tangent's
+            ``omega`` component along the step, the kept end's value halved (Illinois-type); None if the
+            first corrector fails."""
             lo, hi, f_lo, f_hi, best = 0.0, h, tw0, tw1, None
             for _ in range(FOLD_ITERATIONS):
                 mid = lo + (hi - lo) * f_lo / (f_lo - f_hi)

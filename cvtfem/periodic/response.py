@@ -25,6 +25,8 @@ SAMPLES = 2048
 #: Largest estimated right-hand-side evaluations of one Floquet integration a sweep spends (about 15 s
 #: for the 29-disk engine train); stiffer networks get no stability and a warning.
 FLOQUET_BUDGET = 2e5
+#: A multi-valued end is looked for beyond it over ``max(EXTENSION x span, EXTENSION_RELATIVE x frequency)``.
+EXTENSION, EXTENSION_RELATIVE = 0.25, 0.1
 
 
 @dataclass(frozen=True)
@@ -166,11 +168,12 @@ def _fold_warnings(net, branch: Branch, first: PeriodicSolution, last: PeriodicS
     """Why an end of the range is multi-valued: the branch re-crosses it, or folds just outside it."""
     if w0 == w1 or not (net.law != LINEAR).any():
         return ()
-    sign, span = np.sign(w1 - w0), 0.25 * abs(w1 - w0)
+    sign = np.sign(w1 - w0)
     out = []
     for end, sol, away, name in ((w0, first, -sign, "starts"), (w1, last, sign, "ends")):
-        beyond = branch.omega[(branch.omega - end) * away > 0]
-        fold = float(beyond[np.argmax((beyond - end) * away)]) if name == "starts" and beyond.size else None
+        span = max(EXTENSION * abs(w1 - w0), EXTENSION_RELATIVE * end)
+        beyond = [f for f in branch.fold_omega if (f - end) * away > 0]  # the branch turned back across `end`
+        fold = max(beyond, key=lambda f: (f - end) * away) if beyond else None
         if fold is None:
             try:
                 ext = continuation(net, end, max(end + away * span, end / 2), N, samples=samples, tol=tol, a0=sol.a,

@@ -218,3 +218,10 @@ def test_time_integration_settles_on_the_stable_branches_and_leaves_the_unstable
     assert settle(at[2]) == pytest.approx(amp[2], rel=1e-4)
     assert settle(at[1], 1.01) == pytest.approx(amp[0], rel=1e-4)   # a 1 % push off the middle branch
     assert settle(at[1], 0.99) == pytest.approx(amp[2], rel=1e-4)   # falls to either stable one
+
+
+def test_sweep_ending_inside_the_fold_range_names_the_fold_beyond(up):
+    sweep = response_sweep(stop_oscillator(), np.linspace(0.9, 1.1, 3), N, samples=M, stability=False)
+    assert not sweep.turning.any() and len(sweep.warnings) == 1
+    fold_hz = max(up.branch.fold_omega) / (2 * np.pi)
+    assert "ends at" in sweep.warnings[0] and f"{fold_hz:.6g} Hz" in sweep.warnings[0]
