@@ -6,10 +6,11 @@ per iteration, ``J z1 = -r`` and ``J z2 = -dr/domega``.  Variables are scaled
 (harmonics by the largest RMS amplitude met so far, ``omega`` by its start value)
 so the arclength mixes comparable numbers on the way up a resonance and down.
 The tangent at every accepted point is the null vector of ``[J, dr/domega]``
-(one more solve), oriented along the previous one: its ``omega`` component changes sign exactly at a fold, which is then located
-by regula falsi on that component.  The step adapts to
-the corrector's iteration count; requested frequencies (``targets``) are landed
-on exactly by Newton at fixed ``omega`` from the interpolated branch.
+(one more solve), oriented along the previous one: its ``omega`` component
+changes sign exactly at a fold, which is then located by regula falsi on that
+component.  The step adapts to the corrector's iteration count; requested
+frequencies (``targets``) are landed on exactly by Newton at fixed ``omega``
+from the interpolated branch.
 """
 from __future__ import annotations
 
