@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 
 from cvtfem.elements.torsional import LINEAR, TorsionalNetwork
-from cvtfem.errors import NumericalError
+from cvtfem.errors import InputError, NumericalError
 from cvtfem.periodic.continuation import Branch, continuation
 from cvtfem.periodic.hb import PeriodicSolution, solve_linear, solve_periodic
 from cvtfem.periodic.stability import evaluations_estimate, floquet
@@ -138,6 +138,9 @@ def response_sweep(net: TorsionalNetwork, omegas: np.ndarray, N: int, samples: i
         When the continuation cannot reach ``omegas[-1]``.
     """
     omegas = np.asarray(omegas, float)
+    steps = np.diff(omegas)
+    if not (omegas.ndim == 1 and omegas.size and (np.all(steps > 0) or np.all(steps < 0))):
+        raise InputError("omegas", omegas.tolist(), "must be one frequency or strictly increasing or decreasing")
     nl_net = net if backlash else net.linearized("contact")
     w0, w1 = float(omegas[0]), float(omegas[-1])
     start = time.perf_counter()

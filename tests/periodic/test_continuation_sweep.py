@@ -225,3 +225,10 @@ def test_sweep_ending_inside_the_fold_range_names_the_fold_beyond(up):
     assert not sweep.turning.any() and len(sweep.warnings) == 1
     fold_hz = max(up.branch.fold_omega) / (2 * np.pi)
     assert "ends at" in sweep.warnings[0] and f"{fold_hz:.6g} Hz" in sweep.warnings[0]
+
+
+def test_requested_frequencies_must_be_monotonic():
+    from cvtfem.errors import InputError
+
+    with pytest.raises(InputError, match="strictly increasing or decreasing"):
+        response_sweep(stop_oscillator(), [1.0, 2.0, 1.5], N)
