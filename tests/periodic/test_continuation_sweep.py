@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from cvtfem.elements.torsional import GAP, build_network
-from cvtfem.errors import NumericalError
+from cvtfem.errors import InputError, NumericalError
 from cvtfem.periodic.continuation import continuation
 from cvtfem.periodic.hb import solve_periodic
 from cvtfem.periodic.response import SAMPLES, response_sweep
@@ -228,7 +228,5 @@ def test_sweep_ending_inside_the_fold_range_names_the_fold_beyond(up):
 
 
 def test_requested_frequencies_must_be_monotonic():
-    from cvtfem.errors import InputError
-
     with pytest.raises(InputError, match="strictly increasing or decreasing"):
         response_sweep(stop_oscillator(), [1.0, 2.0, 1.5], N)
