@@ -11,7 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from cvtfem.elements.torsional import link_force
+from cvtfem.elements.torsional import TorsionalNetwork, link_force
 from cvtfem.errors import NumericalError
 from cvtfem.periodic import transient
 from cvtfem.periodic.hb import PeriodicSolution
@@ -38,6 +38,25 @@ class Floquet:
     @property
     def spectral_radius(self) -> float:
         return float(np.abs(self.multipliers[0]))
+
+
+#: DOP853 right-hand-side evaluations per radian of the stiffest rate over one period (engine gear train,
+#: rtol 1e-8: 38,150 evaluations for a Gershgorin rate x period of 1095).
+EVALUATIONS_PER_RADIAN = 40
+
+
+def evaluations_estimate(net: TorsionalNetwork, omega: float) -> float:
+    """Rough right-hand-side evaluations of :func:`floquet` at ``omega`` (rad/s): ``EVALUATIONS_PER_RADIAN``
+    x the period x the stiffest rate, a Gershgorin bound of ``M^-1 K`` (contact stiffness, as a frequency)
+    and ``M^-1 C`` (1/s); explicit integration pays for every stiff mode whether it is excited or not."""
+    inner = net.j >= 0
+
+    def rows(v):
+        return np.bincount(net.i, v, net.n_nodes) + np.bincount(net.j[inner], v[inner], net.n_nodes)
+
+    stiff = rows(2 * np.maximum(net.k_out, net.k_in)) / net.m
+    damp = (rows(2 * net.d) + net.b) / net.m
+    return EVALUATIONS_PER_RADIAN * max(np.sqrt(stiff.max()), damp.max(), omega) * 2 * np.pi / omega
 
 
 def floquet(sol: PeriodicSolution, rtol: float = 1e-9, method: str = "DOP853") -> Floquet:

@@ -102,8 +102,10 @@ def test_cli_writes_json_and_png(cli, tmp_path):
               "--png", str(tmp_path / "r.png"))
     assert out.returncode == 0, out.stderr
     data = json.loads((tmp_path / "r.json").read_text())
-    assert len(data["points"]) == 3 and data["probe"] == "pinion-wheel"
-    point = data["points"][1]
+    requested = [p for p in data["points"] if p["requested"]]
+    assert [p["frequency"] for p in requested] == pytest.approx([14, 15, 16]) and data["probe"] == "pinion-wheel"
+    assert len(data["points"]) == 3 + len(data["folds"])   # the turning points come on top
+    point = requested[1]
     assert point["backlash"]["converged"]
     assert set(point["backlash"]["link_force_rms"]) == {"motor-pinion", "pinion-wheel", "wheel-ground"}
     assert len(point["backlash"]["harmonic_amplitudes"]["motor"]) == 17
@@ -116,5 +118,5 @@ def test_cli_writes_json_and_png(cli, tmp_path):
 def test_cli_rejects_non_torsional_scene(cli):
     out = cli("periodic", "reference_cvt")
     assert out.returncode == 2 and "torsional" in out.stderr
-    out = cli("periodic", "engine_gear_train", "--sweep", "3:1:4")
+    out = cli("periodic", "engine_gear_train", "--sweep", "3:3:4")
     assert out.returncode == 2 and "--sweep" in out.stderr
