@@ -120,9 +120,9 @@ def _check_network(scene: Mapping[str, Any], path: str) -> None:
     per = scene.get("periodic")
     if per is not None and per["sweep"]:
         sweep = per["sweep"]
-        if len(sweep) != 3 or not (0 < sweep[0] < sweep[1]) or sweep[2] < 2 or sweep[2] != int(sweep[2]):
-            raise InputError("periodic.sweep", list(sweep), "must be [start, stop, points] with 0 < start < stop "
-                             "(Hz) and an integer number of points >= 2")
+        if len(sweep) != 3 or not (0 < sweep[0] != sweep[1] > 0) or sweep[2] < 2 or sweep[2] != int(sweep[2]):
+            raise InputError("periodic.sweep", list(sweep), "must be [start, stop, points] with 0 < start, 0 < stop, "
+                             "start != stop (Hz; start > stop sweeps down) and an integer number of points >= 2")
     if per is not None and per["probe"] and per["probe"] not in link_names(net):
         raise InputError("periodic.probe", per["probe"], "must name a link",
                          _suggest(per["probe"], link_names(net)))
