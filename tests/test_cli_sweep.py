@@ -34,6 +34,7 @@ def test_unreachable_scheduler_is_one_line_exit_2(cli, tmp_path):
             "--connect-timeout", "0.5", "--out", str(tmp_path / "s"))
     assert r.returncode == 2 and r.stderr.count("\n") == 1
     assert r.stderr.startswith("cvtfem sweep: error: `--scheduler` must be the address of a running dask scheduler")
+    assert not (tmp_path / "s" / "index.json").exists()
 
 
 def test_sweep_then_report(capsys, tmp_path):

@@ -349,7 +349,8 @@ def read_index(folder: str | Path) -> dict[str, Any]:
 def run_sweep(scene, variants: list[Variant], analysis: str, out: str | Path, engine: str = "local",
               workers: int | None = None, scheduler: str | None = None, options: Mapping[str, Any] | None = None,
               files: bool = True, retries: int = RETRIES, retry_failed: bool = False, show_progress: bool = True,
-              connect_timeout: float = CONNECT_TIMEOUT, work: Callable[..., dict[str, Any]] = run_variant) -> dict[str, Any]:
+              connect_timeout: float = CONNECT_TIMEOUT,
+              work: Callable[..., dict[str, Any]] = run_variant) -> dict[str, Any]:
     """Run the variants not yet finished in folder ``out`` and return the index.
 
     Parameters
@@ -399,15 +400,16 @@ def run_sweep(scene, variants: list[Variant], analysis: str, out: str | Path, en
                 index["variants"].append(entries[v.id])
         done = ("finished",) if retry_failed else ("finished", "failed")
         todo = [v for v in variants if entries[v.id]["status"] not in done]
-        (folder / "variants").mkdir(parents=True, exist_ok=True)
-        _atomic_write(folder / INDEX, json.dumps(index, indent=1))
         jobs = [(v.id, (analysis, scenes[v.id], f"{scene.source} [{v.id}]",
                         str(folder / entries[v.id]["results"]) if files else None, options)) for v in todo]
-        bar = progress(len(jobs), "variant", f"sweep {analysis}") if show_progress else None
-        client = None
+        client = bar = None
         try:
-            if engine == "dask" and jobs:
+            if engine == "dask" and jobs:   # connect first: an unreachable scheduler leaves the folder as it was
                 client = dask_client(workers, scheduler, connect_timeout)
+            (folder / "variants").mkdir(parents=True, exist_ok=True)
+            _atomic_write(folder / INDEX, json.dumps(index, indent=1))
+            bar = progress(len(jobs), "variant", f"sweep {analysis}") if show_progress else None
+            if client is not None:
                 outcomes = _dask(work, jobs, client, retries)
             else:
                 outcomes = _local(work, jobs, workers or os.cpu_count() or 1, retries)

@@ -141,7 +141,7 @@ def write_report(index: dict[str, Any], out: str | Path, fmt: str = "md", index_
                              for t, p, note in figures)
         table = ("<table>\n<tr>" + "".join(f"<th>{esc(h)}</th>" for h in head) + "</tr>\n"
                  + "\n".join("<tr>" + "".join(f"<td>{esc(c)}</td>" for c in r) + "</tr>" for r in rows) + "\n</table>")
-        text = HTML.substitute(fields, **{k: esc(v) for k, v in fields.items()}, figures=fig_text, table=table)
+        text = HTML.substitute({k: esc(v) for k, v in fields.items()}, figures=fig_text, table=table)
     else:
         fig_text = "\n\n".join(f"## {t}\n\n{note}\n\n![{t}]({p})" for t, p, note in figures)
         table = "\n".join(["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
