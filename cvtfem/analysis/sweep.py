@@ -281,6 +281,7 @@ def _local(work: Callable, jobs: list[Job], workers: int, retries: int) -> Itera
 
 
 def _retry(job: Job, err: BaseException, attempts: dict[str, int], retries: int, queue: list[Job]):
+    """Queue ``job`` again while it has retries left, else yield it with its error."""
     if attempts[job[0]] <= retries:
         queue.append(job)
     else:
@@ -406,7 +407,8 @@ def run_sweep(scene, variants: list[Variant], analysis: str, out: str | Path, en
         try:
             if engine == "dask" and jobs:   # connect first: an unreachable scheduler leaves the folder as it was
                 client = dask_client(workers, scheduler, connect_timeout)
-            (folder / "variants").mkdir(parents=True, exist_ok=True)
+            if files:   # the folder itself exists: RunLock made it
+                (folder / "variants").mkdir(exist_ok=True)
             _atomic_write(folder / INDEX, json.dumps(index, indent=1))
             bar = progress(len(jobs), "variant", f"sweep {analysis}") if show_progress else None
             if client is not None:
