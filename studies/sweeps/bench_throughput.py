@@ -24,7 +24,7 @@ import numpy as np
 from cvtfem.analysis.sweep import expand, run_sweep
 from cvtfem.scene.loader import load_scene
 
-SIZES = (8, 24)
+SIZES = (8, 56)
 
 
 def machine() -> str:
