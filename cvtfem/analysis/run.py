@@ -56,7 +56,10 @@ def run_scene(scene, until: float | None = None, results: str | Path | None = No
     if not (math.isfinite(t_end) and t_end > 0):
         raise InputError("--until", t_end, "must be a positive, finite number of simulated seconds")
     run = _Run(scene, t_end)
-    x0 = run.x_start = run.loop.initial_state(**(start or {}))
+    x0, report = run.loop.start(**(start or {}))
+    run.x_start = x0
+    run.start_note = report.get("warning", report["kind"] if "residual" not in report else
+                                f"steady (relative Newton correction {report['residual']:.1e})")
     run.check_events(x0)
     writer = None
     if results is not None:
@@ -135,6 +138,7 @@ class _Run:
             except InputError:
                 raise InputError("solver.fallback", sol.fallback, "must be a method with an error estimate (it runs "
                                  "with adaptive steps), e.g. 'Radau', 'BDF', 'trapezoidal'") from None
+        self.start_note = ""    # how the run started: "steady", "no-slip" or the warning of a start without slip
         self.retry = 0          # retries of `solver.on_failure = "retry"` so far
         self.retry_log: list[str] = []
         self._layout = None
@@ -357,6 +361,8 @@ class _Run:
             status, message = "failed", diverged
         if writer is not None:
             extra = {"checkpoints": seq} if checkpoints else {}
+            if self.start_note:
+                extra["start"] = self.start_note
             if resumed is not None:
                 extra["resumed_from_t"] = float(resumed[1]["t"][0])
             if run.status == "event":
