@@ -12,6 +12,7 @@ with ``info["dissipation"]`` and ``info["clamp_power"]``, ``kinetic_energy(q, v)
 """
 from __future__ import annotations
 
+import dataclasses
 import logging
 import math
 from dataclasses import dataclass
@@ -62,6 +63,10 @@ class BandCVT(ModelBase):
         """Views ``q, v, z, W`` of a state vector."""
         n, nc = self.model.n2, self.control.size
         return x[:n], x[n:2 * n], x[2 * n:2 * n + nc], x[2 * n + nc:]
+
+    def with_regime(self, **changes: Any) -> BandCVT:
+        """This loop with the regime's fields ``changes`` (e.g. ``input_speed`` rad/s, ``torque`` N m, ``ratio``)."""
+        return dataclasses.replace(self, regime=dataclasses.replace(self.regime, **changes))
 
     def initial_state(self, ratio: float | None = None, speed_factor: float = 1.0) -> np.ndarray:
         """The start state of :meth:`start` (logs its warning, if any)."""

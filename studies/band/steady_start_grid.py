@@ -10,7 +10,6 @@ steady starts and the wall time.
 from __future__ import annotations
 
 import argparse
-import dataclasses
 import logging
 import math
 import platform
@@ -27,14 +26,8 @@ RPM = math.pi / 30
 SPEEDS = np.arange(1000.0, 6001.0, 500.0)
 TORQUES = np.r_[20.0, np.arange(25.0, 451.0, 25.0)]
 RATIOS = np.array([0.45, 0.5, 0.6, 0.7, 0.8, 0.9, 1.0, 1.2, 1.4, 1.7, 2.0, 2.4])
-#: A coarse grid through the corners and the regimes that failed before the fix (3000 rpm, 300 N m, 0.8).
+#: A coarse grid (27 regimes) through the corners and band-6+2n's failure of issue 18 (3000 rpm, 300 N m, 0.8).
 COARSE = (np.array([1000.0, 3000.0, 6000.0]), np.array([20.0, 300.0, 450.0]), np.array([0.45, 0.8, 2.4]))
-
-
-def loop_at(loop, rpm: float, torque: float, ratio: float):
-    """The closed loop ``loop`` with a stationary regime at ``rpm``, ``torque`` (N m) and ``ratio``."""
-    regime = dataclasses.replace(loop.regime, kind="stationary", input_speed=rpm * RPM, torque=torque, ratio=ratio)
-    return dataclasses.replace(loop, regime=regime)
 
 
 def sweep(model: str, grid=(SPEEDS, TORQUES, RATIOS)) -> list[dict]:
@@ -45,7 +38,7 @@ def sweep(model: str, grid=(SPEEDS, TORQUES, RATIOS)) -> list[dict]:
     for rpm in grid[0]:
         for torque in grid[1]:
             for ratio in grid[2]:
-                lp = loop_at(loop, rpm, torque, ratio)
+                lp = loop.with_regime(kind="stationary", input_speed=rpm * RPM, torque=torque, ratio=ratio)
                 rec = dict(rpm=float(rpm), torque=float(torque), ratio=float(ratio))
                 try:
                     s = lp.start()[1]
