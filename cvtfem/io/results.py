@@ -175,27 +175,28 @@ class ResultsWriter:
         ckpt.write(self._file, self._layout, seq, {**values, "rows": self._rows})
 
     @classmethod
-    def resume(cls, path: str | Path, flush_interval: float = 2.0,
-               where: str = "--resume") -> tuple[ResultsWriter, int, dict[str, np.ndarray]]:
+    def resume(cls, path: str | Path, flush_interval: float = 2.0, where: str = "--resume",
+               scene_toml: str | None = None) -> tuple[ResultsWriter, int, dict[str, np.ndarray]]:
         """Reopen a killed run's file for appending from its newest checkpoint.
 
         Returns the writer (rows up to the checkpoint, later rows dropped: the run recomputes
         them), the checkpoint number and its payload (``rows`` included).  Refused with
         :class:`InputError` for a finished run, a file without checkpoint or not a run.
+        ``scene_toml`` replaces the stored scene (a resume with changed values).
         """
         path = Path(path)
         if not path.is_file():
             raise InputError(where, str(path), "must be an existing results file (.h5) of a killed run")
         lock = RunLock(path, where)
         try:
-            return cls._resume(path, flush_interval, where, lock)
+            return cls._resume(path, flush_interval, where, lock, scene_toml)
         except BaseException:
             lock.release()
             raise
 
     @classmethod
-    def _resume(cls, path: Path, flush_interval: float, where: str,
-                lock: RunLock) -> tuple[ResultsWriter, int, dict[str, np.ndarray]]:
+    def _resume(cls, path: Path, flush_interval: float, where: str, lock: RunLock,
+                scene_toml: str | None) -> tuple[ResultsWriter, int, dict[str, np.ndarray]]:
         f = _open_for_reading(path, where)
         with f:
             attrs = dict(f.attrs)
@@ -226,7 +227,7 @@ class ResultsWriter:
             resume = {"time": group["time"][:rows], "series": {s.name: group[s.name][:rows] for s in specs},
                       "attrs": {"created": attrs.get("created", ""), "resumed": int(attrs.get("resumed", 0)) + 1},
                       "seq": seq, "values": values}
-            scene_toml = f["scene"][()].decode()
+            scene_toml = _scene_text(f, path, where) if scene_toml is None else scene_toml
         fields = tuple(fd for fd in layout.fields if fd[0] != "rows")
         tmp = path.with_name(path.name + ".resume-tmp")
         writer = cls(tmp, scene_toml, "run", specs, flush_interval, overwrite=True, checkpoint=ckpt.Layout(fields),
@@ -369,6 +370,26 @@ def _open_for_reading(path: Path, where: str) -> h5py.File:
         return h5py.File(path, "r", libver="latest", swmr=True, locking=False)
     except OSError as err:
         raise InputError(where, str(path), f"must be a readable HDF5 file ({err})") from None
+
+
+def _scene_text(f: h5py.File, path: Path, where: str) -> str:
+    """The scene TOML stored in an open results file."""
+    if "scene" not in f or not isinstance(f["scene"], h5py.Dataset) or f["scene"].shape != ():
+        raise InputError(where, str(path), "must be a cvtfem results file (it has no scene text)")
+    text = f["scene"][()]
+    try:
+        return text.decode() if isinstance(text, bytes) else str(text)
+    except UnicodeDecodeError:
+        raise InputError(where, str(path), "must be a cvtfem results file (its scene text is not UTF-8)") from None
+
+
+def read_scene_toml(path: str | Path, where: str = "RESULTS") -> str:
+    """The scene TOML stored in a results file (nothing else is read)."""
+    path = Path(path)
+    if not path.is_file():
+        raise InputError(where, str(path), "must be an existing results file (.h5)")
+    with _open_for_reading(path, where) as f:
+        return _scene_text(f, path, where)
 
 
 def read_results(path: str | Path) -> Results:
