@@ -35,7 +35,8 @@ import fcntl
 import os
 import struct
 import time
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterator, Mapping, Sequence
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from datetime import datetime, timezone
 from pathlib import Path
@@ -197,15 +198,12 @@ class ResultsWriter:
     @classmethod
     def _resume(cls, path: Path, flush_interval: float, where: str, lock: RunLock,
                 scene_toml: str | None) -> tuple[ResultsWriter, int, dict[str, np.ndarray]]:
-        f = _open_for_reading(path, where)
-        with f:
-            attrs = dict(f.attrs)
-            if attrs.get("kind") != "run" or "series" not in f:
+        with _reading(path, where) as f:
+            attrs, group = _checked(f, path, where)
+            if attrs.get("kind") != "run":
                 raise InputError(where, str(path), f"must be the results file of `cvtfem run` (kind is "
                                  f"{attrs.get('kind')!r})")
-            status = str(attrs.get("status", ""))
-            group = f["series"]
-            if status == "finished":
+            if attrs.get("status") == "finished":
                 t = group["time"]
                 last = f"{t[-1]:.6g} s" if t.shape[0] else "its end"
                 raise InputError(where, str(path), f"must be an unfinished run: this one finished (t = {last})",
@@ -348,13 +346,17 @@ class Results:
 HDF5_SIGNATURE = b"\x89HDF\r\n\x1a\n"
 
 
-def _open_for_reading(path: Path, where: str) -> h5py.File:
-    """Open a results file read-only (SWMR), after checking that it is not cut short.
+@contextmanager
+def _reading(path: Path, where: str) -> Iterator[h5py.File]:
+    """An open results file (read-only, SWMR) for the ``with`` body; whatever HDF5 raises on damaged metadata or
+    data there (OSError, RuntimeError, KeyError, ValueError from h5py) becomes one :class:`InputError` line.
 
-    A truncated file (a partial copy, a full disk) is refused up front: HDF5's SWMR reader retries
-    metadata reads of a missing region without end, so reading one would hang.  The check reads the
+    A truncated file (a partial copy, a full disk) is refused before HDF5 opens it: HDF5's SWMR reader
+    retries metadata reads of a missing region without end, so reading one would hang.  The check reads the
     end-of-file address of the version 2/3 superblock that the writer creates (``libver="latest"``).
     """
+    if not path.is_file():
+        raise InputError(where, str(path), "must be an existing results file (.h5)")
     try:
         with open(path, "rb") as raw:
             head = raw.read(44)
@@ -367,44 +369,70 @@ def _open_for_reading(path: Path, where: str) -> h5py.File:
             raise InputError(where, str(path), f"is truncated: HDF5 says {base + eof} bytes, the file has {size} "
                              "(a partial copy or a full disk?)")
     try:
-        return h5py.File(path, "r", libver="latest", swmr=True, locking=False)
-    except OSError as err:
-        raise InputError(where, str(path), f"must be a readable HDF5 file ({err})") from None
+        with h5py.File(path, "r", libver="latest", swmr=True, locking=False) as f:
+            yield f
+    except InputError:
+        raise
+    except (OSError, RuntimeError, KeyError, ValueError) as err:
+        text = " ".join(str(err).split()) or type(err).__name__
+        raise InputError(where, str(path), f"must be a readable HDF5 results file (damaged: {text})") from None
+
+
+#: Root attributes of a results file that hold text.
+TEXT_ATTRS = ("cvtfem_version", "kind", "status", "message", "created")
+
+
+def _checked(f: h5py.File, path: Path, where: str) -> tuple[dict[str, Any], h5py.Group]:
+    """Root attributes and ``/series`` of an open results file, once its structure is that of one: text
+    attributes, groups ``/series`` (a 1-D float ``time``, 2-D float arrays) and ``/stats``, a ``/scene``."""
+    def refuse(what: str) -> InputError:
+        return InputError(where, str(path), f"must be a cvtfem results file ({what})")
+
+    missing = [name for name in ("series", "scene", "stats") if name not in f]
+    if missing:
+        raise refuse(f"it has no {', '.join(missing)}")
+    attrs = dict(f.attrs)
+    for key in TEXT_ATTRS:
+        if key in attrs and not isinstance(attrs[key], str):
+            raise refuse(f"its attribute `{key}` is not text")
+    group = f["series"]
+    if not isinstance(group, h5py.Group) or not isinstance(f["stats"], h5py.Group):
+        raise refuse("`/series` and `/stats` must be groups")
+    if "time" not in group:
+        raise refuse("it has no `/series/time`")
+    for name, d in group.items():
+        ndim = 1 if name == "time" else 2
+        if not isinstance(d, h5py.Dataset) or d.ndim != ndim or d.dtype.kind != "f":
+            raise refuse(f"`/series/{name}` is not a {ndim}-D float array")
+    return attrs, group
 
 
 def _scene_text(f: h5py.File, path: Path, where: str) -> str:
     """The scene TOML stored in an open results file."""
-    if "scene" not in f or not isinstance(f["scene"], h5py.Dataset) or f["scene"].shape != ():
-        raise InputError(where, str(path), "must be a cvtfem results file (it has no scene text)")
-    text = f["scene"][()]
+    d = f.get("scene")
+    if not isinstance(d, h5py.Dataset) or d.shape != () or d.dtype.kind not in "OSU":
+        raise InputError(where, str(path), "must be a cvtfem results file (its `/scene` is not a text)")
+    text = d[()]
     try:
         return text.decode() if isinstance(text, bytes) else str(text)
     except UnicodeDecodeError:
-        raise InputError(where, str(path), "must be a cvtfem results file (its scene text is not UTF-8)") from None
+        raise InputError(where, str(path), "must be a cvtfem results file (its `/scene` is not UTF-8)") from None
 
 
 def read_scene_toml(path: str | Path, where: str = "RESULTS") -> str:
     """The scene TOML stored in a results file (nothing else is read)."""
     path = Path(path)
-    if not path.is_file():
-        raise InputError(where, str(path), "must be an existing results file (.h5)")
-    with _open_for_reading(path, where) as f:
+    with _reading(path, where) as f:
         return _scene_text(f, path, where)
 
 
 def read_results(path: str | Path) -> Results:
     """Read a results file (also one whose run was killed: complete rows only)."""
     path = Path(path)
-    if not path.is_file():
-        raise InputError("RESULTS", str(path), "must be an existing results file (.h5)")
-    f = _open_for_reading(path, "RESULTS")
-    with f:
-        missing = [name for name in ("series", "scene", "stats") if name not in f]
-        if missing:
-            raise InputError("RESULTS", str(path), f"must be a cvtfem results file (it has no {', '.join(missing)})")
-        group = f["series"]
+    with _reading(path, "RESULTS") as f:
+        attrs, group = _checked(f, path, "RESULTS")
         rows = min(d.shape[0] for d in group.values())
         series = {name: d[:rows] for name, d in group.items() if name != "time"}
         units = {name: str(d.attrs.get("unit", "")) for name, d in group.items()}
-        return Results(path=path, attrs=dict(f.attrs), scene_toml=f["scene"][()].decode(),
+        return Results(path=path, attrs=attrs, scene_toml=_scene_text(f, path, "RESULTS"),
                        stats=dict(f["stats"].attrs), time=group["time"][:rows], series=series, units=units)
