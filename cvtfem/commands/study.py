@@ -183,15 +183,13 @@ def run(args: argparse.Namespace) -> int:
 
     methods = [parse_method(m) for m in getattr(args, "methods", "").split(",") if m.strip()]
     _check_args(args, methods)
-    for out in (getattr(args, "png", None), getattr(args, "csv", None)):
-        if out:
-            Path(out).parent.mkdir(parents=True, exist_ok=True)
+    problem = _problem(args.problem, args) if args.study in ("order", "work") else None
+    hs = _hs(args.hs) if args.study == "order" else None
+    settings = _settings(args, problem.t_span) if args.study == "work" else None
     if args.study == "stability":
-        out = plots.plot_stability(methods, args.png, extent=args.extent, log=args.log, n=args.n)
+        out = plots.plot_stability(methods, _out(args.png), extent=args.extent, log=args.log, n=args.n)
         print(f"wrote {out}")
     elif args.study == "order":
-        hs = _hs(args.hs)
-        problem = _problem(args.problem, args)
         curves, rows = [], []
         for label, method, opts in methods:
             if method not in METHODS:
@@ -203,17 +201,15 @@ def run(args: argparse.Namespace) -> int:
             rows += [{"label": label, "h": h, "error": e, "p_eff": q}
                      for h, e, q in zip(hs, errs, [math.nan, *p])]
             print(f"{label:28s} nominal {nominal}  p~ = " + " ".join(f"{q:5.2f}" for q in p))
-        plots.plot_effective_order(curves, args.png, f"effective order on {problem.name}")
-        plots.write_csv(rows, args.csv)
+        plots.plot_effective_order(curves, _out(args.png), f"effective order on {problem.name}")
+        plots.write_csv(rows, _out(args.csv))
         print(f"wrote {args.png}, {args.csv}")
     elif args.study == "work":
-        problem = _problem(args.problem, args)
-        settings = _settings(args, problem.t_span)
         runs = [(label, method, {**opts, **s}) for label, method, opts in methods for s in settings]
         rows = study.work_precision(problem, runs, repeats=args.repeats, error=getattr(problem, "error", None))
         _print_rows(rows)
-        plots.plot_work_precision(rows, args.png, f"work-precision on {problem.name}")
-        plots.write_csv(rows, args.csv)
+        plots.plot_work_precision(rows, _out(args.png), f"work-precision on {problem.name}")
+        plots.write_csv(rows, _out(args.csv))
         print(f"wrote {args.png}, {args.csv}")
     elif args.study == "heat":
         names = [m.strip() for m in args.methods.split(",") if m.strip()] or None
@@ -228,9 +224,15 @@ def run(args: argparse.Namespace) -> int:
               f"median of {args.repeats} runs on {platform.machine()} {platform.processor() or ''} "
               f"Python {platform.python_version()}")
         _print_rows(rows)
-        plots.write_csv(rows, args.csv)
+        plots.write_csv(rows, _out(args.csv))
         print(f"wrote {args.csv}")
     return 0
+
+
+def _out(path: str) -> str:
+    """An output file's path, its folder created (once the study has its results)."""
+    Path(path).parent.mkdir(parents=True, exist_ok=True)
+    return path
 
 
 def problem_system(problem):

@@ -351,7 +351,7 @@ HDF5_SIGNATURE = b"\x89HDF\r\n\x1a\n"
 @contextmanager
 def _reading(path: Path, where: str) -> Iterator[h5py.File]:
     """An open results file (read-only, SWMR) for the ``with`` body; whatever HDF5 raises on damaged metadata or
-    data there (OSError, RuntimeError, KeyError, ValueError from h5py) becomes one :class:`InputError` line.
+    data there (OSError, RuntimeError, KeyError, TypeError, ValueError from h5py) becomes one :class:`InputError` line.
 
     A truncated file (a partial copy, a full disk) is refused before HDF5 opens it: HDF5's SWMR reader
     retries metadata reads of a missing region without end, so reading one would hang.  The check reads the
@@ -375,7 +375,7 @@ def _reading(path: Path, where: str) -> Iterator[h5py.File]:
             yield f
     except InputError:
         raise
-    except (OSError, RuntimeError, KeyError, ValueError) as err:
+    except (OSError, RuntimeError, KeyError, TypeError, ValueError) as err:
         text = " ".join(str(err).split()) or type(err).__name__
         raise InputError(where, str(path), f"must be a readable HDF5 results file (damaged: {text})") from None
 
