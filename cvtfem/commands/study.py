@@ -187,6 +187,9 @@ def run(args: argparse.Namespace) -> int:
     hs = _hs(args.hs) if args.study == "order" else None
     settings = _settings(args, problem.t_span) if args.study == "work" else None
     if args.study == "stability":
+        for _, method, _ in methods:   # scipy's solvers take real states only: no complex test equation
+            if method not in METHODS:
+                raise InputError("--methods", method, f"must be native methods {sorted(METHODS)}")
         out = plots.plot_stability(methods, _out(args.png), extent=args.extent, log=args.log, n=args.n)
         print(f"wrote {out}")
     elif args.study == "order":

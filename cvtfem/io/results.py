@@ -224,7 +224,12 @@ class ResultsWriter:
                                  "series hold fewer")
             specs = [OutputSpec(name, str(d.attrs.get("unit", "")), str(d.attrs.get("doc", "")), d.shape[1])
                      for name, d in group.items() if name != "time"]
-            resume = {"time": group["time"][:rows], "series": {s.name: group[s.name][:rows] for s in specs},
+            kept = {name: d[:rows] for name, d in group.items()}
+            bad = next((name for name, a in kept.items() if not np.isfinite(a).all()), None)
+            if bad is not None:   # the writer never stores one: the file is damaged
+                raise InputError(where, str(path), f"is damaged: `/series/{bad}` holds non-finite values in the "
+                                 f"{rows} rows up to checkpoint {seq}")
+            resume = {"time": kept["time"], "series": {s.name: kept[s.name] for s in specs},
                       "attrs": {"created": attrs.get("created", ""), "resumed": int(attrs.get("resumed", 0)) + 1},
                       "seq": seq, "values": values}
             scene_toml = _scene_text(f, path, where) if scene_toml is None else scene_toml
@@ -429,8 +434,8 @@ def _checked(f: h5py.File, path: Path, where: str) -> tuple[dict[str, Any], h5py
         raise refuse(f"it has no {', '.join(missing)}")
     attrs = dict(f.attrs)
     for key in TEXT_ATTRS:
-        if key in attrs and not isinstance(attrs[key], str):
-            raise refuse(f"its attribute `{key}` is not text")
+        if key in attrs and not (isinstance(attrs[key], str) and _utf8(attrs[key])):
+            raise refuse(f"its attribute `{key}` is not UTF-8 text")
     group = f["series"]
     if not isinstance(group, h5py.Group) or not isinstance(f["stats"], h5py.Group):
         raise refuse("`/series` and `/stats` must be groups")
@@ -440,7 +445,19 @@ def _checked(f: h5py.File, path: Path, where: str) -> tuple[dict[str, Any], h5py
         ndim = 1 if name == "time" else 2
         if not isinstance(d, h5py.Dataset) or d.ndim != ndim or d.dtype.kind != "f":
             raise refuse(f"`/series/{name}` is not a {ndim}-D float array")
+        texts = [name] + [d.attrs[key] for key in ("unit", "doc") if key in d.attrs]
+        if not all(isinstance(text, str) and _utf8(text) for text in texts):
+            raise refuse(f"the name, unit or doc of `/series/{name!r}` is not UTF-8 text")
     return attrs, group
+
+
+def _utf8(text: str) -> bool:
+    """False for a string h5py decoded from invalid UTF-8 (it maps the bad bytes to surrogates)."""
+    try:
+        text.encode()
+    except UnicodeEncodeError:
+        return False
+    return True
 
 
 def _scene_text(f: h5py.File, path: Path, where: str) -> str:
