@@ -75,12 +75,18 @@ def parse_method(spec: str) -> tuple[str, str, dict]:
     """``"gbs:stages=2"`` -> ``("gbs:stages=2", "gbs", {"stages": 2})``."""
     from cvtfem.errors import InputError
 
+    import inspect
+
+    from cvtfem.integrate.driver import solve
+
     name, *pairs = spec.strip().split(":")
     opts = {}
     for pair in pairs:
         key, sep, val = pair.partition("=")
         if not sep:
             raise InputError("--methods", spec, "options must be key=value, e.g. gbs:stages=2")
+        if key in inspect.signature(solve).parameters:   # h, rtol, ...: the study sets them
+            raise InputError("--methods", spec, f"options must be the method's own, not `{key}` (the study sets it)")
         for conv in (int, float):
             try:
                 opts[key] = conv(val)
