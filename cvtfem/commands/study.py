@@ -158,7 +158,8 @@ def _hs(text: str):
     except ValueError:
         raise InputError("--hs", text, "must be H_MAX:H_MIN:COUNT") from None
     if not (math.isfinite(hmax) and 0 < hmin < hmax and 2 <= n <= MAX_HS):
-        raise InputError("--hs", text, f"must be H_MAX:H_MIN:COUNT with finite H_MAX > H_MIN > 0 and COUNT in 2..{MAX_HS}")
+        raise InputError("--hs", text, "must be H_MAX:H_MIN:COUNT with finite H_MAX > H_MIN > 0 and COUNT in "
+                         f"2..{MAX_HS}")
     return np.geomspace(hmax, hmin, n)
 
 

@@ -7,6 +7,7 @@ Before the fix scipy's hybr reported "not making good progress" at converged sta
 """
 import dataclasses
 import importlib.util
+import itertools
 import logging
 import math
 
@@ -26,8 +27,14 @@ MODELS = ("band-6+2n", "band-6+2n+8")
 #: (rpm, N m, ratio) where the start failed with exit 3 before the fix.
 FAILED_BEFORE = {"band-6+2n": [(3000, 300, 0.8), (1500, 25, 0.8), (2000, 150, 0.8), (4500, 125, 0.8)],
                  "band-6+2n+8": [(1000, 25, 1.0), (1000, 20, 0.45), (4000, 325, 1.0), (1500, 400, 0.7)]}
-COARSE = [(rpm, torque, ratio) for rpm in (1000, 3000, 6000) for torque in (20, 300, 450)
-          for ratio in (0.45, 0.8, 2.4)]
+
+
+def _study():
+    """``studies/band/steady_start_grid.py`` as a module (its grids and sweep)."""
+    spec = importlib.util.spec_from_file_location("steady_start_grid", ROOT / "studies/band/steady_start_grid.py")
+    study = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(study)
+    return study
 
 
 @pytest.fixture(scope="module", params=MODELS)
@@ -36,10 +43,11 @@ def loop(request):
 
 
 def test_steady_start_on_a_coarse_grid(loop):
-    """27 regimes plus the former failures: steady, with the band's momentum and power balance closed."""
+    """The study's 27-regime grid plus the former failures: steady, with the band's momentum and power balance
+    closed."""
     name, loop = loop
     model = loop.model
-    for rpm, torque, ratio in COARSE + FAILED_BEFORE[name]:
+    for rpm, torque, ratio in [*itertools.product(*_study().COARSE), *FAILED_BEFORE[name]]:
         lp = loop.with_regime(kind="stationary", input_speed=rpm * RPM, torque=torque, ratio=ratio)
         x0, report = lp.start()
         assert report["kind"] == "steady" and report["residual"] <= STEADY_TOL, (rpm, torque, ratio, report)
@@ -113,10 +121,7 @@ def test_cli_start_without_steady_state_warns_in_one_line(tmp_path, cli):
 @pytest.mark.parametrize("model", MODELS)
 def test_steady_start_on_the_whole_grid(model):
     """The 2,508 regimes of the study script (about 4 s per model)."""
-    spec = importlib.util.spec_from_file_location("steady_start_grid", ROOT / "studies/band/steady_start_grid.py")
-    study = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(study)
-    records = study.sweep(model)
+    records = _study().sweep(model)
     assert len(records) == 2508
     bad = [r for r in records if r["outcome"] != "steady" or not r["detail"] <= STEADY_TOL]
     assert bad == []
