@@ -416,7 +416,7 @@ class CompressibleBand:
         if not rel <= STEADY_TOL:
             raise NumericalError(f"steady state not found: relative Newton correction {rel:.3g} after hybr and "
                                  f"{POLISH_STEPS} Newton steps (tolerance {STEADY_TOL:g})",
-                                 component=f"band-6+2n (n = {self.p.n_ritz})")
+                                 component=f"band-6+2n{'+8' if self.shaft_compliance else ''} (n = {self.p.n_ritz})")
         q, v, M = unpack(y)
         a, info = self.accel(q, v, F, M)
         info["residual"] = rel
