@@ -25,7 +25,9 @@ class _Parser(argparse.ArgumentParser):
     """argparse parser whose errors name the program and exit with status 2."""
 
     def error(self, message: str) -> None:  # noqa: D401 - argparse API
-        self.exit(2, f"{self.prog}: error: {message}\n")
+        # one line whatever the arguments hold: control characters and line separators escaped, as InputError quotes
+        shown = "".join(c if c.isprintable() else repr(c)[1:-1] for c in message)
+        self.exit(2, f"{self.prog}: error: {shown}\n")
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -56,7 +56,10 @@ def run_scene(scene, until: float | None = None, results: str | Path | None = No
     if not (math.isfinite(t_end) and t_end > 0):
         raise InputError("--until", t_end, "must be a positive, finite number of simulated seconds")
     run = _Run(scene, t_end)
-    x0 = run.x_start = run.loop.initial_state(**(start or {}))
+    x0, report = run.loop.start(**(start or {}))
+    run.x_start = x0
+    run.start_note = report.get("warning", report["kind"] if "residual" not in report else
+                                f"steady (relative Newton correction {report['residual']:.1e})")
     run.check_events(x0)
     writer = None
     if results is not None:
@@ -68,7 +71,8 @@ def run_scene(scene, until: float | None = None, results: str | Path | None = No
 
 
 def resume_run(results: str | Path, show_progress: bool = True,
-               on_checkpoint: Callable[[float, int], None] | None = None) -> RunSummary:
+               on_checkpoint: Callable[[float, int], None] | None = None, scene=None,
+               changed: bool = False) -> RunSummary:
     """Continue a killed run from the newest checkpoint of its results file, appending to that file.
 
     The scene (TOML stored in the file), end time and solver come from the file; rows after the
@@ -78,27 +82,65 @@ def resume_run(results: str | Path, show_progress: bool = True,
     run; others (W-methods, stabilized methods, LSODA) restart their memory, so their results agree within
     the solver tolerance.  A finished run or a file without checkpoint is refused
     with :class:`InputError`.
+
+    ``scene`` (a :class:`~cvtfem.scene.loader.Scene`, optional) must equal the stored one but for its
+    ``title`` and ``description``: a difference is an :class:`InputError` naming the first differing key,
+    unless ``changed``: then the run continues with ``scene``'s values from the checkpoint (which must have
+    its state layout), and the file stores ``scene`` and the changes (``/stats`` ``scene_changed``).
     """
-    from cvtfem.io.results import ResultsWriter
+    from cvtfem.io.results import ResultsWriter, read_scene_toml
     from cvtfem.scene.loader import _parse, scene_from_dict
 
-    writer, seq, values = ResultsWriter.resume(results)
+    diff = []
+    if scene is not None:
+        stored = scene_from_dict(_parse(read_scene_toml(results, "--resume"), str(results)), source=str(results))
+        diff = scene_differences(stored, scene)
+        if diff and not changed:
+            raise InputError("SCENE", scene.source, f"must equal the scene stored in {results} to resume it: "
+                             f"{diff[0]}" + (f" (and {len(diff) - 1} more)" if len(diff) > 1 else ""),
+                             "pass --resume-changed to continue the run with the new values")
+        if diff and _Run.prepared(scene).layout() != _Run.prepared(stored).layout():
+            raise InputError("SCENE", scene.source, f"must give the state layout of the run in {results} to "
+                             "continue it: its model, solver method or events change what a checkpoint holds")
+    writer, seq, values = ResultsWriter.resume(results, scene_toml=scene.to_toml() if diff else None)
     try:
-        scene = scene_from_dict(_parse(writer.scene_toml, str(results)), source=f"{results} (resumed)")
-        run = _Run(scene, float(values["t_end"][0]))
-        run.check_events(run.loop.initial_state())
-        layout = run.layout()
-        if dict(writer.checkpoint_layout) != {**dict(layout.fields), "rows": 1}:
+        stored = scene_from_dict(_parse(writer.scene_toml, str(results)), source=f"{results} (resumed)")
+        if diff:
+            writer.set_stats({"scene_changed": "; ".join(diff)})
+        run = _Run.prepared(stored, float(values["t_end"][0]))
+        if dict(writer.checkpoint_layout) != {**dict(run.layout().fields), "rows": 1}:
             raise InputError("--resume", str(results), "must hold a checkpoint of this cvtfem version's run driver "
                              f"(state layout {writer.checkpoint_layout} differs)")
         run.specs = writer.specs
-        writer.flush_interval = scene.output.flush_interval
+        writer.flush_interval = stored.output.flush_interval
     except BaseException as err:
         writer.close("failed", f"resume: {err}")
         raise
     run.retry, run.x_start = int(values["retry"][0]), run.loop.initial_state()
     return run.drive_with_policy(writer, float(values["t"][0]), values["x"], (seq, values), show_progress,
                                  on_checkpoint)
+
+
+#: Scene keys a resume may change without ``--resume-changed`` (free text without effect on the run).
+FREE_TEXT_KEYS = ("title", "description")
+
+
+def scene_differences(stored, new) -> list[str]:
+    """``"`KEY` is A in the results file, B in SCENE"`` for every key (dotted path, schema order) whose value
+    differs between two scenes, but :data:`FREE_TEXT_KEYS`."""
+    from cvtfem.scene.node import thaw
+
+    out: list[str] = []
+
+    def walk(a, b, path: str) -> None:
+        if isinstance(a, dict) and isinstance(b, dict):
+            for key in dict.fromkeys([*a, *b]):
+                walk(a.get(key), b.get(key), f"{path}.{key}" if path else key)
+        elif a != b and path not in FREE_TEXT_KEYS:
+            out.append(f"`{path}` is {a!r} in the results file, {b!r} in SCENE")
+
+    walk(thaw(stored.data), thaw(new.data), "")
+    return out
 
 
 class _Run:
@@ -135,11 +177,19 @@ class _Run:
             except InputError:
                 raise InputError("solver.fallback", sol.fallback, "must be a method with an error estimate (it runs "
                                  "with adaptive steps), e.g. 'Radau', 'BDF', 'trapezoidal'") from None
+        self.start_note = ""    # how the run started: "steady", "no-slip" or the warning of a start without slip
         self.retry = 0          # retries of `solver.on_failure = "retry"` so far
         self.retry_log: list[str] = []
         self._layout = None
         self.events = None      # (indicators, direction, terminal) of `[[solver.event]]`, set by `check_events`
         self.event_names: list[str] = []
+
+    @classmethod
+    def prepared(cls, scene, t_end: float | None = None) -> _Run:
+        """A run of ``scene`` to ``t_end`` (default ``solver.t_end``) with its events checked (as for a resume)."""
+        run = cls(scene, scene.solver.t_end if t_end is None else t_end)
+        run.check_events(run.loop.initial_state())
+        return run
 
     def check_events(self, x0) -> None:
         """Event indicators ``output(t, x) - value`` of the scene's ``[[solver.event]]`` (scalar outputs only)."""
@@ -357,6 +407,8 @@ class _Run:
             status, message = "failed", diverged
         if writer is not None:
             extra = {"checkpoints": seq} if checkpoints else {}
+            if self.start_note:
+                extra["start"] = self.start_note
             if resumed is not None:
                 extra["resumed_from_t"] = float(resumed[1]["t"][0])
             if run.status == "event":

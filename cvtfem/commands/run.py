@@ -2,6 +2,8 @@
 
 ``cvtfem run --resume RESULTS.h5`` continues a killed run from the newest checkpoint in its
 results file (scene, end time and solver from the file), appending to the same file.
+``cvtfem run SCENE --resume RESULTS.h5`` checks that SCENE is the stored scene (exit 2 naming the first
+differing key otherwise); with ``--resume-changed`` it continues the run with SCENE's values.
 """
 from __future__ import annotations
 
@@ -18,7 +20,11 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--overwrite", action="store_true", help="replace an existing results file")
     p.add_argument("--summary-json", default=None, metavar="OUT", help="write the run summary as JSON")
     p.add_argument("--resume", default=None, metavar="RESULTS.h5",
-                   help="continue a killed run from the newest checkpoint of its results file (scene from the file)")
+                   help="continue a killed run from the newest checkpoint of its results file (scene from the "
+                        "file; a SCENE given too must equal it)")
+    p.add_argument("--resume-changed", action="store_true",
+                   help="with SCENE and --resume: continue the run with SCENE's values where they differ from the "
+                        "stored scene's (same state layout)")
     p.add_argument("--report-checkpoints", action="store_true",
                    help="print a line on stdout when a checkpoint is on disk")
     p.set_defaults(func=run)
@@ -36,13 +42,17 @@ def run(args: argparse.Namespace) -> int:
         print(f"checkpoint {seq} at t = {t:.6g} s", flush=True)
 
     on_checkpoint = report if args.report_checkpoints else None
+    if args.resume_changed and (args.resume is None or args.scene is None):
+        raise InputError("--resume-changed", True, "needs SCENE and --resume RESULTS.h5 (it continues that run "
+                         "with SCENE's values)")
     if args.resume is not None:
-        for name, value in (("SCENE", args.scene), ("--until", args.until), ("--results", args.results),
+        for name, value in (("--until", args.until), ("--results", args.results),
                             ("--overwrite", args.overwrite or None)):
             if value is not None:
-                raise InputError(name, value, "cannot be combined with --resume (scene, end time and results file "
+                raise InputError(name, value, "cannot be combined with --resume (end time and results file "
                                  "are those of the resumed run)", "run `cvtfem run --resume RESULTS.h5`")
-        summary = resume_run(args.resume, on_checkpoint=on_checkpoint)
+        scene = None if args.scene is None else load_scene(args.scene)
+        summary = resume_run(args.resume, on_checkpoint=on_checkpoint, scene=scene, changed=args.resume_changed)
     else:
         if args.scene is None:
             raise InputError("SCENE", None, "is required (a scene file or preset name), unless --resume RESULTS.h5")

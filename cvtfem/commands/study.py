@@ -8,12 +8,24 @@ relative error of ratio, speeds and work ratio at the end against Radau at ``--r
 from __future__ import annotations
 
 import argparse
+import math
 import platform
 from pathlib import Path
 
 DEFAULT_STABILITY = ("euler,rk4,dopri45,dopri56,dopri78,gbs:stages=2,gbs-smooth:stages=2,"
                      "euler-extrapolation:stages=4,sw24:d=0.5,w1:d=1.0,w1-extrapolation:d=0.5:stages=4,"
                      "trapezoidal,implicit-euler,rkc:stages=5,rock2:stages=5,rock4:stages=5,dumka3:polynomial=0")
+#: Upper bounds of what a study may be asked for (checked before any work; each message names the cost).
+MAX_METHODS = 40        # methods per study (a panel or a row each)
+MAX_PIXELS = 2001       # `stability --n`: n^2 amplification factors per method
+MAX_EXTENT = 1e8        # `stability --extent`
+MAX_HS = 50             # `order --hs` COUNT
+MAX_SETTINGS = 20       # `work --rtols` / `--steps` entries
+MIN_RTOL = 1e-14        # below double precision's reach
+MAX_FIXED_STEPS = 10_000_000    # steps of one fixed-step run of `work --steps`
+MAX_REPEATS = 100
+MAX_HEAT_N = 1000       # `heat --N`: RK4 needs ~0.15 N^2 steps of N unknowns (1.5e5 at N = 1000, minutes)
+MAX_UNTIL = 10.0        # s: `--scene ... --until` (the reference at --ref-rtol takes minutes per second)
 DEFAULT_ORDER = ("euler,rk4,dopri45,dopri56,dopri78,gbs:stages=2,sw24,trapezoidal,rkc:stages=10,"
                  "dumka3:polynomial=6")
 
@@ -63,12 +75,18 @@ def parse_method(spec: str) -> tuple[str, str, dict]:
     """``"gbs:stages=2"`` -> ``("gbs:stages=2", "gbs", {"stages": 2})``."""
     from cvtfem.errors import InputError
 
+    import inspect
+
+    from cvtfem.integrate.driver import solve
+
     name, *pairs = spec.strip().split(":")
     opts = {}
     for pair in pairs:
         key, sep, val = pair.partition("=")
         if not sep:
             raise InputError("--methods", spec, "options must be key=value, e.g. gbs:stages=2")
+        if key in inspect.signature(solve).parameters:   # h, rtol, ...: the study sets them
+            raise InputError("--methods", spec, f"options must be the method's own, not `{key}` (the study sets it)")
         for conv in (int, float):
             try:
                 opts[key] = conv(val)
@@ -103,28 +121,85 @@ def _problem(name: str, args=None):
     return PROBLEMS[name]()
 
 
-def run(args: argparse.Namespace) -> int:
+def _check_args(args: argparse.Namespace, methods: list) -> None:
+    """Counts, sizes and values of a study's arguments within their bounds, before any work."""
+    from cvtfem.errors import InputError
+
+    def bounded(where: str, value: float, lo: float, hi: float, rule: str = "") -> None:
+        if not (math.isfinite(value) and lo <= value <= hi):
+            raise InputError(where, value, f"must lie in {lo:g}..{hi:g}{rule}")
+
+    if args.study != "heat" and not 1 <= len(methods) <= MAX_METHODS:
+        raise InputError("--methods", args.methods, f"must name 1..{MAX_METHODS} methods, comma separated")
+    if args.study == "stability":
+        bounded("--n", args.n, 2, MAX_PIXELS, f" pixels per axis ({args.n}^2 evaluations per method)")
+        if not (math.isfinite(args.extent) and 0 < args.extent <= MAX_EXTENT):
+            raise InputError("--extent", args.extent, f"must be a half-width in (0, {MAX_EXTENT:g}]")
+    if hasattr(args, "repeats"):
+        bounded("--repeats", args.repeats, 1, MAX_REPEATS, " (runs per setting)")
+    if getattr(args, "scene", ""):
+        bounded("--until", args.until, 0.0, MAX_UNTIL, " s (the reference run costs minutes per simulated second)")
+        bounded("--ref-rtol", args.ref_rtol, MIN_RTOL, 1e-2)
+    if args.study == "heat":
+        bounded("--N", args.N, 3, MAX_HEAT_N, f" (RK4 needs ~{0.15 * args.N ** 2:.3g} steps of {args.N} unknowns)")
+        if not (math.isfinite(args.target) and 0 < args.target < 1):
+            raise InputError("--target", args.target, "must be a relative error in (0, 1)")
+
+
+def _hs(text: str):
+    """``H_MAX:H_MIN:COUNT`` -> COUNT log-spaced steps from H_MAX down to H_MIN."""
     import numpy as np
 
+    from cvtfem.errors import InputError
+
+    try:
+        hmax, hmin, n = text.split(":")
+        hmax, hmin, n = float(hmax), float(hmin), int(n)
+    except ValueError:
+        raise InputError("--hs", text, "must be H_MAX:H_MIN:COUNT") from None
+    if not (math.isfinite(hmax) and 0 < hmin < hmax and 2 <= n <= MAX_HS):
+        raise InputError("--hs", text, "must be H_MAX:H_MIN:COUNT with finite H_MAX > H_MIN > 0 and COUNT in "
+                         f"2..{MAX_HS}")
+    return np.geomspace(hmax, hmin, n)
+
+
+def _settings(args: argparse.Namespace, t_span) -> list[dict]:
+    """The runs of `work`: fixed steps ``--steps`` (at most MAX_FIXED_STEPS over the span) or tolerances ``--rtols``."""
+    from cvtfem.errors import InputError
+
+    steps = _floats(args.steps, "--steps")
+    values = steps or _floats(args.rtols, "--rtols")
+    where = "--steps" if steps else "--rtols"
+    if not 1 <= len(values) <= MAX_SETTINGS:
+        raise InputError(where, args.steps or args.rtols, f"must hold 1..{MAX_SETTINGS} values")
+    span = t_span[1] - t_span[0]
+    for v in values:
+        if steps and not (math.isfinite(v) and v > 0 and span / v <= MAX_FIXED_STEPS):
+            raise InputError("--steps", v, f"must be step sizes > {span / MAX_FIXED_STEPS:.3g} s (at most "
+                             f"{MAX_FIXED_STEPS:.0e} steps over the problem's {span:g} s)")
+        if not steps and not (math.isfinite(v) and MIN_RTOL <= v < 1):
+            raise InputError("--rtols", v, f"must be relative tolerances in {MIN_RTOL:g}..1")
+    return [{"h": h} for h in steps] if steps else [{"rtol": r, "atol": r * 1e-3} for r in values]
+
+
+def run(args: argparse.Namespace) -> int:
     from cvtfem.errors import InputError
     from cvtfem.integrate import study
     from cvtfem.integrate.methods import METHODS
     from cvtfem.post import integrators as plots
 
     methods = [parse_method(m) for m in getattr(args, "methods", "").split(",") if m.strip()]
-    for out in (getattr(args, "png", None), getattr(args, "csv", None)):
-        if out:
-            Path(out).parent.mkdir(parents=True, exist_ok=True)
+    _check_args(args, methods)
+    problem = _problem(args.problem, args) if args.study in ("order", "work") else None
+    hs = _hs(args.hs) if args.study == "order" else None
+    settings = _settings(args, problem.t_span) if args.study == "work" else None
     if args.study == "stability":
-        out = plots.plot_stability(methods, args.png, extent=args.extent, log=args.log, n=args.n)
+        for _, method, _ in methods:   # scipy's solvers take real states only: no complex test equation
+            if method not in METHODS:
+                raise InputError("--methods", method, f"must be native methods {sorted(METHODS)}")
+        out = plots.plot_stability(methods, _out(args.png), extent=args.extent, log=args.log, n=args.n)
         print(f"wrote {out}")
     elif args.study == "order":
-        try:
-            hmax, hmin, n = args.hs.split(":")
-            hs = np.geomspace(float(hmax), float(hmin), int(n))
-        except ValueError:
-            raise InputError("--hs", args.hs, "must be H_MAX:H_MIN:COUNT") from None
-        problem = _problem(args.problem, args)
         curves, rows = [], []
         for label, method, opts in methods:
             if method not in METHODS:
@@ -134,32 +209,40 @@ def run(args: argparse.Namespace) -> int:
             curves.append((label, hs, errs, nominal))
             p = study.effective_order(hs, errs)
             rows += [{"label": label, "h": h, "error": e, "p_eff": q}
-                     for h, e, q in zip(hs, errs, [np.nan, *p])]
+                     for h, e, q in zip(hs, errs, [math.nan, *p])]
             print(f"{label:28s} nominal {nominal}  p~ = " + " ".join(f"{q:5.2f}" for q in p))
-        plots.plot_effective_order(curves, args.png, f"effective order on {problem.name}")
-        plots.write_csv(rows, args.csv)
+        plots.plot_effective_order(curves, _out(args.png), f"effective order on {problem.name}")
+        plots.write_csv(rows, _out(args.csv))
         print(f"wrote {args.png}, {args.csv}")
     elif args.study == "work":
-        problem = _problem(args.problem, args)
-        steps = _floats(args.steps, "--steps")
-        settings = ([{"h": h} for h in steps] if steps else
-                    [{"rtol": r, "atol": r * 1e-3} for r in _floats(args.rtols, "--rtols")])
         runs = [(label, method, {**opts, **s}) for label, method, opts in methods for s in settings]
         rows = study.work_precision(problem, runs, repeats=args.repeats, error=getattr(problem, "error", None))
         _print_rows(rows)
-        plots.plot_work_precision(rows, args.png, f"work-precision on {problem.name}")
-        plots.write_csv(rows, args.csv)
+        plots.plot_work_precision(rows, _out(args.png), f"work-precision on {problem.name}")
+        plots.write_csv(rows, _out(args.csv))
         print(f"wrote {args.png}, {args.csv}")
     elif args.study == "heat":
-        names = [m for m in args.methods.split(",") if m.strip()] or None
-        rows = study.heat_benchmark(N=args.N, target=args.target, repeats=args.repeats, methods=names)
+        names = [m.strip() for m in args.methods.split(",") if m.strip()] or None
+        try:
+            rows = study.heat_benchmark(N=args.N, target=args.target, repeats=args.repeats, methods=names)
+        except KeyError as err:   # a name the benchmark's plan does not hold
+            if names is None or err.args[0] not in names:
+                raise
+            raise InputError("--methods", err.args[0], "must be methods of the heat benchmark (rk4, dopri45, dumka3, "
+                             "rock2, rock4, rkc, trapezoidal, Radau, BDF)") from None
         print(f"heat equation N={args.N}, t=0.1, target relative error {args.target:g}; "
               f"median of {args.repeats} runs on {platform.machine()} {platform.processor() or ''} "
               f"Python {platform.python_version()}")
         _print_rows(rows)
-        plots.write_csv(rows, args.csv)
+        plots.write_csv(rows, _out(args.csv))
         print(f"wrote {args.csv}")
     return 0
+
+
+def _out(path: str) -> str:
+    """An output file's path, its folder created (once the study has its results)."""
+    Path(path).parent.mkdir(parents=True, exist_ok=True)
+    return path
 
 
 def problem_system(problem):

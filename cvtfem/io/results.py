@@ -31,11 +31,14 @@ name next to it and moved over the original once it is consistent.
 """
 from __future__ import annotations
 
+import ctypes
 import fcntl
+import functools
 import os
 import struct
 import time
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterator, Mapping, Sequence
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from datetime import datetime, timezone
 from pathlib import Path
@@ -175,36 +178,34 @@ class ResultsWriter:
         ckpt.write(self._file, self._layout, seq, {**values, "rows": self._rows})
 
     @classmethod
-    def resume(cls, path: str | Path, flush_interval: float = 2.0,
-               where: str = "--resume") -> tuple[ResultsWriter, int, dict[str, np.ndarray]]:
+    def resume(cls, path: str | Path, flush_interval: float = 2.0, where: str = "--resume",
+               scene_toml: str | None = None) -> tuple[ResultsWriter, int, dict[str, np.ndarray]]:
         """Reopen a killed run's file for appending from its newest checkpoint.
 
         Returns the writer (rows up to the checkpoint, later rows dropped: the run recomputes
         them), the checkpoint number and its payload (``rows`` included).  Refused with
         :class:`InputError` for a finished run, a file without checkpoint or not a run.
+        ``scene_toml`` replaces the stored scene (a resume with changed values).
         """
         path = Path(path)
         if not path.is_file():
             raise InputError(where, str(path), "must be an existing results file (.h5) of a killed run")
         lock = RunLock(path, where)
         try:
-            return cls._resume(path, flush_interval, where, lock)
+            return cls._resume(path, flush_interval, where, lock, scene_toml)
         except BaseException:
             lock.release()
             raise
 
     @classmethod
-    def _resume(cls, path: Path, flush_interval: float, where: str,
-                lock: RunLock) -> tuple[ResultsWriter, int, dict[str, np.ndarray]]:
-        f = _open_for_reading(path, where)
-        with f:
-            attrs = dict(f.attrs)
-            if attrs.get("kind") != "run" or "series" not in f:
+    def _resume(cls, path: Path, flush_interval: float, where: str, lock: RunLock,
+                scene_toml: str | None) -> tuple[ResultsWriter, int, dict[str, np.ndarray]]:
+        with _reading(path, where) as f:
+            attrs, group = _checked(f, path, where)
+            if attrs.get("kind") != "run":
                 raise InputError(where, str(path), f"must be the results file of `cvtfem run` (kind is "
                                  f"{attrs.get('kind')!r})")
-            status = str(attrs.get("status", ""))
-            group = f["series"]
-            if status == "finished":
+            if attrs.get("status") == "finished":
                 t = group["time"]
                 last = f"{t[-1]:.6g} s" if t.shape[0] else "its end"
                 raise InputError(where, str(path), f"must be an unfinished run: this one finished (t = {last})",
@@ -223,10 +224,15 @@ class ResultsWriter:
                                  "series hold fewer")
             specs = [OutputSpec(name, str(d.attrs.get("unit", "")), str(d.attrs.get("doc", "")), d.shape[1])
                      for name, d in group.items() if name != "time"]
-            resume = {"time": group["time"][:rows], "series": {s.name: group[s.name][:rows] for s in specs},
+            kept = {name: d[:rows] for name, d in group.items()}
+            bad = next((name for name, a in kept.items() if not np.isfinite(a).all()), None)
+            if bad is not None:   # the writer never stores one: the file is damaged
+                raise InputError(where, str(path), f"is damaged: `/series/{bad}` holds non-finite values in the "
+                                 f"{rows} rows up to checkpoint {seq}")
+            resume = {"time": kept["time"], "series": {s.name: kept[s.name] for s in specs},
                       "attrs": {"created": attrs.get("created", ""), "resumed": int(attrs.get("resumed", 0)) + 1},
                       "seq": seq, "values": values}
-            scene_toml = f["scene"][()].decode()
+            scene_toml = _scene_text(f, path, where) if scene_toml is None else scene_toml
         fields = tuple(fd for fd in layout.fields if fd[0] != "rows")
         tmp = path.with_name(path.name + ".resume-tmp")
         writer = cls(tmp, scene_toml, "run", specs, flush_interval, overwrite=True, checkpoint=ckpt.Layout(fields),
@@ -347,13 +353,17 @@ class Results:
 HDF5_SIGNATURE = b"\x89HDF\r\n\x1a\n"
 
 
-def _open_for_reading(path: Path, where: str) -> h5py.File:
-    """Open a results file read-only (SWMR), after checking that it is not cut short.
+@contextmanager
+def _reading(path: Path, where: str) -> Iterator[h5py.File]:
+    """An open results file (read-only, SWMR) for the ``with`` body; whatever HDF5 raises on damaged metadata or
+    data there (OSError, RuntimeError, KeyError, TypeError, ValueError from h5py) becomes one :class:`InputError` line.
 
-    A truncated file (a partial copy, a full disk) is refused up front: HDF5's SWMR reader retries
-    metadata reads of a missing region without end, so reading one would hang.  The check reads the
+    A truncated file (a partial copy, a full disk) is refused before HDF5 opens it: HDF5's SWMR reader
+    retries metadata reads of a missing region without end, so reading one would hang.  The check reads the
     end-of-file address of the version 2/3 superblock that the writer creates (``libver="latest"``).
     """
+    if not path.is_file():
+        raise InputError(where, str(path), "must be an existing results file (.h5)")
     try:
         with open(path, "rb") as raw:
             head = raw.read(44)
@@ -366,24 +376,116 @@ def _open_for_reading(path: Path, where: str) -> h5py.File:
             raise InputError(where, str(path), f"is truncated: HDF5 says {base + eof} bytes, the file has {size} "
                              "(a partial copy or a full disk?)")
     try:
-        return h5py.File(path, "r", libver="latest", swmr=True, locking=False)
-    except OSError as err:
-        raise InputError(where, str(path), f"must be a readable HDF5 file ({err})") from None
+        with _open_swmr(path) as f:
+            yield f
+    except InputError:
+        raise
+    except (OSError, RuntimeError, KeyError, TypeError, ValueError) as err:
+        text = " ".join(str(err).split()) or type(err).__name__
+        raise InputError(where, str(path), f"must be a readable HDF5 results file (damaged: {text})") from None
+
+
+#: Metadata read attempts of a SWMR reader: HDF5's default of 100 retried a file with damaged metadata for more
+#: than 10 minutes (the fuzz of `show`); 10 end in ~0.02 s and leave a live writer's torn reads 9 retries.
+READ_ATTEMPTS = 10
+
+
+@functools.cache
+def _hdf5_library() -> ctypes.CDLL | None:
+    """The HDF5 library h5py runs on, for the one setting h5py does not offer (None where it is not found)."""
+    try:
+        maps = Path("/proc/self/maps").read_text()
+    except OSError:
+        return None
+    names = {line.split()[-1] for line in maps.splitlines() if "/libhdf5" in line and "libhdf5_hl" not in line}
+    if len(names) != 1:
+        return None
+    lib = ctypes.CDLL(names.pop())
+    if not hasattr(lib, "H5Pset_metadata_read_attempts"):
+        return None
+    lib.H5Pset_metadata_read_attempts.argtypes = [ctypes.c_int64, ctypes.c_uint]
+    return lib
+
+
+def _open_swmr(path: Path) -> h5py.File:
+    """``h5py.File(path, "r", libver="latest", swmr=True, locking=False)`` with at most :data:`READ_ATTEMPTS`
+    metadata read attempts."""
+    fapl = h5py.h5p.create(h5py.h5p.FILE_ACCESS)
+    fapl.set_libver_bounds(h5py.h5f.LIBVER_LATEST, h5py.h5f.LIBVER_LATEST)
+    fapl.set_file_locking(False, True)
+    lib = _hdf5_library()
+    if lib is not None:
+        lib.H5Pset_metadata_read_attempts(fapl.id, READ_ATTEMPTS)
+    return h5py.File(h5py.h5f.open(os.fsencode(path), h5py.h5f.ACC_RDONLY | h5py.h5f.ACC_SWMR_READ, fapl=fapl))
+
+
+#: Root attributes of a results file that hold text.
+TEXT_ATTRS = ("cvtfem_version", "kind", "status", "message", "created")
+
+
+def _checked(f: h5py.File, path: Path, where: str) -> tuple[dict[str, Any], h5py.Group]:
+    """Root attributes and ``/series`` of an open results file, once its structure is that of one: text
+    attributes, groups ``/series`` (a 1-D float ``time``, 2-D float arrays) and ``/stats``, a ``/scene``."""
+    def refuse(what: str) -> InputError:
+        return InputError(where, str(path), f"must be a cvtfem results file ({what})")
+
+    missing = [name for name in ("series", "scene", "stats") if name not in f]
+    if missing:
+        raise refuse(f"it has no {', '.join(missing)}")
+    attrs = dict(f.attrs)
+    for key in TEXT_ATTRS:
+        if key in attrs and not (isinstance(attrs[key], str) and _utf8(attrs[key])):
+            raise refuse(f"its attribute `{key}` is not UTF-8 text")
+    group = f["series"]
+    if not isinstance(group, h5py.Group) or not isinstance(f["stats"], h5py.Group):
+        raise refuse("`/series` and `/stats` must be groups")
+    if "time" not in group:
+        raise refuse("it has no `/series/time`")
+    for name, d in group.items():
+        ndim = 1 if name == "time" else 2
+        if not isinstance(d, h5py.Dataset) or d.ndim != ndim or d.dtype.kind != "f":
+            raise refuse(f"`/series/{name}` is not a {ndim}-D float array")
+        texts = [name] + [d.attrs[key] for key in ("unit", "doc") if key in d.attrs]
+        if not all(isinstance(text, str) and _utf8(text) for text in texts):
+            raise refuse(f"the name, unit or doc of `/series/{name!r}` is not UTF-8 text")
+    return attrs, group
+
+
+def _utf8(text: str) -> bool:
+    """False for a string h5py decoded from invalid UTF-8 (it maps the bad bytes to surrogates)."""
+    try:
+        text.encode()
+    except UnicodeEncodeError:
+        return False
+    return True
+
+
+def _scene_text(f: h5py.File, path: Path, where: str) -> str:
+    """The scene TOML stored in an open results file."""
+    d = f.get("scene")
+    if not isinstance(d, h5py.Dataset) or d.shape != () or d.dtype.kind not in "OSU":
+        raise InputError(where, str(path), "must be a cvtfem results file (its `/scene` is not a text)")
+    text = d[()]
+    try:
+        return text.decode() if isinstance(text, bytes) else str(text)
+    except UnicodeDecodeError:
+        raise InputError(where, str(path), "must be a cvtfem results file (its `/scene` is not UTF-8)") from None
+
+
+def read_scene_toml(path: str | Path, where: str = "RESULTS") -> str:
+    """The scene TOML stored in a results file (nothing else is read)."""
+    path = Path(path)
+    with _reading(path, where) as f:
+        return _scene_text(f, path, where)
 
 
 def read_results(path: str | Path) -> Results:
     """Read a results file (also one whose run was killed: complete rows only)."""
     path = Path(path)
-    if not path.is_file():
-        raise InputError("RESULTS", str(path), "must be an existing results file (.h5)")
-    f = _open_for_reading(path, "RESULTS")
-    with f:
-        missing = [name for name in ("series", "scene", "stats") if name not in f]
-        if missing:
-            raise InputError("RESULTS", str(path), f"must be a cvtfem results file (it has no {', '.join(missing)})")
-        group = f["series"]
+    with _reading(path, "RESULTS") as f:
+        attrs, group = _checked(f, path, "RESULTS")
         rows = min(d.shape[0] for d in group.values())
         series = {name: d[:rows] for name, d in group.items() if name != "time"}
         units = {name: str(d.attrs.get("unit", "")) for name, d in group.items()}
-        return Results(path=path, attrs=dict(f.attrs), scene_toml=f["scene"][()].decode(),
+        return Results(path=path, attrs=attrs, scene_toml=_scene_text(f, path, "RESULTS"),
                        stats=dict(f["stats"].attrs), time=group["time"][:rows], series=series, units=units)

@@ -12,6 +12,8 @@ with ``info["dissipation"]`` and ``info["clamp_power"]``, ``kinetic_energy(q, v)
 """
 from __future__ import annotations
 
+import dataclasses
+import logging
 import math
 from dataclasses import dataclass
 from typing import Any
@@ -23,7 +25,10 @@ from cvtfem.assembly.model import Linearization, ModelBase, StateLayout
 from cvtfem.control.clamping import Clamping
 from cvtfem.control.regimes import Regime
 from cvtfem.elements.base import Block, Layout
+from cvtfem.errors import NumericalError
 from cvtfem.outputs import OutputSpec
+
+log = logging.getLogger(__name__)
 
 #: SI unit of a band-family coordinate by its name without the arc digits.
 COORDINATE_UNITS = {"phi": "rad", "sigma": "m", "z": "m", "h": "m", "U": "m", "psi": "rad"}
@@ -59,12 +64,23 @@ class BandCVT(ModelBase):
         n, nc = self.model.n2, self.control.size
         return x[:n], x[n:2 * n], x[2 * n:2 * n + nc], x[2 * n + nc:]
 
+    def with_regime(self, **changes: Any) -> BandCVT:
+        """This loop with the regime's fields ``changes`` (e.g. ``input_speed`` rad/s, ``torque`` N m, ``ratio``)."""
+        return dataclasses.replace(self, regime=dataclasses.replace(self.regime, **changes))
+
     def initial_state(self, ratio: float | None = None, speed_factor: float = 1.0) -> np.ndarray:
-        """Band at the span angle of the target ratio, driving shaft at the target speed.
+        """The start state of :meth:`start` (logs its warning, if any)."""
+        return self.start(ratio, speed_factor)[0]
+
+    def start(self, ratio: float | None = None, speed_factor: float = 1.0) -> tuple[np.ndarray, dict[str, Any]]:
+        """Band at the span angle of the target ratio, driving shaft at the target speed: ``(x0, report)``.
 
         Band families with ``steady_state`` start in steady running (elastic coordinates and slips in
-        balance); others start without slip on pulley 1.  ``ratio`` and ``speed_factor`` start the run away
-        from the targets (geometric ratio, driving speed as a multiple of its target).
+        balance; ``report = {"kind": "steady", "residual": ...}``, the relative Newton correction); others,
+        and a steady state that is not found, start without slip on pulley 1 from the static elastic
+        equilibrium (``{"kind": "no-slip"}``; for a steady state not found also ``"warning"``, one line saying
+        why, logged).  ``ratio`` and ``speed_factor`` start the run away from the targets (geometric ratio,
+        driving speed as a multiple of its target).
         """
         w1, M1, i = self.regime.targets(0.0)
         F = self.clamping.forces(M1, i)
@@ -72,11 +88,26 @@ class BandCVT(ModelBase):
             i = ratio
         w1 *= speed_factor
         phi = self.clamping.span_angle(i)
+        report: dict[str, Any] = {"kind": "no-slip"}
         if hasattr(self.model, "steady_state"):  # start in steady running: no start-up transient
-            q, v, _, _ = self.model.steady_state(phi, w1, F, M1)
-        else:
+            try:
+                q, v, _, info = self.model.steady_state(phi, w1, F, M1)
+                report = {"kind": "steady", "residual": info["residual"]}
+            except NumericalError as err:
+                report["warning"] = self._no_steady_state(w1, M1, i, F, err)
+                log.warning("%s", report["warning"])
+        if report["kind"] == "no-slip":
             q, v = self.model.initial_state(phi, w1, w1 / i, F)
-        return np.concatenate([q, v, self.control.initial_state(w1, w1 / i), np.zeros(4)])
+        return np.concatenate([q, v, self.control.initial_state(w1, w1 / i), np.zeros(4)]), report
+
+    def _no_steady_state(self, w1: float, M1: float, i: float, F, err: NumericalError) -> str:
+        """Why a run starts without slip: the torques the clamping forces carry by (1.13), and the solver's word."""
+        safety = min(F / self.clamping.estimates(M1, i)) if M1 > 0 else math.inf
+        why = (f"the clamping forces {F[0] / 1e3:.3g} / {F[1] / 1e3:.3g} kN carry {safety:.3g} x the torque by the "
+               "estimate (1.13), so friction cannot hold it (the slip grows without bound)" if safety <= 1.0 else
+               f"not found ({err})")
+        return (f"no steady state at {w1 * 30 / math.pi:.0f} rpm, {M1:g} N m, ratio {i:g}: {why}; "
+                "starting without slip on the driving pulley (a start-up transient follows)")
 
     def _controls(self, t: float, w, z):
         """Clamping forces, shaft torques and control-state derivative at shaft speeds ``w`` (rad/s), state z."""

@@ -231,3 +231,44 @@ def test_diverged_fixed_step_run_fails_loudly(tmp_path, cli, until, needles):
     from cvtfem.io.results import read_results
 
     assert read_results(tmp_path / "r.h5").attrs["status"] == "failed"
+
+
+def test_damaged_results_file_metadata_ends_in_one_line(tmp_path, finished_run):
+    """64 damaged 64-byte blocks over the file's first 4 KiB (its metadata), each read by `show` in a subprocess
+    with a deadline: HDF5's SWMR reader retried damaged metadata for more than 10 minutes before the fix."""
+    import subprocess
+    import sys
+
+    base = finished_run.read_bytes()
+    for k, at in enumerate(range(0, 4096, 64)):
+        blob = bytearray(base)
+        blob[at:at + 64] = bytes((at + i) * 37 % 256 for i in range(64))
+        (tmp_path / f"d{k}.h5").write_bytes(bytes(blob))
+    code = ("import sys\nfrom cvtfem.cli import main\n"
+            "for k in range(64):\n    print(main(['show', sys.argv[1] + f'/d{k}.h5']), file=sys.stderr)\n")
+    res = subprocess.run([sys.executable, "-c", code, str(tmp_path)], capture_output=True, text=True, timeout=120)
+    assert res.returncode == 0 and "Traceback" not in res.stderr, res.stderr[-2000:]
+    lines = res.stderr.strip().splitlines()
+    codes = [int(line) for line in lines if line in ("0", "2", "3")]
+    assert len(codes) == 64 and set(codes) <= {0, 2}, lines
+    errors = [line for line in lines if line not in ("0", "2", "3")]
+    assert len(errors) == codes.count(2) and all(line.startswith("cvtfem show: error: `RESULTS` ")
+                                                 for line in errors), errors
+
+
+@pytest.mark.parametrize("argv,needles", [
+    (("study", "stability", "--n", "0"), ("`--n`", "2..2001")),                            # TypeError
+    (("study", "stability", "--methods", ","), ("`--methods`", "1..40 methods")),          # ZeroDivisionError
+    (("study", "stability", "--extent", "nan"), ("`--extent`",)),                          # ran on NaN
+    (("study", "order", "--hs", "0.1:0.01:0"), ("`--hs`", "COUNT in 2..50")),               # empty study
+    (("study", "work", "--repeats", "0"), ("`--repeats`", "1..100")),                      # AttributeError
+    (("study", "work", "--problem", "oscillator", "--steps", "1e-12"), ("`--steps`", "1e+07 steps")),
+    (("study", "heat", "--methods", "foo", "--N", "10"), ("`--methods`", "heat benchmark")),  # KeyError
+    (("study", "heat", "--N", "100000"), ("`--N`", "3..1000", "1.5e+09 steps")),
+    (("study", "order", "--png", "o.0"), ("`--png`", ".png file")),                        # matplotlib ValueError
+    (("study", "heat", "\x1e", "--N", "10"), ("unrecognized arguments: \\x1e",)),          # two lines
+])
+def test_study_arguments_refused_up_front(tmp_path, cli, argv, needles):
+    line = _one_line_error(cli(*argv, cwd=tmp_path, timeout=60), *needles)
+    assert not list(tmp_path.iterdir())   # nothing written
+    assert "\x1e" not in line

@@ -267,9 +267,70 @@ def test_resume_refuses_file_without_checkpoint(tmp_path, cli):
 
 
 def test_resume_argument_errors(tmp_path, cli):
-    res = cli("run", "band-4dof", "--resume", str(tmp_path / "x.h5"))
-    assert res.returncode == 2 and "cannot be combined with --resume" in res.stderr
+    res = cli("run", "--resume", str(tmp_path / "x.h5"), "--until", "1")
+    assert res.returncode == 2 and "`--until` cannot be combined with --resume" in res.stderr
     res = cli("run", "--resume", str(tmp_path / "missing.h5"))
     assert res.returncode == 2 and "must be an existing results file" in res.stderr
     res = cli("run")
     assert res.returncode == 2 and "`SCENE` is required" in res.stderr
+
+
+CHANGED = """preset = "band-4dof"
+title = "{title}"
+[solver]
+method = "{method}"
+[cvt.regime]
+torque = {torque}
+[output]
+checkpoint_interval = 0.005
+"""
+
+
+def _cli(capsys, *args):
+    """``cvtfem ARGS`` in this process: (exit status, stderr lines)."""
+    from cvtfem.cli import main
+
+    code = main(list(args))
+    return code, capsys.readouterr().err.strip().splitlines()
+
+
+def test_resume_with_a_changed_scene(tmp_path, capsys):
+    """Issue 18: SCENE with --resume must be the stored scene (its title aside), unless --resume-changed."""
+    def scene(title="a", method="RK45", torque=200.0):
+        path = tmp_path / f"{title}-{method}-{torque}.toml"
+        path.write_text(CHANGED.format(title=title, method=method, torque=torque))
+        return str(path)
+
+    base = scene()
+    _interrupted(load_scene(base), tmp_path / "r.h5", 1, 0.015)
+    before = read_results(tmp_path / "r.h5")
+    code, err = _cli(capsys, "run", scene(torque=250.0), "--resume", str(tmp_path / "r.h5"))
+    assert code == 2 and len(err) == 1, err
+    assert "`cvt.regime.torque` is 200.0 in the results file, 250.0 in SCENE" in err[0]
+    assert "--resume-changed" in err[0]
+    after = read_results(tmp_path / "r.h5")
+    assert after.attrs["status"] == "failed" and _series_equal(before, after)   # untouched
+    # another method changes the checkpoint's layout: refused even with --resume-changed
+    code, err = _cli(capsys, "run", scene(method="BDF"), "--resume", str(tmp_path / "r.h5"), "--resume-changed")
+    assert code == 2 and len(err) == 1 and "must give the state layout of the run in" in err[0], err
+    assert _series_equal(before, read_results(tmp_path / "r.h5"))   # untouched
+    code, err = _cli(capsys, "run", "--resume", str(tmp_path / "r.h5"), "--resume-changed")
+    assert code == 2 and len(err) == 1 and "`--resume-changed`" in err[0] and "needs SCENE" in err[0], err
+    # a new title only: resumed as without SCENE, bitwise the uninterrupted run
+    ref = run_scene(load_scene(base), until=0.015, results=tmp_path / "ref.h5", show_progress=False)
+    _interrupted(load_scene(base), tmp_path / "same.h5", 1, 0.015)
+    code, err = _cli(capsys, "run", scene(title="renamed"), "--resume", str(tmp_path / "same.h5"))
+    assert code == 0 and err == [], err
+    assert _series_equal(read_results(tmp_path / "ref.h5"), read_results(tmp_path / "same.h5"))
+    # with --resume-changed: the rows up to the checkpoint stay, the run continues at the new torque
+    code, err = _cli(capsys, "run", scene(torque=250.0), "--resume", str(tmp_path / "r.h5"), "--resume-changed")
+    assert code == 0 and err == [], err
+    res = read_results(tmp_path / "r.h5")
+    t_ck = res.stats["resumed_from_t"]
+    assert res.attrs["status"] == "finished" and "torque = 250.0" in res.scene_toml
+    assert res.stats["scene_changed"] == "`cvt.regime.torque` is 200.0 in the results file, 250.0 in SCENE"
+    kept = before.time <= t_ck
+    ref = read_results(tmp_path / "ref.h5")
+    np.testing.assert_array_equal(res.series["driving.torque"][:kept.sum()], ref.series["driving.torque"][:kept.sum()])
+    assert np.all(res.series["driving.torque"][res.time > t_ck] == 250.0)
+    assert ref.series["driving.torque"][-1] == 200.0
