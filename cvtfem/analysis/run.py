@@ -239,7 +239,7 @@ class _Run:
         from cvtfem.io.checkpoint import Layout
 
         if self._layout is None:
-            n, n2, m = self.loop.size, self.loop.model.n2, len(self.events[1]) if self.events else 0
+            n, n2, m = self.loop.size, self.loop.n2, len(self.events[1]) if self.events else 0
             sparsity = getattr(self.loop, "jac_sparsity", None)
             fields = [("t_end", 1), ("k", 1), ("steps", 1), ("next_checkpoint", 1), ("t_last", 1), ("x_last", n),
                       ("x_window", n), ("wall", 1), ("retry", 1)] + list(loop_fields(n, m))
@@ -299,7 +299,7 @@ class _Run:
 
         scene, loop, sol, t_end, t_out = self.scene, self.loop, self.scene.solver, self.t_end, self.t_out
         method, h_fixed, rtol, atol = self.settings()
-        n, n2 = loop.size, loop.model.n2
+        n, n2 = loop.size, loop.n2
         k, steps, seq, wall_before = 0, 0, 0, 0.0
         last, x_window = (math.nan, np.full(n, math.nan)), np.full(n, math.nan)
         next_ck = self.interval
@@ -395,7 +395,7 @@ class _Run:
         counts = run.counts
         stats = {"name": method, "steps": steps, "nfev": int(counts["nfev"]), "njev": int(counts["njev"]),
                  "nlu": int(counts["nlu"]), "rtol": rtol, "atol": atol,
-                 "kernel": getattr(loop.model, "backend", "numpy")}  # compiled (numba) or numpy right-hand side
+                 "kernel": getattr(getattr(loop, "model", loop), "backend", "numpy")}  # numba or numpy RHS
         stats.update(run.engine.report())
         warning = run.engine.warning()
         if warning is not None:
@@ -420,8 +420,10 @@ class _Run:
                 for i, name in enumerate(self.event_names):
                     writer.add_array(f"event.{i}.times", np.array(run.t_events[i], dtype=float), "s",
                                      f"Times of event {name!r}.")
-            writer.add_array("band.node_xi", loop.model.arc_nodes(0.0)[0] / (math.pi / 2), "-",
-                             "Quadrature nodes xi = theta / theta* of band.normal_force (same on both arcs).")
+            arc_nodes = getattr(getattr(loop, "model", None), "arc_nodes", None)   # band 6+2n models
+            if arc_nodes is not None:
+                writer.add_array("band.node_xi", arc_nodes(0.0)[0] / (math.pi / 2), "-",
+                                 "Quadrature nodes xi = theta / theta* of band.normal_force (same on both arcs).")
             writer.close(status, message)
             summary.results = str(writer.path)
         if diverged:

@@ -55,7 +55,7 @@ def summarise(scene, loop, last, window, t_end, wall, stats, status) -> RunSumma
                 f"{info['M'][0]:.3g} N m); efficiency needs positive input power")
     rpm = 30 / math.pi
     w = info["w"]
-    return RunSummary(scene=scene.source, model=scene.cvt.model, n_coordinates=loop.model.n2,
+    return RunSummary(scene=scene.source, model=scene.cvt.model, n_coordinates=loop.n2,
                       simulated_time_s=float(t_last), wall_time_s=wall, ratio=float(w[0] / w[1]), target_ratio=i_d,
                       input_speed_rpm=float(w[0] * rpm), output_speed_rpm=float(w[1] * rpm),
                       target_output_speed_rpm=float(w1d / i_d * rpm), efficiency=eff,

@@ -126,17 +126,22 @@ class ChainCVT(ModelBase):
         X = self.contact.gather(pins, shafts, u, u3, ud, u3d, q[iz], v[iz], v[iphi])
         return pins, shafts, X, self.contact.local(X, shafts, details)
 
-    def _forces(self, q, v, F, M):
-        """Generalized forces on all coordinates (N, N m) and the friction power (W)."""
+    def _forces(self, q, v, F, M, slip: bool = False):
+        """Generalized forces on all coordinates (N, N m) and the friction power (W); with ``slip`` also the
+        contact-force-weighted mean slip speed on each shaft (m/s, 0 without contact)."""
         nc, iphi, iz, dof3 = self._idx
         Q = np.zeros(self.n2)
         Q[:nc] = self.family.forces(q[:nc], v[:nc])
-        pins, shafts, _, Y = self._contacts(q, v)
+        pins, shafts, _, Y = self._contacts(q, v, details=slip)
+        if slip:
+            Y, det = Y
+            N = np.bincount(shafts, det["N"], 2)
+            mean_slip = np.bincount(shafts, det["N"] * np.linalg.norm(det["slip"], axis=1), 2) / np.maximum(N, 1e-300)
         Qp, Qz, Qphi, Pf = self.contact.scatter(Y, pins, shafts, self.family.n)
         Q[dof3] += Qp
         Q[iphi] += Qphi + M
         Q[iz] += Qz - 2 * F
-        return Q, Pf
+        return (Q, Pf, mean_slip) if slip else (Q, Pf)
 
     def solve_mass(self, Q):
         nc, iphi, iz, _ = self._idx
@@ -146,20 +151,23 @@ class ChainCVT(ModelBase):
         a[iz] = Q[iz] / self.m_sheave
         return a
 
-    def evaluate(self, t: float, x):
-        """``(dx/dt, info)``: right-hand side and the loop's quantities."""
+    def evaluate(self, t: float, x, slip: bool = True):
+        """``(dx/dt, info)``: right-hand side and the loop's quantities (``targets`` of the regime, clamping
+        forces ``F``, torques ``M``, speeds ``w``, friction power; with ``slip`` the mean slip speed per shaft)."""
         q, v, zc, _ = self.split(x)
         nc, iphi, iz, _ = self._idx
         w = v[iphi]
         F, M, dz, diag = self._controls(t, w, zc)
-        Q, Pf = self._forces(q, v, F, M)
+        Q, Pf, *mean_slip = self._forces(q, v, F, M, slip)
         D = 2 * self.family.rayleigh(q[:nc], v[:nc]) - Pf
         dW = np.array([M[0] * w[0], -M[1] * w[1], D, -2 * float(F @ v[iz])])
-        diag = dict(diag, F=F, M=M, w=w, friction_power=Pf)
+        diag = dict(diag, F=F, M=M, w=w, friction_power=Pf, targets=self.regime.targets(t))
+        if slip:
+            diag["slip"] = mean_slip[0]
         return np.concatenate([v, self.solve_mass(Q), dz, dW]), diag
 
     def rhs(self, t: float, x):
-        return self.evaluate(t, x)[0]
+        return self.evaluate(t, x, slip=False)[0]
 
     # ----- Jacobian ----------------------------------------------------------------------------
     @cached_property
@@ -461,8 +469,15 @@ class ChainCVT(ModelBase):
 
     def initial_state(self) -> np.ndarray:
         """The quasi-static state (:meth:`static_state`) at the regime's ratio and driving speed at ``t = 0``."""
+        return self.start()[0]
+
+    def start(self) -> tuple[np.ndarray, dict[str, Any]]:
+        """``(x0, report)`` of :meth:`initial_state`; ``report["kind"]`` says how the run starts (the run
+        driver's interface)."""
         w1, _, i = self.regime.targets(0.0)
-        return self.static_state(i, w1)[0]
+        x0, rep = self.static_state(i, w1)
+        return x0, {"kind": f"quasi-static on the sheaves (residual {rep['residual']:.1e} of F2, largest "
+                            f"penetration {1e6 * rep['max_penetration']:.1f} um)"}
 
     def with_clamping(self, F_appl) -> "ChainCVT":
         """The same model with other prescribed clamping forces (N per sheave)."""

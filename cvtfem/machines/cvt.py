@@ -100,8 +100,10 @@ def _components(scene: Scene, body: Layout) -> tuple[Layout, ...]:
 
 
 def layout(scene: Scene) -> tuple[Layout, ...]:
-    """Components of the CVT model the scene calls for, in DOF order (without building its physics)."""
+    """Components of the CVT model the scene calls for, in DOF order (a running chain: from its model)."""
     cvt = scene.cvt
+    if cvt.model in RUNNING_CHAINS:
+        return _running_chain_layout(scene)
     body = _band(cvt.model, cvt.ritz_order, cvt.quadrature_nodes) if cvt.model.startswith("band") else _chain(scene)
     return _components(scene, body)
 
@@ -154,17 +156,20 @@ def chain_geometry(scene: Scene):
                  period=ch.lacing_period, c_pin=ch.pin_axial_stiffness)
 
 
+#: Discrete-chain models that run as a transmission (the others exist as element families only).
+RUNNING_CHAINS = ("chain-S2", "chain-S3")
+
+
 def band_model(scene: Scene, **overrides: Any):
     """The dynamic band model a scene calls for (``band-4dof``, ``band-6+2n``, ``band-6+2n+8``).
 
-    Raises InputError for the static ``band-1dof`` and for discrete-chain models (not available yet).
+    Raises InputError for the static ``band-1dof`` and for discrete-chain models (:func:`chain_loop`).
     """
     from cvtfem.elements.band import model_for
 
     model = scene.cvt.model
     if model.startswith("chain"):
-        raise InputError("cvt.model", model, "is a discrete-chain model, which is not available yet",
-                         "use one of band-4dof, band-6+2n, band-6+2n+8 (e.g. `preset = \"band-4dof\"`)")
+        raise InputError("cvt.model", model, "is a discrete-chain model, not a band model")
     if model == "band-1dof":
         raise InputError("cvt.model", model, "is the static equilibrium model and has no time run",
                          "use a dynamic band model (band-4dof, band-6+2n, band-6+2n+8)")
@@ -203,6 +208,8 @@ def closed_loop(scene: Scene, **overrides: Any):
     from cvtfem.machines.band_cvt import BandCVT
 
     cvt = scene.cvt
+    if cvt.model.startswith("chain"):
+        return chain_loop(scene)
     model = band_model(scene, **overrides)
     p = model.p
     rg = cvt.regime
@@ -218,3 +225,60 @@ def closed_loop(scene: Scene, **overrides: Any):
                                                     c.c_sat, c.tau, c.nu, J_sigma))
     parts = _components(scene, _band(cvt.model, p.n_ritz, p.n_gauss))
     return BandCVT(model, clamping, regime, control, parts)
+
+
+def chain_loop(scene: Scene):
+    """Scene -> :class:`~cvtfem.machines.chain_cvt.ChainCVT`: the chain of :func:`chain_geometry` on two rigid
+    shafts with Hertz contact at the pin-axis ends (H1), the scene's friction, shafts, loops and regime.
+
+    The prescribed clamping forces are those the band models get (:class:`~cvtfem.control.clamping.Clamping`
+    at the regime's start: torque, ratio, safety factor, split); the ratio loop corrects ``F1`` from there.
+    Only what runs is accepted: ``chain-S2`` (no pin bending) and ``chain-S3`` (pin bending), rigid shafts,
+    ``effects.contact = "hertz"``, friction on.
+    """
+    from cvtfem.control.clamping import Clamping
+    from cvtfem.machines.chain_cvt import from_scene
+
+    cvt = scene.cvt
+    model, eff, rg = cvt.model, cvt.effects, cvt.regime
+    if model not in RUNNING_CHAINS:
+        raise InputError("cvt.model", model, "must be a discrete chain that runs in time: " + ", ".join(RUNNING_CHAINS)
+                         + " (the other chain models exist as element families only so far, docs/chain.md)")
+    if model == "chain-S3" and not eff.pin_bending:
+        raise InputError("cvt.effects.pin_bending", False, "must be true for `chain-S3` (S2 plus pin bending); "
+                         "without pin bending use `chain-S2`")
+    if eff.shaft_elasticity:
+        raise InputError("cvt.effects.shaft_elasticity", True, f"is not available for `{model}` yet: the chain "
+                         "runs on rigid shafts (set it false)")
+    if eff.contact != "hertz":
+        raise InputError("cvt.effects.contact", eff.contact, f"must be 'hertz' for `{model}`: Hertz contact at the "
+                         "pin-axis end (the refined and impact contacts are not coupled to a running chain yet)")
+    if not eff.friction:
+        raise InputError("cvt.effects.friction", False, "must be true for a chain transmission: the chain "
+                         "transmits torque only by pin-sheave friction")
+    check_ratio_range(scene)
+    F_appl = Clamping(band_params(scene), rg.clamping_safety, rg.clamping_split, rg.min_clamping_force).forces(rg.torque, rg.ratio)
+    overrides = {} if eff.damping else {"damping_ratio": 0.0}
+    return from_scene(scene, chain_geometry(scene), F_appl, model=model, **overrides)
+
+
+def _running_chain_layout(scene: Scene) -> tuple[Layout, ...]:
+    """Components of :func:`chain_loop`'s model with the outputs it writes, grouped by name prefix."""
+    model = chain_loop(scene)
+    n, per_pin = model.family.n, CHAIN_COORDS_PER_PIN[scene.cvt.model]
+
+    def outputs(*prefixes: str) -> tuple[OutputSpec, ...]:
+        return tuple(o for o in model.output_specs if o.name.startswith(prefixes))
+
+    parts = [Layout("chain", scene.cvt.model, n * per_pin, outputs=outputs("chain.", "contact."),
+                    note=f"{n} pins x {per_pin}; Hertz contact at both pin ends with each shaft's sheaves "
+                         "(continuous: no discrete state)"),
+             Layout("driving pulley", "rigid-shaft", 2, outputs=outputs("driving."), note="spin angle, sheave axial"),
+             Layout("driven pulley", "rigid-shaft", 2, outputs=outputs("driven."), note="spin angle, sheave axial")]
+    if scene.cvt.effects.stabilisation:
+        parts.append(Layout("stabilisation", "speed-ratio-control", 0, n1=Stabilisation.size,
+                            outputs=outputs("control."), note="smoothed speeds, F1 integral, b2 integral"))
+    parts.append(Layout("transmission", "derived", 0, n1=4, outputs=outputs("ratio", "efficiency", "power", "work",
+                                                                            "energy"),
+                        note="work integrals and derived outputs"))
+    return tuple(parts)

@@ -36,10 +36,10 @@ def test_run_writes_results_and_summary(cli, tmp_path):
     assert W[-1, 0] == pytest.approx(np.trapezoid(P[:, 0], r.time), rel=1e-3)
 
 
-def test_discrete_chain_model_is_refused(cli):
-    proc = cli("run", "reference_cvt", "--results", "none")
+def test_chain_model_without_a_time_run_is_refused(cli):
+    proc = cli("run", "reference_cvt", "--results", "none")      # chain-A5: element families only so far
     assert proc.returncode == 2
-    assert "cvt.model" in proc.stderr and "not available yet" in proc.stderr
+    assert "cvt.model" in proc.stderr and "chain-S2" in proc.stderr and len(proc.stderr.splitlines()) == 1
     proc = cli("run", "band-1dof", "--results", "none")
     assert proc.returncode == 2 and "static" in proc.stderr
 
