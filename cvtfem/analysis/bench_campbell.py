@@ -6,14 +6,13 @@ bearings, 50 speeds x 20 modes (sparse shift-invert), with peak memory.
 """
 from __future__ import annotations
 
-import os
-import platform
 import resource
-import statistics
 import time
 from collections.abc import Callable
 
 import numpy as np
+
+from cvtfem.analysis.timing import machine, wall_times
 
 
 def large_shaft_scene(n_elements: int = 1666) -> dict:
@@ -27,27 +26,9 @@ def large_shaft_scene(n_elements: int = 1666) -> dict:
                         {"node": n, "kxx": 5e7, "kyy": 4e7, "cxx": 1e3, "cyy": 1e3}]}
 
 
-def machine() -> str:
-    """One line describing the machine and the BLAS threading."""
-    load = os.getloadavg()
-    threads = os.environ.get("OPENBLAS_NUM_THREADS", "default")
-    try:
-        import threadpoolctl  # noqa: F401
-
-        limit = "solves limited to 1 BLAS thread (threadpoolctl)"
-    except ImportError:
-        limit = "threadpoolctl absent: BLAS threads not limited"
-    return (f"{platform.node()} {platform.machine()}, {os.cpu_count()} cores, load {load[0]:.1f}, "
-            f"python {platform.python_version()}, numpy {np.__version__}, OPENBLAS_NUM_THREADS={threads}, {limit}")
-
-
 def _median_time(fn: Callable[[], object], repeat: int) -> tuple[float, list[float]]:
-    times = []
-    for _ in range(repeat):
-        t = time.perf_counter()
-        fn()
-        times.append(time.perf_counter() - t)
-    return statistics.median(times), times
+    times = wall_times(fn, repeat)
+    return float(np.median(times)), times.tolist()
 
 
 def run(repeat: int = 5, large: bool = True, log: Callable[[str], None] = print) -> dict[str, float]:

@@ -9,13 +9,11 @@ compiled kernels and of their numpy twins, then an RHS estimate of an 84-pin A1 
 per-plate plates) with its 336 contacts, split into its parts: chain forces, gathering the contact poses
 from the state, the contact kernel, scattering the loads into generalized forces, the mass solve.
 """
-import os
-import platform
-import time
 from pathlib import Path
 
 import numpy as np
 
+from cvtfem.analysis.timing import machine, median_us
 from cvtfem.elements.chain.a_loads_kernel import axis_points_kernel, point_loads_kernel
 from cvtfem.elements.chain.asymmetric import ChainA1
 from cvtfem.elements.chain.per_plate import ChainPerPlate
@@ -27,21 +25,6 @@ OUT = Path("out/studies/chain")
 N_PINS, N_PLATES, PITCH, PIN_L = 84, 12, 0.009, 0.033
 MERIDIAN = Meridian("torus", R=0.6, y=0.05, f0=-0.6)
 C, F0, V0 = 2.0e10, 0.1, 1e-3
-
-
-def machine() -> str:
-    return (f"{platform.platform()}, {platform.processor() or platform.machine()}, {os.cpu_count()} cores, "
-            f"load {os.getloadavg()[0]:.1f}, Python {platform.python_version()}, numpy {np.__version__}")
-
-
-def median_us(fun, calls: int = 1000) -> float:
-    fun()
-    times = np.empty(calls)
-    for k in range(calls):
-        t0 = time.perf_counter()
-        fun()
-        times[k] = time.perf_counter() - t0
-    return float(np.median(times) * 1e6)
 
 
 def chain_args() -> dict:

@@ -8,28 +8,12 @@ and of ``jacobian(q, qd)`` (median of 20), with the machine and its load.  No sh
 from __future__ import annotations
 
 import argparse
-import os
-import platform
-import time
 
 import numpy as np
 
+from cvtfem.analysis.timing import machine, median_us
 from cvtfem.elements.chain.geometry import reference_geometry, ring_positions
 from cvtfem.elements.chain.symmetric import ChainS1, ChainS2, ChainS3, damping_from_ratio
-
-
-def machine() -> str:
-    return (f"{platform.processor() or platform.machine()}, {os.cpu_count()} cores, "
-            f"load {os.getloadavg()[0]:.1f}, Python {platform.python_version()}, numpy {np.__version__}")
-
-
-def median_us(fn, calls: int) -> float:
-    times = np.empty(calls)
-    for i in range(calls):
-        t = time.perf_counter()
-        fn()
-        times[i] = time.perf_counter() - t
-    return float(np.median(times)) * 1e6
 
 
 def main() -> None:

@@ -7,22 +7,15 @@ Prints the machine and its load with the medians of 1,000 calls of ``elastic_for
 the compiled kernel (numba) and its numpy twin, and of 100 calls of the analytic ``stiffness_matrix``
 and ``damping_matrix`` (sparse, numpy).
 """
-import os
-import platform
-import time
 from pathlib import Path
 
 import numpy as np
 
+from cvtfem.analysis.timing import machine, median_us
 from cvtfem.elements.chain.asymmetric import ChainA1
 
 OUT = Path("out/studies/chain")
 N_PINS, N_PLATES, PITCH, PIN_L = 84, 12, 0.009, 0.03
-
-
-def machine() -> str:
-    return (f"{platform.processor() or platform.machine()}, {os.cpu_count()} cores, "
-            f"load {os.getloadavg()[0]:.1f}, Python {platform.python_version()}, numpy {np.__version__}")
 
 
 def build(use_numba: bool) -> ChainA1:
@@ -35,15 +28,6 @@ def build(use_numba: bool) -> ChainA1:
                    pin_bending_tau=60.0, pin_bending_n=40.0, beta_link_ext=1e-6, beta_link_tors=1e-6,
                    beta_link_shear=1e-6, beta_bend=1e-7, pin_axial_damping=5.0, joint_damping=1e-4,
                    use_numba=use_numba)
-
-
-def median_us(fun, calls: int = 1000) -> float:
-    times = np.empty(calls)
-    for k in range(calls):
-        t0 = time.perf_counter()
-        fun()
-        times[k] = time.perf_counter() - t0
-    return float(np.median(times) * 1e6)
 
 
 def main() -> None:

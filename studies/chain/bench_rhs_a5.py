@@ -9,23 +9,16 @@ the machine and its load with the medians of 1,000 calls of ``forces`` (elastic,
 twin; everything else is numpy in both), and of 3 calls of the coloured-difference ``jacobian`` (both
 matrices, numba plate pass).
 """
-import os
-import platform
-import time
 from pathlib import Path
 
 import numpy as np
 
+from cvtfem.analysis.timing import machine, median_us
 from cvtfem.elements.chain.geometry import reference_geometry
 from cvtfem.elements.chain.halves import ChainA5, ring_state
 
 OUT = Path("out/studies/chain")
 H_PIN = 1.2e-3
-
-
-def machine() -> str:
-    return (f"{platform.processor() or platform.machine()}, {os.cpu_count()} cores, "
-            f"load {os.getloadavg()[0]:.1f}, Python {platform.python_version()}, numpy {np.__version__}")
 
 
 def build(use_numba: bool) -> ChainA5:
@@ -42,15 +35,6 @@ def build(use_numba: bool) -> ChainA5:
                    friction_speed=1e-3, friction_law="smooth", half_axial_damping=2.0, beta_plate_ext=1e-6,
                    beta_plate_shear=1e-6, beta_twist=1e-6, beta_bend=1e-7, joint_damping=1e-4,
                    use_numba=use_numba)
-
-
-def median_us(fun, calls: int = 1000) -> float:
-    times = np.empty(calls)
-    for k in range(calls):
-        t0 = time.perf_counter()
-        fun()
-        times[k] = time.perf_counter() - t0
-    return float(np.median(times) * 1e6)
 
 
 def main() -> None:

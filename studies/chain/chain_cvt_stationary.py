@@ -15,11 +15,11 @@ from __future__ import annotations
 
 import argparse
 import os
-import platform
 import time
 
 import numpy as np
 
+from cvtfem.analysis.timing import machine, median_us
 from cvtfem.elements.chain.geometry import reference_geometry
 from cvtfem.integrate import solve
 from cvtfem.machines import build_model
@@ -77,12 +77,7 @@ def plot(t, T, balance, ratio, T_band, path):
 
 
 def median_s(fn, calls):
-    times = []
-    for _ in range(calls):
-        t = time.perf_counter()
-        fn()
-        times.append(time.perf_counter() - t)
-    return float(np.median(times))
+    return 1e-6 * median_us(fn, calls)
 
 
 def main() -> None:
@@ -92,8 +87,7 @@ def main() -> None:
     ap.add_argument("--model", default="chain-S2")
     ap.add_argument("--png", default="")
     a = ap.parse_args()
-    print(f"machine: {platform.processor() or platform.machine()}, {os.cpu_count()} cores, "
-          f"load {os.getloadavg()[0]:.1f}")
+    print(f"machine: {machine()}")
     F, Tb, ob = band_reference()
     print(f"band 6+2n: F1 {F[0]:.0f} N, F2 {F[1]:.0f} N, ratio {ob['ratio']:.4f}, tight {Tb[0]:.0f} N, "
           f"slack {Tb[1]:.0f} N, efficiency {ob['efficiency']:.4f}")

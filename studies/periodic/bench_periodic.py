@@ -13,14 +13,13 @@ Prints medians of several runs and the machine; writes out/studies/periodic/benc
 from __future__ import annotations
 
 import json
-import os
-import platform
 import sys
 import time
 from pathlib import Path
 
 import numpy as np
 
+from cvtfem.analysis.timing import machine
 from cvtfem.assembly.numbering import through_numbering
 from cvtfem.elements.torsional import build_network
 from cvtfem.machines.torsional import build
@@ -28,11 +27,6 @@ from cvtfem.periodic import blocktri, hb, transient
 from cvtfem.scene.loader import load_scene
 
 OUT = Path("out/studies/periodic")
-
-
-def machine() -> str:
-    return (f"{platform.processor() or platform.machine()}, {os.cpu_count()} cores, "
-            f"load {os.getloadavg()[0]:.1f}, Python {platform.python_version()}, numpy {np.__version__}")
 
 
 def median_time(fn, repeats: int) -> tuple[float, object]:

@@ -14,22 +14,16 @@ down) and per-variant overhead m * workers - c, with c the median compute time o
 from __future__ import annotations
 
 import argparse
-import os
-import platform
 import tempfile
 import time
 
 import numpy as np
 
+from cvtfem.analysis.timing import machine
 from cvtfem.analysis.sweep import expand, run_sweep
 from cvtfem.scene.loader import load_scene
 
 SIZES = (8, 56)
-
-
-def machine() -> str:
-    return (f"{platform.processor() or platform.machine()}, {os.cpu_count()} cores, "
-            f"load {os.getloadavg()[0]:.1f}, Python {platform.python_version()}")
 
 
 def sweep_wall(base, engine: str, workers: int, n: int, until: float, offset: float) -> tuple[float, float]:
