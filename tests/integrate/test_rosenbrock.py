@@ -1,0 +1,65 @@
+"""RODAS4 (issue 19): order 4, order-3 dense output, non-autonomous terms, second-order structure,
+sparse Jacobians, and tolerance proportionality on HIRES."""
+import numpy as np
+import pytest
+
+from cvtfem.integrate import solve
+from cvtfem.integrate.stepping import Stepping, make_engine
+from cvtfem.integrate.system import as_system
+from cvtfem.problems import heat1d, hires, limit_cycle, prothero_robinson, van_der_pol_stiff
+
+
+def orders(p, ns):
+    t_end = p.t_span[1]
+    errs = [np.max(np.abs(solve(**p.solve_kwargs(), method="rodas4", h=t_end / n).y[:, -1] - p.exact(t_end)))
+            for n in ns]
+    return np.log2(np.array(errs[:-1]) / errs[1:])
+
+
+def test_order_four_autonomous():
+    assert np.all(np.abs(orders(limit_cycle(), [20, 40, 80, 160]) - 4) < 0.1)
+
+
+def test_order_four_non_autonomous():
+    """Prothero-Robinson with g = sin t: the F_t terms (weights d_i) carry the time dependence."""
+    assert np.all(np.abs(orders(prothero_robinson(lam=-1.0, t_end=2.0), [10, 20, 40, 80]) - 4) < 0.15)
+
+
+def test_dense_output_local_error_order_four():
+    """The continuous extension is of order 3: its error inside one step falls like h^4."""
+    p = limit_cycle()
+    errs = []
+    for h in (0.2, 0.1, 0.05, 0.025):
+        x0 = p.exact(0.3)
+        engine = make_engine("rodas4", as_system(p.fun, x0, jac=p.jac), 0.3, x0, 10.0, 1e-6, 1e-9, h=h)
+        run = Stepping(engine, 0.3, x0, 10.0)
+        run.step()
+        errs.append(max(np.max(np.abs(run.dense(0.3 + s * h) - p.exact(0.3 + s * h))) for s in (0.25, 0.5, 0.8)))
+    assert np.all(np.abs(np.log2(np.array(errs[:-1]) / errs[1:]) - 4) < 0.15)
+
+
+@pytest.mark.parametrize("rtol", [1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8])
+def test_hires_error_tracks_tolerance(rtol):
+    """Against the published reference, the achieved relative error stays within 10x rtol."""
+    p = hires()
+    res = solve(**p.solve_kwargs(), method="rodas4", rtol=rtol, atol=1e-3 * rtol)
+    err = np.max(np.abs(res.y[:, -1] - p.reference()) / np.abs(p.reference()))
+    assert res.success and err < 10 * rtol
+
+
+def test_second_order_structure_van_der_pol_stiff():
+    """n2 = 1 (reduced linear systems) on Van der Pol, eps = 1e-3: agrees with scipy Radau to 10 rtol."""
+    p = van_der_pol_stiff(eps=1e-3)
+    ref = solve(**p.solve_kwargs(), method="Radau", rtol=1e-9, atol=1e-9).y[:, -1]
+    res = solve(**p.solve_kwargs(), method="rodas4", rtol=1e-6, atol=1e-6)
+    assert res.success and np.max(np.abs(res.y[:, -1] - ref) / np.abs(ref)) < 1e-5
+
+
+def test_sparse_jacobian_heat_equation():
+    """N = 1000 with a sparse tridiagonal Jacobian (SuperLU): the exact semi-discrete solution to
+    within 10x rtol, one LU per step attempt."""
+    p = heat1d(N=1000, t_end=0.1)
+    res = solve(**p.solve_kwargs(), method="rodas4", rtol=1e-6, atol=1e-9)
+    ex = p.exact(0.1)
+    assert res.success and np.max(np.abs(res.y[:, -1] - ex)) < 1e-5 * np.max(np.abs(ex))
+    assert res.stats["nlu"] == res.stats["nsteps"] + res.stats["nreject"]
