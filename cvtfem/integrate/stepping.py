@@ -135,7 +135,7 @@ class NativeEngine:
             floor = step_floor(t)
             if h_new < floor:
                 why = failure or f"the error estimate stayed above tolerance (last error norm {err:.3g})"
-                return None, (f"step size underflow at t = {t:.6g} s: h = {h_new:.3g} s fell below the floor "
+                return None, (f"step size underflow (h = {h_new:.3g} s) at t = {t:.6g} s: below the floor "
                               f"{floor:.3g} s (16 spacings of doubles at t) after {why}; likely causes: a "
                               f"singularity or discontinuity of the right-hand side near t, a tolerance below "
                               f"what double precision resolves there, or a method that does not damp stiff "

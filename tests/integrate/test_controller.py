@@ -58,4 +58,5 @@ def test_underflow_message_names_t_h_floor_and_cause():
                 jac=lambda t, y: np.array([[2 * y[0]]]))
     assert res.status == -1 and 0.99 < res.t[-1] < 1.0
     msg = res.message
-    assert "step size underflow at t = " in msg and "h = " in msg and "floor" in msg and "singularity" in msg
+    assert msg.startswith("step size underflow (h = ") and " s) at t = " in msg
+    assert "floor" in msg and "singularity" in msg
