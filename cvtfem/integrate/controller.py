@@ -7,6 +7,7 @@ Both error-based controllers apply Hairer's rule ``facmax = 1`` on the step afte
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -26,8 +27,8 @@ FLOOR_ULPS = 16
 def error_norm(err: np.ndarray, x0: np.ndarray, x1: np.ndarray, rtol: float,
                atol: np.ndarray | float) -> float:
     """Weighted RMS norm of a local error vector (1 = exactly at tolerance)."""
-    scale = atol + rtol * np.maximum(np.abs(x0), np.abs(x1))
-    return float(np.sqrt(np.mean(np.abs(err / scale) ** 2)))
+    e = np.abs(err) / (atol + rtol * np.maximum(np.abs(x0), np.abs(x1)))
+    return math.sqrt(float(e @ e) / e.size)
 
 
 def step_floor(t: float) -> float:

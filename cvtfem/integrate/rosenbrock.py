@@ -38,6 +38,7 @@ CC[2, :2] = [-2.430093356833875, -0.2063599157091915]
 CC[3, :3] = [-0.1073529058151375, -9.594562251023355, -20.47028614809616]
 CC[4, :4] = [7.496443313967647, -10.24680431464352, -33.99990352819905, 11.70890893206160]
 CC[5, :5] = [8.083246795921522, -7.981132988064893, -31.52159432874371, 16.31930543123136, -6.058818238834054]
+AC = [np.vstack([A[i, :i], CC[i, :i]]) for i in range(6)]   # both sums of stage i in one product
 D = np.array([0.25, -0.1043, 0.1035, -0.0362, 0.0, 0.0])   # F_t weights
 H2 = np.array([10.12623508344586, -7.487995877610167, -34.80091861555747, -7.992771707568823,
                1.025137723295662])
@@ -66,11 +67,11 @@ class Rodas4(_WBase):
         g = GAMMA * h
         f0 = self.f0(t, x)
         ft = h * self._dfdt(t, x, f0)
-        u = np.zeros((6, len(x)), dtype=np.result_type(x, float))
-        for i in range(6):
-            fi = f0 if i == 0 else self.f(t + C[i] * h, x + A[i, :i] @ u[:i])
-            rhs = fi + (CC[i, :i] @ u[:i]) / h + D[i] * ft
-            u[i] = g * W.solve_full(rhs)
+        u = np.empty((6, len(x)), dtype=np.result_type(x, f0, float))
+        u[0] = g * W.solve_full(f0 + D[0] * ft)
+        for i in range(1, 6):
+            shift, couple = AC[i] @ u[:i]
+            u[i] = g * W.solve_full(self.f(t + C[i] * h, x + shift) + couple / h + D[i] * ft)
         x1 = x + A[5, :5] @ u[:5] + u[5]
         h2, h3 = H2 @ u[:5], H3 @ u[:5]
 
