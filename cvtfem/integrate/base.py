@@ -54,6 +54,8 @@ class Stepper:
     error_order: int | None = None
     OPTIONS: frozenset[str] = frozenset()
     stages = 1
+    #: Default step-size controller of adaptive runs (:mod:`cvtfem.integrate.controller`).
+    controller = "i"
     #: Set by the driver: False in fixed-step runs, so methods skip optional error estimates.
     need_error = True
     #: Set by the driver in adaptive runs: ``(rtol, atol)`` (implicit methods tie Newton to it).

@@ -14,7 +14,7 @@ import numpy as np
 
 from cvtfem.errors import InputError
 
-__all__ = ["FixedStep", "SimpleController", "PIController", "CONTROLLERS", "make_controller", "error_norm",
+__all__ = ["FixedStep", "SimpleController", "PIController", "PredictiveController", "CONTROLLERS", "make_controller", "error_norm",
            "step_floor"]
 
 SAFETY = 0.9
@@ -69,9 +69,9 @@ class SimpleController:
             return False, h * MIN_FACTOR
         accept = err_norm <= 1.0
         factor = MAX_FACTOR if err_norm == 0.0 else self.factor(err_norm, q)
-        if accept:
-            factor = min(1.0 if self.rejected else MAX_FACTOR, max(1.0, factor))
-            if factor < self.quantum:
+        if accept:   # an accepted step near the tolerance shrinks h (else the next one is rejected)
+            factor = min(1.0 if self.rejected else MAX_FACTOR, max(MIN_FACTOR, factor))
+            if 1.0 <= factor < self.quantum:
                 factor = 1.0
             self.accepted(err_norm)
         else:
@@ -101,11 +101,32 @@ class PIController(SimpleController):
         self.err_prev = err_norm
 
 
-CONTROLLERS = {"i": SimpleController, "pi": PIController}
+@dataclass
+class PredictiveController(SimpleController):
+    """Gustafsson's predictive controller (Hairer-Wanner II §IV.8, as in RADAU5 and RODAS): an accepted
+    step also proposes ``h (h / h_acc) (err_acc / err^2)^(1/k)`` (the error's trend over the last two
+    accepted steps, ``k = q + 1``) and the smaller proposal wins, so a run whose error grows from step to
+    step (approaching a fast transient) shrinks ``h`` before a rejection, not after."""
+
+    h_acc: float = 0.0
+    err_acc: float = 1.0
+
+    def propose(self, h: float, err_norm: float, q: int) -> tuple[bool, float]:
+        accept, h_new = super().propose(h, err_norm, q)
+        if accept:
+            if self.h_acc > 0.0:
+                trend = SAFETY * (h / self.h_acc) * (self.err_acc / max(err_norm, 1e-10) ** 2) ** (1.0 / (q + 1))
+                h_new = min(h_new, h * max(MIN_FACTOR, trend))
+            self.h_acc, self.err_acc = h, max(1e-2, err_norm)
+        return accept, h_new
+
+
+CONTROLLERS = {"i": SimpleController, "pi": PIController, "predictive": PredictiveController}
 
 
 def make_controller(name: str, quantum: float = 1.0) -> SimpleController:
-    """The error-based controller ``name`` (``"i"`` elementary, ``"pi"`` proportional-integral)."""
+    """The error-based controller ``name`` (``"i"`` elementary, ``"pi"`` proportional-integral,
+    ``"predictive"`` Gustafsson's)."""
     if name not in CONTROLLERS:
         raise InputError("controller", name, f"must be one of {sorted(CONTROLLERS)}")
     return CONTROLLERS[name](quantum=quantum)

@@ -52,6 +52,7 @@ class Rodas4(_WBase):
     name, order, error_order, stages = "rodas4", 4, 3, 6
     OPTIONS = frozenset()
     STEP_QUANTUM = 1.0   # a new Jacobian (and LU) every step anyway
+    controller = "predictive"   # as Hairer's RODAS: fewer rejections before fast transients
 
     def __init__(self, system, stats=None) -> None:
         super().__init__(system, stats, d=GAMMA, jac_every=1)

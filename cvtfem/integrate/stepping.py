@@ -75,7 +75,7 @@ class NativeEngine:
 
     def __init__(self, method: str, system: OdeSystem, t0: float, y0, t_end: float, rtol: float, atol,
                  h: float | None = None, adaptive: bool | None = None, error_check: int = 0,
-                 first_step: float | None = None, options: dict | None = None, controller: str = "i") -> None:
+                 first_step: float | None = None, options: dict | None = None, controller: str | None = None) -> None:
         cls = METHODS[method]
         self.name, self.system, self.stats = method, system, Stats()
         self.stepper = cls(system, self.stats, **check_options(method, cls.OPTIONS, options or {}))
@@ -87,6 +87,7 @@ class NativeEngine:
         self.stepper.need_error = self.adaptive
         self.stepper.tolerances = (rtol, atol) if self.adaptive else None
         self.rtol, self.atol = rtol, atol
+        controller = controller or self.stepper.controller
         self.ctrl = (make_controller(controller, getattr(self.stepper, "STEP_QUANTUM", 1.0)) if self.adaptive
                      else FixedStep(h))
         if not (isinstance(error_check, (int, np.integer)) and error_check >= 0):
@@ -190,9 +191,10 @@ class NativeEngine:
 
 def make_engine(method: str, system: OdeSystem, t0: float, y0, t_end: float, rtol: float, atol,
                 h: float | None = None, adaptive: bool | None = None, error_check: int = 0,
-                first_step: float | None = None, options: dict | None = None, controller: str = "i"):
+                first_step: float | None = None, options: dict | None = None, controller: str | None = None):
     """The engine of ``method`` (a native or a scipy name, :mod:`cvtfem.integrate.methods`); ``controller``
-    (``"i"`` or ``"pi"``, :mod:`cvtfem.integrate.controller`) steers native adaptive runs."""
+    (``"i"``, ``"pi"``, ``"predictive"``, :mod:`cvtfem.integrate.controller`; None: the method's default)
+    steers native adaptive runs."""
     if method in SCIPY_METHODS:
         from cvtfem.integrate.scipy_bridge import ScipyEngine
 
