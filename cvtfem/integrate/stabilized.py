@@ -10,6 +10,8 @@ Error estimate (SSV97): ``(12 (x0 - x1) + 6 h (F0 + F1)) / 15``.
 """
 from __future__ import annotations
 
+from functools import lru_cache
+
 import numpy as np
 
 from cvtfem.errors import InputError
@@ -57,6 +59,7 @@ def rkc_coefficients(s: int):
     return mu, nu, mu_t, gam_t, c
 
 
+@lru_cache(maxsize=None)
 def rkc_stability_length(s: int) -> float:
     """Real stability interval ``[-beta, 0]`` of s-stage RKC: ``beta = (1 + w0)/w1``."""
     w0 = 1 + EPS_DAMP / s ** 2

@@ -108,6 +108,9 @@ class NativeEngine:
             h_try = min(h, tf - t, stepper.max_step()) if adaptive else min(h, tf - t)
             if tf - (t + h_try) < 1e-9 * h_try:   # absorb round-off: land on tf
                 h_try = tf - t
+            elif adaptive and h_try < step_floor(t):   # shrunk by accepted steps or a method's cap
+                return None, self._underflow(t, h_try, "the step size shrank on accepted steps or to the "
+                                             "method's largest stable step")
             self.monitor.before()
             try:
                 with np.errstate(over="ignore", invalid="ignore"):   # detected here, reported
@@ -133,14 +136,17 @@ class NativeEngine:
             if accept:
                 return self._candidate(att), None
             self.stats.counts["nreject"] += 1
-            floor = step_floor(t)
-            if h_new < floor:
-                why = failure or f"the error estimate stayed above tolerance (last error norm {err:.3g})"
-                return None, (f"step size underflow (h = {h_new:.3g} s) at t = {t:.6g} s: below the floor "
-                              f"{floor:.3g} s (16 spacings of doubles at t) after {why}; likely causes: a "
-                              f"singularity or discontinuity of the right-hand side near t, a tolerance below "
-                              f"what double precision resolves there, or a method that does not damp stiff "
-                              f"components")
+            if h_new < step_floor(t):
+                return None, self._underflow(t, h_new, failure or f"the error estimate stayed above tolerance "
+                                                                  f"(last error norm {err:.3g})")
+
+    @staticmethod
+    def _underflow(t: float, h: float, why: str) -> str:
+        """The message of a step-size underflow at ``t`` with step ``h``, s, after ``why``."""
+        return (f"step size underflow (h = {h:.3g} s) at t = {t:.6g} s: below the floor {step_floor(t):.3g} s "
+                f"(16 spacings of doubles at t) after {why}; likely causes: a singularity or discontinuity of "
+                f"the right-hand side near t, a tolerance below what double precision resolves there, or a "
+                f"method that does not damp stiff components")
 
     def _candidate(self, att: Attempt) -> Candidate:
         stepper = self.stepper
