@@ -47,7 +47,7 @@ def time_at(rows, target):
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeats", type=int, default=3)
-    ap.add_argument("--methods", default="rodas4")
+    ap.add_argument("--methods", default="rodas4,rodas5p")
     args = ap.parse_args()
     methods = args.methods.split(",") + ["Radau"]
     problems = {"hires": hires(), "vdp": with_reference(van_der_pol_stiff(1e-6), 1e-12),

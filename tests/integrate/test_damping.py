@@ -24,6 +24,7 @@ def R(method, z, **options):
     ("w1", {"d": 0.5}, -1.0),
     ("w1-extrapolation", {}, 0.0),
     ("rodas4", {}, 0.0),
+    ("rodas5p", {}, 0.0),
     ("implicit-euler", {}, 0.0),
     ("trapezoidal", {}, -1.0),
     ("theta", {"alpha": 0.75}, 1 - 1 / 0.75)])
@@ -39,12 +40,13 @@ def test_sw24_stability_function_closed_form(d):
         assert R("sw24", z, d=d) == pytest.approx(closed, rel=1e-12)
 
 
-def test_rodas4_is_a_stable_on_the_imaginary_axis():
-    """A-stability of RODAS4 (Hairer-Wanner IV.7): a rotation ``y' = [[0, w], [-w, 0]] y`` (eigenvalues
+@pytest.mark.parametrize("method", ["rodas4", "rodas5p"])
+def test_rodas_is_a_stable_on_the_imaginary_axis(method):
+    """A-stability (Hairer-Wanner IV.7; Steinebach 2023): a rotation ``y' = [[0, w], [-w, 0]] y`` (eigenvalues
     ``+-iw``) is not amplified by one step, ``|R(iw)| <= 1``, and damped strongly for large ``w``."""
-    for w in (0.1, 1.0, 3.0, 30.0, 1e4):
+    for w in (0.1, 1.0, 3.0, 30.0, 1e4, 1e6):
         J = np.array([[0.0, w], [-w, 0.0]])
-        res = solve(lambda t, u: J @ u, (0.0, 1.0), [1.0, 0.0], method="rodas4", h=1.0, jac=lambda t, u: J,
+        res = solve(lambda t, u: J @ u, (0.0, 1.0), [1.0, 0.0], method=method, h=1.0, jac=lambda t, u: J,
                     growth_limit=None)
         assert np.linalg.norm(res.y[:, -1]) <= 1 + 1e-12
-    assert np.linalg.norm(res.y[:, -1]) < 1e-3
+    assert np.linalg.norm(res.y[:, -1]) < 1e-4   # |R(iw)| -> 0 like 1/w (L-stability)

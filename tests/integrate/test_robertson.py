@@ -13,7 +13,7 @@ from cvtfem.problems import robertson
 RTOL, ATOL = 1e-6, 1e-14
 T_ENDS = [10.0 ** k for k in range(12)]
 #: L-stable or strongly damping: every span in seconds
-DAMPING = ["rodas4", "w1-extrapolation", "sw24"]
+DAMPING = ["rodas4", "rodas5p", "w1-extrapolation", "sw24"]
 
 
 @lru_cache(maxsize=None)
@@ -36,7 +36,7 @@ def test_robertson_short_span(method):
     assert np.all(relative_error(method, 1.0) < 1e-2)
 
 
-@pytest.mark.parametrize("method", ["w1-extrapolation", "rodas4"])
+@pytest.mark.parametrize("method", ["w1-extrapolation", "rodas4", "rodas5p"])
 def test_robertson_long_span_completes_and_conserves_mass(method):
     """The default suite's cheap check of the floor (no reference run): t_end = 1e11 is reached with
     ``y1 + y2 + y3 = 1`` (every method here conserves linear invariants up to the tolerance) and y >= 0."""
