@@ -24,6 +24,8 @@ _SPECS: dict[str, object] = {
     "sw24": "cvtfem.integrate.wmethods:SW24",
     "w1": "cvtfem.integrate.wmethods:W1",
     "w1-extrapolation": "cvtfem.integrate.wmethods:W1Extrapolation",
+    "rodas4": "cvtfem.integrate.rosenbrock:Rodas4",
+    "rodas5p": "cvtfem.integrate.rosenbrock:Rodas5P",
     "theta": "cvtfem.integrate.theta:Theta",
     "trapezoidal": "cvtfem.integrate.theta:Trapezoidal",
     "implicit-euler": "cvtfem.integrate.theta:ImplicitEuler",

@@ -7,6 +7,7 @@ RHS calls go through :meth:`Stepper.f`, which counts and times them.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Callable
 
 import numpy as np
 
@@ -26,7 +27,8 @@ class Attempt:
     """One attempted step ``t0 -> t0 + h``.
 
     ``err`` is the local error estimate vector (None for methods without one); ``f0`` and
-    ``f1`` are ``F`` at both ends when already known (for dense output and FSAL).
+    ``f1`` are ``F`` at both ends when already known (for dense output and FSAL); ``interp(t)``
+    is the method's own continuous extension when it has one (else the cubic Hermite one is used).
     """
 
     t0: float
@@ -36,6 +38,7 @@ class Attempt:
     err: np.ndarray | None = None
     f0: np.ndarray | None = None
     f1: np.ndarray | None = None
+    interp: Callable[[float], np.ndarray] | None = None
 
 
 class Stepper:
@@ -51,6 +54,8 @@ class Stepper:
     error_order: int | None = None
     OPTIONS: frozenset[str] = frozenset()
     stages = 1
+    #: Default step-size controller of adaptive runs (:mod:`cvtfem.integrate.controller`).
+    controller = "i"
     #: Set by the driver: False in fixed-step runs, so methods skip optional error estimates.
     need_error = True
     #: Set by the driver in adaptive runs: ``(rtol, atol)`` (implicit methods tie Newton to it).

@@ -2,25 +2,39 @@
 
 A controller maps ``(h, err_norm, q)`` to ``(accept, h_new)``; ``err_norm`` is the weighted
 RMS norm of the error vector with scale ``atol + rtol*max(|x0|, |x1|)`` (spec §9.7).
+Both error-based controllers apply Hairer's rule ``facmax = 1`` on the step after a rejection
+(Hairer-Norsett-Wanner I, §II.4): a step that had to be shrunk is not grown again at once.
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["FixedStep", "SimpleController", "error_norm"]
+from cvtfem.errors import InputError
+
+__all__ = ["FixedStep", "SimpleController", "PIController", "PredictiveController", "CONTROLLERS", "make_controller", "error_norm",
+           "step_floor"]
 
 SAFETY = 0.9
 MIN_FACTOR = 0.2
 MAX_FACTOR = 5.0
+#: step-size floor in units of the spacing of doubles at the current time (scipy uses 10)
+FLOOR_ULPS = 16
 
 
 def error_norm(err: np.ndarray, x0: np.ndarray, x1: np.ndarray, rtol: float,
                atol: np.ndarray | float) -> float:
     """Weighted RMS norm of a local error vector (1 = exactly at tolerance)."""
-    scale = atol + rtol * np.maximum(np.abs(x0), np.abs(x1))
-    return float(np.sqrt(np.mean(np.abs(err / scale) ** 2)))
+    e = np.abs(err) / (atol + rtol * np.maximum(np.abs(x0), np.abs(x1)))
+    return math.sqrt(float(e @ e) / e.size)
+
+
+def step_floor(t: float) -> float:
+    """Smallest step, s, worth attempting at time ``t``: ``FLOOR_ULPS`` spacings of doubles at ``|t|``
+    (relative to the current time, as scipy's ``OdeSolver``; a smaller ``h`` barely moves ``t``)."""
+    return FLOOR_ULPS * float(np.spacing(abs(t)))
 
 
 @dataclass(frozen=True)
@@ -33,9 +47,9 @@ class FixedStep:
         return True, self.h
 
 
-@dataclass(frozen=True)
+@dataclass
 class SimpleController:
-    """Elementary controller ``h_new = h * SAFETY * (1/err)^(1/(q+1))``, factor-limited.
+    """Elementary (integral) controller ``h_new = h * SAFETY * (1/err)^(1/(q+1))``, factor-limited.
 
     ``quantum`` > 1 keeps ``h`` unchanged unless the proposed growth exceeds it (the ref-impl's
     "discreteness" of 1.3, which lets W-methods and const Newton reuse their LU).
@@ -43,19 +57,76 @@ class SimpleController:
 
     quantum: float = 1.0
     h_max: float = np.inf
+    rejected: bool = False   # the last attempt was rejected: no growth on the next accepted step
+
+    def factor(self, err_norm: float, q: int) -> float:
+        """Unlimited step-size factor for an attempt with error ``err_norm`` (> 0)."""
+        return SAFETY * err_norm ** (-1.0 / (q + 1))
 
     def propose(self, h: float, err_norm: float, q: int) -> tuple[bool, float]:
         if not np.isfinite(err_norm):
+            self.rejected = True
             return False, h * MIN_FACTOR
-        if err_norm == 0.0:
-            factor = MAX_FACTOR
-        else:
-            factor = SAFETY * err_norm ** (-1.0 / (q + 1))
         accept = err_norm <= 1.0
-        if accept:
-            factor = min(MAX_FACTOR, max(1.0, factor))
-            if factor < self.quantum:
+        factor = MAX_FACTOR if err_norm == 0.0 else self.factor(err_norm, q)
+        if accept:   # an accepted step near the tolerance shrinks h (else the next one is rejected)
+            factor = min(1.0 if self.rejected else MAX_FACTOR, max(MIN_FACTOR, factor))
+            if 1.0 <= factor < self.quantum:
                 factor = 1.0
+            self.accepted(err_norm)
         else:
             factor = max(MIN_FACTOR, factor)
+        self.rejected = not accept
         return accept, min(h * factor, self.h_max)
+
+    def accepted(self, err_norm: float) -> None:
+        """Hook: an attempt with error ``err_norm`` was accepted."""
+
+
+@dataclass
+class PIController(SimpleController):
+    """PI controller ``h_new = h * SAFETY * err^(-0.7/k) * err_prev^(0.4/k)``, ``k = q + 1``
+    (Gustafsson; Hairer-Wanner II §IV.2): the previous accepted error damps oscillating step
+    sequences; rejections use the integral part only."""
+
+    err_prev: float = 1.0
+
+    def factor(self, err_norm: float, q: int) -> float:
+        k = q + 1
+        if self.rejected or err_norm > 1.0:
+            return super().factor(err_norm, q)
+        return SAFETY * err_norm ** (-0.7 / k) * max(self.err_prev, 1e-4) ** (0.4 / k)
+
+    def accepted(self, err_norm: float) -> None:
+        self.err_prev = err_norm
+
+
+@dataclass
+class PredictiveController(SimpleController):
+    """Gustafsson's predictive controller (Hairer-Wanner II §IV.8, as in RADAU5 and RODAS): an accepted
+    step also proposes ``h (h / h_acc) (err_acc / err^2)^(1/k)`` (the error's trend over the last two
+    accepted steps, ``k = q + 1``) and the smaller proposal wins, so a run whose error grows from step to
+    step (approaching a fast transient) shrinks ``h`` before a rejection, not after."""
+
+    h_acc: float = 0.0
+    err_acc: float = 1.0
+
+    def propose(self, h: float, err_norm: float, q: int) -> tuple[bool, float]:
+        accept, h_new = super().propose(h, err_norm, q)
+        if accept:
+            if self.h_acc > 0.0:
+                trend = SAFETY * (h / self.h_acc) * (self.err_acc / max(err_norm, 1e-10) ** 2) ** (1.0 / (q + 1))
+                h_new = min(h_new, h * max(MIN_FACTOR, trend))
+            self.h_acc, self.err_acc = h, max(1e-2, err_norm)
+        return accept, h_new
+
+
+CONTROLLERS = {"i": SimpleController, "pi": PIController, "predictive": PredictiveController}
+
+
+def make_controller(name: str, quantum: float = 1.0) -> SimpleController:
+    """The error-based controller ``name`` (``"i"`` elementary, ``"pi"`` proportional-integral,
+    ``"predictive"`` Gustafsson's)."""
+    if name not in CONTROLLERS:
+        raise InputError("controller", name, f"must be one of {sorted(CONTROLLERS)}")
+    return CONTROLLERS[name](quantum=quantum)

@@ -55,7 +55,7 @@ def solve(fun, t_span, y0, method: str = "dopri45", h: float | None = None, rtol
           switch=None, adaptive: bool | None = None, event_location: str = "dense",
           max_steps: int = 10_000_000, max_events: int = 100_000, raise_on_failure: bool = False,
           growth_limit: float | None = GROWTH_LIMIT, event_samples: int = EVENT_SAMPLES,
-          error_check: int = 0, **options) -> OdeResult:
+          error_check: int = 0, controller: str | None = None, **options) -> OdeResult:
     """Integrate ``x' = F(t, x)`` over ``t_span`` with one of the playground's methods.
 
     Parameters
@@ -96,6 +96,11 @@ def solve(fun, t_span, y0, method: str = "dopri45", h: float | None = None, rtol
         estimate, or step doubling for explicit RK methods without one; 0: off) and warn in
         ``message`` when it exceeded rtol/atol; counters ``nerr_checks``, ``nfev_err_check``,
         ``err_check_max`` in ``stats``.
+    controller : str or None
+        Step-size controller of native adaptive runs: ``"i"`` (elementary), ``"pi"`` (proportional-
+        integral, smoother step sequences at a stability limit) or ``"predictive"`` (Gustafsson, shrinks
+        ``h`` when the error grows from step to step); None: the method's default (``"predictive"``
+        for ``rodas4``, else ``"i"``). All take no growth right after a rejection.
     **options : method options (``d``, ``alpha``, ``newton``, ``stages``, ``sequence`` ...);
         an option the method ignores warns with :class:`IgnoredOptionWarning`.
     """
@@ -124,11 +129,13 @@ def solve(fun, t_span, y0, method: str = "dopri45", h: float | None = None, rtol
             if value is not None and name not in SCIPY_OPTIONS[method]:
                 warnings.warn(f"option `{name}` is ignored by scipy method {method!r}",
                               IgnoredOptionWarning, stacklevel=2)
-        for key, val, default in (("adaptive", adaptive, None), ("error_check", error_check, 0)):
+        for key, val, default in (("adaptive", adaptive, None), ("error_check", error_check, 0),
+                                  ("controller", controller, None)):
             if val != default:
                 warnings.warn(f"option `{key}` is ignored by scipy method {method!r}",
                               IgnoredOptionWarning, stacklevel=2)
-    engine = make_engine(method, system, t0, y0, tf, rtol, atol, h, adaptive, error_check, options=options)
+    engine = make_engine(method, system, t0, y0, tf, rtol, atol, h, adaptive, error_check, options=options,
+                         controller=controller)
     run = Stepping(engine, t0, y0, tf, growth_limit=growth_limit, event_location=event_location,
                    event_samples=event_samples, max_steps=max_steps, max_events=max_events)
     wall = time.perf_counter()

@@ -137,10 +137,7 @@ class DUMKA3(SpectralRadiusTracker, Stepper):
     def max_step(self) -> float:
         """The longest polynomial's (or the fixed one's) real stability length over the last spectral-radius
         estimate, s: longer steps would leave every region and only be rejected by the error estimate."""
-        rho = self._rho if self.rho_user is None else None if callable(self.rho_user) else float(self.rho_user)
-        if not rho:
-            return np.inf
-        return stability_length(len(DEGREES) - 1 if self.fixed is None else self.fixed) / rho
+        return self._step_cap(stability_length(len(DEGREES) - 1 if self.fixed is None else self.fixed))
 
     def attempt(self, t, x, h):
         f0 = self.f0(t, x)

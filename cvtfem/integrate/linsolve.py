@@ -32,7 +32,7 @@ def reduced_matrix(J, n2: int, gamma: float):
         M = -gamma * J[n2:, n2:]
         if n2:
             M[:, :n2] -= gamma * gamma * J[n2:, :n2]
-        M[np.diag_indices_from(M)] += 1.0
+        M.flat[::n - n2 + 1] += 1.0
         return M
     Jy = sp.csr_matrix(J)[n2:]
     M = -gamma * Jy[:, n2:]
@@ -53,11 +53,12 @@ class LU:
                 M = M.toarray()
             self.dense = not sp.issparse(M)
             try:
-                if self.dense:
-                    self.lu = sla.lu_factor(M, check_finite=False)
-                    self._getrs = sla.get_lapack_funcs("getrs", (self.lu[0],))
-                    if np.any(np.diag(self.lu[0]) == 0):
-                        raise RuntimeError("zero pivot")
+                if self.dense:   # LAPACK getrf/getrs directly: lu_factor's checks cost more than an 8x8 LU
+                    getrf, self._getrs = sla.get_lapack_funcs(("getrf", "getrs"), (M,))
+                    lu, piv, info = getrf(M)
+                    if info != 0:
+                        raise RuntimeError("zero pivot" if info > 0 else f"getrf info {info}")
+                    self.lu = (lu, piv)
                 else:
                     self.lu = spla.splu(sp.csc_matrix(M))
             except (RuntimeError, ValueError) as err:
@@ -71,7 +72,7 @@ class LU:
                 k, _ = self._getrs(self.lu[0], self.lu[1], r_y)
             else:
                 k = self.lu.solve(r_y)
-        if not np.all(np.isfinite(k)):
+        if not np.isfinite(k.sum()):   # a finite sum means every entry is finite
             raise StepFailure("non-finite solution of the iteration matrix")
         return k
 

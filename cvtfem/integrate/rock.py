@@ -160,6 +160,7 @@ class _Rock(SpectralRadiusTracker, Stepper):
             raise InputError("spectral_radius", spectral_radius, "must be a positive number, a callable or None")
         self._init_rho(spectral_radius, rho_every)
         self.stages = int(ms[self.fixed if self.fixed is not None else 0])
+        self._longest = 0.0   # the longest degree's stability length, once known
 
     def _degree(self, t, x, f0, h) -> int:
         if self.fixed is not None:
@@ -169,7 +170,16 @@ class _Rock(SpectralRadiusTracker, Stepper):
         for k in range(n):   # lengths are computed lazily (cached), smallest sufficient degree
             if stability_length(self.family, k) >= h * rho:
                 return k
-        return max(range(n), key=lambda k: stability_length(self.family, k))
+        k = max(range(n), key=lambda k: stability_length(self.family, k))
+        self._longest = stability_length(self.family, k)
+        return k
+
+    def max_step(self) -> float:
+        """The fixed degree's, or (once a step has needed more than any degree offers) the longest degree's
+        stability length over the spectral radius, s; inf before (the lengths of all degrees take seconds)."""
+        if self.fixed is not None:
+            return self._step_cap(stability_length(self.family, self.fixed))
+        return self._step_cap(self._longest) if self._longest else np.inf
 
     def _chebyshev_stages(self, t, x, h, f0, k):
         """The ``m`` recurrence stages; returns ``(g_m, t_m, g_{m-1}, t_{m-1})``."""

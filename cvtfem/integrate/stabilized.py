@@ -10,6 +10,8 @@ Error estimate (SSV97): ``(12 (x0 - x1) + 6 h (F0 + F1)) / 15``.
 """
 from __future__ import annotations
 
+from functools import lru_cache
+
 import numpy as np
 
 from cvtfem.errors import InputError
@@ -57,6 +59,7 @@ def rkc_coefficients(s: int):
     return mu, nu, mu_t, gam_t, c
 
 
+@lru_cache(maxsize=None)
 def rkc_stability_length(s: int) -> float:
     """Real stability interval ``[-beta, 0]`` of s-stage RKC: ``beta = (1 + w0)/w1``."""
     w0 = 1 + EPS_DAMP / s ** 2
@@ -119,6 +122,13 @@ class SpectralRadiusTracker:
         super().accept(att)
         self._rho_age += 1
 
+    def _step_cap(self, length: float) -> float:
+        """``length`` (a real stability length) over the last spectral-radius estimate, s (inf before the
+        first estimate or with a callable ``spectral_radius``): longer steps leave the stability region of
+        every available degree and would only be rejected by the error estimate, again and again."""
+        rho = self._rho if self.rho_user is None else None if callable(self.rho_user) else float(self.rho_user)
+        return length / rho if rho else np.inf
+
 
 class RKC(SpectralRadiusTracker, Stepper):
     """Runge-Kutta-Chebyshev, order 2; ``stages`` fixed, or None for automatic selection."""
@@ -146,6 +156,10 @@ class RKC(SpectralRadiusTracker, Stepper):
         while rkc_stability_length(s) < h * rho and s < MAX_STAGES:
             s += 1
         return s
+
+    def max_step(self) -> float:
+        """The largest (or the fixed) stage count's stability length over the spectral radius, s."""
+        return self._step_cap(rkc_stability_length(self.fixed_stages or MAX_STAGES))
 
     def attempt(self, t, x, h):
         f0 = self.f0(t, x)

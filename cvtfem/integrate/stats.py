@@ -2,7 +2,6 @@
 from __future__ import annotations
 
 import time
-from contextlib import contextmanager
 from dataclasses import dataclass, field
 
 #: Counter names, in the order reports list them.
@@ -28,15 +27,26 @@ class Stats:
     def add(self, name: str, n: int = 1) -> None:
         self.counts[name] += n
 
-    @contextmanager
-    def timer(self, name: str):
+    def timer(self, name: str) -> "_Timer":
         """Accumulate the wall time of a ``with`` block into ``times[name]``."""
-        t0 = time.perf_counter()
-        try:
-            yield
-        finally:
-            self.times[name] += time.perf_counter() - t0
+        return _Timer(self.times, name)
 
     def as_dict(self) -> dict[str, float]:
         """Counters and timers in one flat dict (the ``.stats`` of a result)."""
         return {**self.counts, **self.times}
+
+
+class _Timer:
+    """The ``with`` block of :meth:`Stats.timer` (a plain class: a generator-based context manager
+    costs several microseconds per RHS call and linear solve)."""
+
+    __slots__ = ("times", "name", "t0")
+
+    def __init__(self, times: dict, name: str) -> None:
+        self.times, self.name = times, name
+
+    def __enter__(self) -> None:
+        self.t0 = time.perf_counter()
+
+    def __exit__(self, *exc) -> None:
+        self.times[self.name] += time.perf_counter() - self.t0

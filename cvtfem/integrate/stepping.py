@@ -18,7 +18,7 @@ import numpy as np
 
 from cvtfem.errors import InputError, NumericalError
 from cvtfem.integrate.base import Attempt, StepFailure, hermite
-from cvtfem.integrate.controller import FixedStep, SimpleController, error_norm
+from cvtfem.integrate.controller import FixedStep, error_norm, make_controller, step_floor
 from cvtfem.integrate.events import EVENT_SAMPLES, EventLocator
 from cvtfem.integrate.guards import ErrorMonitor, GrowthGuard
 from cvtfem.integrate.methods import METHODS, SCIPY_METHODS, check_options
@@ -75,7 +75,7 @@ class NativeEngine:
 
     def __init__(self, method: str, system: OdeSystem, t0: float, y0, t_end: float, rtol: float, atol,
                  h: float | None = None, adaptive: bool | None = None, error_check: int = 0,
-                 first_step: float | None = None, options: dict | None = None) -> None:
+                 first_step: float | None = None, options: dict | None = None, controller: str | None = None) -> None:
         cls = METHODS[method]
         self.name, self.system, self.stats = method, system, Stats()
         self.stepper = cls(system, self.stats, **check_options(method, cls.OPTIONS, options or {}))
@@ -87,7 +87,8 @@ class NativeEngine:
         self.stepper.need_error = self.adaptive
         self.stepper.tolerances = (rtol, atol) if self.adaptive else None
         self.rtol, self.atol = rtol, atol
-        self.ctrl = (SimpleController(quantum=getattr(self.stepper, "STEP_QUANTUM", 1.0)) if self.adaptive
+        controller = controller or self.stepper.controller
+        self.ctrl = (make_controller(controller, getattr(self.stepper, "STEP_QUANTUM", 1.0)) if self.adaptive
                      else FixedStep(h))
         if not (isinstance(error_check, (int, np.integer)) and error_check >= 0):
             raise InputError("error_check", error_check, "must be a whole number of steps >= 0 (0: off)")
@@ -98,7 +99,6 @@ class NativeEngine:
             self.h = initial_step(self.stepper, t0, np.asarray(y0), rtol, atol, t_end - t0)
         else:
             self.h = float(h)
-        self.h_min = 16 * np.finfo(float).eps * max(abs(t0), abs(t_end))
 
     def advance(self, t: float, x: np.ndarray, tf: float) -> tuple[Candidate | None, str | None]:
         """Attempts from ``(t, x)`` until one is accepted: ``(candidate, None)`` or ``(None, why)``."""
@@ -108,6 +108,9 @@ class NativeEngine:
             h_try = min(h, tf - t, stepper.max_step()) if adaptive else min(h, tf - t)
             if tf - (t + h_try) < 1e-9 * h_try:   # absorb round-off: land on tf
                 h_try = tf - t
+            elif adaptive and h_try < step_floor(t):   # shrunk by accepted steps or a method's cap
+                return None, self._underflow(t, h_try, "the step size shrank on accepted steps or to the "
+                                             "method's largest stable step")
             self.monitor.before()
             try:
                 with np.errstate(over="ignore", invalid="ignore"):   # detected here, reported
@@ -124,20 +127,31 @@ class NativeEngine:
                     return None, f"{failure}{bad} at t = {t + h_try:.6g} s with fixed step h = {h:.3g} s"
                 return self._candidate(att), None
             if failure is None:
-                accept, h_new = self.ctrl.propose(h_try, error_norm(att.err, x, att.x1, self.rtol, self.atol),
-                                                  stepper.error_order)
+                err = error_norm(att.err, x, att.x1, self.rtol, self.atol)
+                accept, h_new = self.ctrl.propose(h_try, err, stepper.error_order)
             else:
                 accept, h_new = False, 0.25 * h_try
+                self.ctrl.rejected = True
             self.h = h_new
             if accept:
                 return self._candidate(att), None
             self.stats.counts["nreject"] += 1
-            if h_new < self.h_min:
-                return None, f"step size underflow (h = {h_new:.3g} s) at t = {t:.6g} s" + (
-                    f": {failure}" if failure else "")
+            if h_new < step_floor(t):
+                return None, self._underflow(t, h_new, failure or f"the error estimate stayed above tolerance "
+                                                                  f"(last error norm {err:.3g})")
+
+    @staticmethod
+    def _underflow(t: float, h: float, why: str) -> str:
+        """The message of a step-size underflow at ``t`` with step ``h``, s, after ``why``."""
+        return (f"step size underflow (h = {h:.3g} s) at t = {t:.6g} s: below the floor {step_floor(t):.3g} s "
+                f"(16 spacings of doubles at t) after {why}; likely causes: a singularity or discontinuity of "
+                f"the right-hand side near t, a tolerance below what double precision resolves there, or a "
+                f"method that does not damp stiff components")
 
     def _candidate(self, att: Attempt) -> Candidate:
         stepper = self.stepper
+        if att.interp is not None:
+            return Candidate(att.t0, att.x0, att.h, att.t0 + att.h, att.x1, att.f0, att.interp, att)
 
         def dense(tq):
             if att.f1 is None:        # kept: accept() caches it as the next step's F0
@@ -183,15 +197,18 @@ class NativeEngine:
 
 def make_engine(method: str, system: OdeSystem, t0: float, y0, t_end: float, rtol: float, atol,
                 h: float | None = None, adaptive: bool | None = None, error_check: int = 0,
-                first_step: float | None = None, options: dict | None = None):
-    """The engine of ``method`` (a native or a scipy name, :mod:`cvtfem.integrate.methods`)."""
+                first_step: float | None = None, options: dict | None = None, controller: str | None = None):
+    """The engine of ``method`` (a native or a scipy name, :mod:`cvtfem.integrate.methods`); ``controller``
+    (``"i"``, ``"pi"``, ``"predictive"``, :mod:`cvtfem.integrate.controller`; None: the method's default)
+    steers native adaptive runs."""
     if method in SCIPY_METHODS:
         from cvtfem.integrate.scipy_bridge import ScipyEngine
 
         return ScipyEngine(method, system, t0, y0, t_end, rtol, atol, first_step or h, options or {})
     if method not in METHODS:
         raise InputError("method", method, f"must be one of {sorted(METHODS) + sorted(SCIPY_METHODS)}")
-    return NativeEngine(method, system, t0, y0, t_end, rtol, atol, h, adaptive, error_check, first_step, options)
+    return NativeEngine(method, system, t0, y0, t_end, rtol, atol, h, adaptive, error_check, first_step, options,
+                        controller)
 
 
 class Stepping:

@@ -6,6 +6,13 @@ through the reduced matrix of :mod:`cvtfem.integrate.linsolve`. The LU is reused
 and ``h`` are unchanged (the controller keeps ``h`` unless it wants >= 1.3x).
 W1-d is order 1 for any ``d`` and ``A``; its extrapolation (harmonic sequence) is
 ``w1-extrapolation`` (Deuflhard-Bornemann §6.4.2).
+
+Defaults damp stiff components (``A = J``, scalar test equation, ``z = h lambda``):
+SW24-d has ``R(z) = [1 + (1 - 2d) z + (d^2 - 2d + 1/2) z^2] / (1 - d z)^2`` (the 2-stage Rosenbrock
+function), ``R(-inf) = 1 - 2/d + 1/(2 d^2)``: -1 at the source's d = 1/2 (no damping, like the
+trapezoidal rule), -1/2 at d = 1, 0 at ``d = 1 - 1/sqrt(2)`` (L-stable and A-stable, as d >= 1/4;
+the default). W1-d has ``R = 1 + z/(1 - d z)``, ``R(-inf) = 1 - 1/d``: 0 at the default d = 1 (linearly
+implicit Euler), and every extrapolated W1-1 entry then also vanishes at ``-inf``.
 """
 from __future__ import annotations
 
@@ -26,8 +33,11 @@ class _WBase(Stepper):
     OPTIONS = frozenset({"d", "jac_every"})
     STEP_QUANTUM = 1.3
 
-    def __init__(self, system, stats=None, d: float = 0.5, jac_every: int = 1, **kw) -> None:
+    default_d = 1.0
+
+    def __init__(self, system, stats=None, d: float | None = None, jac_every: int = 1, **kw) -> None:
         super().__init__(system, stats, **kw)
+        d = self.default_d if d is None else d
         if not 0.0 < d <= 1.0:
             raise InputError("d", d, "must lie in (0, 1]")
         if not (isinstance(jac_every, (int, np.integer)) and jac_every >= 1):
@@ -64,6 +74,7 @@ class SW24(_WBase):
     """Steihaug-Wolfbrandt SW24-d: order 2 for any ``A``; 2 more stages estimate the error."""
 
     name, order, error_order, stages = "sw24", 2, 2, 2
+    default_d = 1.0 - 1.0 / np.sqrt(2.0)   # L-stable (see module docstring)
 
     def attempt(self, t, x, h):
         self._refresh(t, x)
@@ -100,7 +111,7 @@ class W1Extrapolation(_WBase, Extrapolator):
     name, base_order, gamma = "w1-extrapolation", 1, 1
     OPTIONS = _WBase.OPTIONS | Extrapolator.OPTIONS
 
-    def __init__(self, system, stats=None, d: float = 0.5, jac_every: int = 1, stages: int = 4,
+    def __init__(self, system, stats=None, d: float | None = None, jac_every: int = 1, stages: int = 4,
                  sequence: str = "harmonic") -> None:
         super().__init__(system, stats, d=d, jac_every=jac_every, stages=stages, sequence=sequence)
 

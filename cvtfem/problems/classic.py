@@ -8,7 +8,8 @@ import scipy.sparse as sp
 from cvtfem.errors import InputError
 from cvtfem.problems.base import Problem
 
-__all__ = ["oscillator", "limit_cycle", "van_der_pol", "prothero_robinson", "coupled_oscillators"]
+__all__ = ["oscillator", "limit_cycle", "van_der_pol", "van_der_pol_stiff", "prothero_robinson",
+           "coupled_oscillators"]
 
 
 def oscillator(omega: float = 1.0, t_end: float = 10.0) -> Problem:
@@ -62,6 +63,22 @@ def van_der_pol(mu: float = 1.0, t_end: float | None = None) -> Problem:
 
     return Problem(f"van_der_pol(mu={mu:g})", fun, np.array([2.0, 0.0]),
                    (0.0, t_end if t_end is not None else 2.0 * max(mu, 3.0)), n2=1, jac=jac)
+
+
+def van_der_pol_stiff(eps: float = 1e-6, t_end: float = 2.0) -> Problem:
+    """Van der Pol in Hairer-Wanner's singular-perturbation scaling (II §IV.10, test set "vdpol"):
+    ``u' = v``, ``eps v' = (1 - u^2) v - u``, ``u(0) = 2``, ``v(0) = -2/3`` (n2 = 1); stiffness ~ 1/eps."""
+    if not eps > 0:
+        raise InputError("eps", eps, "must be positive")
+
+    def fun(t, x):
+        return np.array([x[1], ((1 - x[0] ** 2) * x[1] - x[0]) / eps])
+
+    def jac(t, x):
+        return np.array([[0.0, 1.0], [(-2 * x[0] * x[1] - 1) / eps, (1 - x[0] ** 2) / eps]])
+
+    return Problem(f"van_der_pol_stiff(eps={eps:g})", fun, np.array([2.0, -2.0 / 3.0]), (0.0, t_end), n2=1,
+                   jac=jac)
 
 
 def prothero_robinson(lam: float = -1e4, t_end: float = 1.0) -> Problem:

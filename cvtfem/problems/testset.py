@@ -1,4 +1,4 @@
-"""IVP test-set problems with published reference solutions: HIRES and Pleiades.
+"""IVP test-set problems with published reference solutions: HIRES, Pleiades and Robertson.
 
 References: Mazzia & Magherini, *Test Set for IVP Solvers* (release 2.4, Univ. Bari);
 Hairer & Wanner, *Solving ODEs II*, §IV.10 (HIRES) and Hairer-Norsett-Wanner I, §II.10
@@ -8,9 +8,10 @@ from __future__ import annotations
 
 import numpy as np
 
+from cvtfem.errors import InputError
 from cvtfem.problems.base import Problem
 
-__all__ = ["hires", "pleiades"]
+__all__ = ["hires", "pleiades", "robertson"]
 
 HIRES_REF = np.array([0.7371312573325668e-3, 0.1442485726316185e-3, 0.5888729740967575e-4,
                       0.1175651343283149e-2, 0.2386356198831331e-2, 0.6238968252742796e-2,
@@ -74,3 +75,29 @@ def pleiades() -> Problem:
                          [0, 0, 0, 0, 0, 1.75, -1.5], [0, 0, 0, -1.25, 1, 0, 0]]).astype(float)
     return Problem("pleiades", fun, y0, (0.0, 3.0), n2=14, y_ref=PLEIADES_REF,
                    ref_index=np.arange(10))
+
+
+def robertson(t_end: float = 1e5) -> Problem:
+    """Robertson's chemical kinetics (Hairer-Wanner II §IV.1), 3 equations, ``t`` in [0, t_end].
+
+    ``y1' = -0.04 y1 + 1e4 y2 y3``, ``y2' = 0.04 y1 - 1e4 y2 y3 - 3e7 y2^2``, ``y3' = 3e7 y2^2``;
+    ``y(0) = (1, 0, 0)``, ``y1 + y2 + y3 = 1`` for all ``t``. ``y2`` peaks at 3.65e-5 and decays
+    like ``1/t``; stiffness grows with ``t`` (eigenvalue ~ -1e4 at the peak), so long spans
+    (``t_end`` up to 1e11) test the step-size floor. No closed form: references come from a
+    tight run (scipy Radau, rtol 1e-12).
+    """
+    if not (np.isfinite(t_end) and t_end > 0):
+        raise InputError("t_end", t_end, "must be a positive finite time in s")
+
+    def fun(t, y):
+        y1, y2, y3 = y
+        a, b, c = 0.04 * y1, 1e4 * y2 * y3, 3e7 * y2 * y2
+        return np.array([-a + b, a - b - c, c])
+
+    def jac(t, y):
+        y1, y2, y3 = y
+        return np.array([[-0.04, 1e4 * y3, 1e4 * y2],
+                         [0.04, -1e4 * y3 - 6e7 * y2, -1e4 * y2],
+                         [0.0, 6e7 * y2, 0.0]])
+
+    return Problem(f"robertson(t_end={t_end:g})", fun, np.array([1.0, 0.0, 0.0]), (0.0, float(t_end)), jac=jac)

@@ -110,3 +110,15 @@ def test_heat_automatic_stages(method):
     ref = p.reference()
     assert res.success and np.max(np.abs(res.y[:, -1] - ref)) / np.max(np.abs(ref)) < 1e-3
     assert res.stats["nfev"] * 10 < 4 * 0.1 / (2.78 / p.info["rho"])
+
+
+@pytest.mark.slow
+def test_rock2_loose_tolerance_is_not_dearer_than_tight():
+    """Heat N = 1000 at rtol 3e-3: steps beyond the longest degree's stability length (error norm 170)
+    were rejected, cut 5x and grown 5x again in a cycle (16 rejections, 8 817 RHS calls, more than the
+    7 238 at rtol 1e-4); ``max_step`` now caps them there once that length is known."""
+    p = heat1d(N=1000, t_end=0.1)
+    loose, tight = (solve(**p.solve_kwargs(), method="rock2", rtol=r, atol=1e-3 * r) for r in (3e-3, 1e-4))
+    assert loose.stats["nreject"] <= 2 and loose.stats["nfev"] < tight.stats["nfev"]
+    ex = p.exact(0.1)
+    assert np.max(np.abs(loose.y[:, -1] - ex)) < 3e-3 * np.max(np.abs(ex))

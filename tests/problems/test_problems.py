@@ -11,7 +11,8 @@ from cvtfem import problems as P
 
 
 @pytest.mark.parametrize("make,x", [(P.hires, np.linspace(0.1, 0.9, 8)), (P.limit_cycle, np.array([0.3, -0.7])),
-                                    (P.van_der_pol, np.array([1.5, -0.4])), (P.oscillator, np.array([0.2, 1.0]))])
+                                    (P.van_der_pol, np.array([1.5, -0.4])), (P.oscillator, np.array([0.2, 1.0])),
+                                    (lambda: P.van_der_pol_stiff(eps=1e-2), np.array([1.5, -0.4]))])
 def test_analytic_jacobian_matches_finite_differences(make, x):
     p = make()
     J = np.asarray(p.jac(0.0, x))
@@ -68,3 +69,20 @@ def test_bouncing_ball_closed_form_consistent_with_free_fall():
     p = P.bouncing_ball(x0=2.0, v0=1.0, g=9.81)
     t1 = p.info["impacts"](1)[0]
     assert abs(2.0 + 1.0 * t1 - 0.5 * 9.81 * t1 ** 2) < 1e-12
+
+
+def test_robertson_jacobian_central_differences():
+    """The right-hand side is quadratic, so central differences are exact up to round-off (forward
+    differences are off by 3e7 * delta in the y2 column)."""
+    p = P.robertson()
+    y, d = np.array([0.7, 2e-5, 0.3]), 1e-6
+    fd = np.column_stack([(p.fun(0, y + d * e) - p.fun(0, y - d * e)) / (2 * d) for e in np.eye(3)])
+    assert np.allclose(p.jac(0.0, y), fd, rtol=1e-8, atol=1e-8)
+
+
+def test_robertson_rhs_conserves_mass():
+    """``y1 + y2 + y3`` is invariant: the right-hand side sums to zero (to round-off) anywhere."""
+    p = P.robertson()
+    for y in (np.array([1.0, 0, 0]), np.array([0.3, 3.6e-5, 0.7]), np.array([1e-8, 1e-13, 1.0])):
+        f = p.fun(0.0, y)
+        assert abs(f.sum()) <= 1e-12 * np.abs(f).max()

@@ -1,0 +1,54 @@
+"""Robertson's kinetics to t_end = 1 ... 1e11 (issue 19 acceptance): with the step-size floor relative
+to the current time every adaptive stiff method completes (the floor ``16 eps t_end`` of the span's end
+stopped sw24 and the theta methods at t ~ 1e-5 for t_end = 1e11), with an error below 1e-2 relative in
+every component against scipy Radau at rtol 1e-12."""
+from functools import lru_cache
+
+import numpy as np
+import pytest
+
+from cvtfem.integrate import solve
+from cvtfem.problems import robertson
+
+RTOL, ATOL = 1e-6, 1e-14
+T_ENDS = [10.0 ** k for k in range(12)]
+#: L-stable or strongly damping: every span in seconds
+DAMPING = ["rodas4", "rodas5p", "w1-extrapolation", "sw24"]
+
+
+@lru_cache(maxsize=None)
+def reference(t_end: float) -> np.ndarray:
+    p = robertson(t_end)
+    return solve(**p.solve_kwargs(), method="Radau", rtol=1e-12, atol=1e-20).y[:, -1]
+
+
+def relative_error(method: str, t_end: float, **kw) -> np.ndarray:
+    p = robertson(t_end)
+    res = solve(**p.solve_kwargs(), method=method, rtol=RTOL, atol=ATOL, **kw)
+    assert res.success, res.message
+    assert res.t[-1] == t_end
+    ref = reference(t_end)
+    return np.abs(res.y[:, -1] - ref) / np.abs(ref)
+
+
+@pytest.mark.parametrize("method", DAMPING)
+def test_robertson_short_span(method):
+    assert np.all(relative_error(method, 1.0) < 1e-2)
+
+
+@pytest.mark.parametrize("method", ["w1-extrapolation", "rodas4", "rodas5p"])
+def test_robertson_long_span_completes_and_conserves_mass(method):
+    """The default suite's cheap check of the floor (no reference run): t_end = 1e11 is reached with
+    ``y1 + y2 + y3 = 1`` (every method here conserves linear invariants up to the tolerance) and y >= 0."""
+    p = robertson(1e11)
+    res = solve(**p.solve_kwargs(), method=method, rtol=RTOL, atol=ATOL)
+    assert res.success and res.t[-1] == 1e11
+    y = res.y[:, -1]
+    assert abs(y.sum() - 1) < 1e-8 and np.all(y > -ATOL)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("method", DAMPING)
+@pytest.mark.parametrize("t_end", T_ENDS[1:])
+def test_robertson_every_decade(method, t_end):
+    assert np.all(relative_error(method, t_end) < 1e-2)
