@@ -2,8 +2,8 @@
 
 The numpy functions :func:`.plates.strain_hessians` and :func:`.plates.force_jacobians` are the reference
 twin: :func:`plate_jacobians_kernel` computes, plate by plate, the strain gradient ``J`` (the compiled
-``plates_kernel._strains``), the state and its Jacobian ``A`` (``plates_kernel._state``, or the clamped
-plate of A3), the strain Hessians and ``dQ/dq``, ``dQ/dqdot`` within the current state with the same
+``plates_kernel._strains``), the state and its Jacobian ``A`` (``plates_kernel._plate_law``: A4, or the
+clamped plate of A3), the strain Hessians and ``dQ/dq``, ``dQ/dqdot`` within the current state with the same
 formulas, and adds them into the blocks of the plate's link (``tests/machines/test_free_chain.py``
 holds the two equal).
 """
@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from cvtfem.elements.chain.plates_kernel import A3_KEEP, A4, _state, _strains
+from cvtfem.elements.chain.plates_kernel import _plate_law, _strains
 from cvtfem.elements.jit import njit
 
 
@@ -65,18 +65,7 @@ def plate_jacobians_kernel(q, qdot, link, xi, l, L, c, c1, c2, h, beta_ext, beta
     K, D = np.zeros((3, 3)), np.zeros((3, 3))
     for p in range(q.shape[0]):
         psi1, psi2, Delta = _strains(q[p], xi[p], l[p], L[p], J, H, Hp, V, t, e)   # V becomes tau
-        if model == A4:
-            st, d1, d2, stretch = _state(psi1, psi2, Delta, c[p], c1[p], c2[p], h[p], A, m)
-        else:
-            live = Delta > 0 or model == A3_KEEP
-            st, d1, d2, stretch = (1, 0.0, 0.0, Delta) if live else (10, psi1, psi2, Delta)
-            A[:, :] = 0.0
-            if live:
-                for i in range(3):
-                    A[i, i] = 1.0
-        tension = c[p] * (max(stretch, 0.0) if model != A3_KEEP else stretch)
-        if st == 10:
-            tension = 0.0
+        st, d1, d2, tension = _plate_law(model, psi1, psi2, Delta, c[p], c1[p], c2[p], h[p], A, m)
         z1, z2 = psi1 - d1, psi2 - d2
         K[:, :] = 0.0
         K[0, 0], K[0, 1], K[1, 0], K[1, 1], K[2, 2] = c1[p], c2[p], c2[p], c1[p], c[p]

@@ -62,6 +62,25 @@ def _strains(q, xi, l, L, J, H, Hp, V, t, e):
 
 
 @njit(cache=True)
+def _plate_law(model, psi1, psi2, Delta, c, c1, c2, h, A, m):
+    """State, corner angles and tension (N) of one plate under ``model`` (A4: the ten-state law; A3: clamped,
+    a compressed plate dropped, or kept with ``A3_KEEP``); fills the state Jacobian ``A``."""
+    if model == A4:
+        st, d1, d2, stretch = _state(psi1, psi2, Delta, c, c1, c2, h, A, m)
+    else:
+        live = Delta > 0 or model == A3_KEEP
+        st, d1, d2, stretch = (1, 0.0, 0.0, Delta) if live else (10, psi1, psi2, Delta)
+        A[:, :] = 0.0
+        if live:
+            for i in range(3):
+                A[i, i] = 1.0
+    tension = c * (max(stretch, 0.0) if model != A3_KEEP else stretch)
+    if st == 10:
+        tension = 0.0
+    return st, d1, d2, tension
+
+
+@njit(cache=True)
 def _state(psi1, psi2, Delta, c, c1, c2, h, A, m):
     """State 1..10, ``(delta_1, delta_2)`` and ``Delta~`` of one A4 plate (1.175)-(1.185); fills ``A`` (1.205)-(1.208).
 
@@ -143,19 +162,8 @@ def plate_forces_kernel(q, qdot, xi, l, L, c, c1, c2, h, beta_ext, beta_shear, m
     ed, r, stress, m = np.zeros(3), np.zeros(3), np.zeros(3), np.zeros(10)
     for p in range(q.shape[0]):
         psi1, psi2, Delta = _strains(q[p], xi[p], l[p], L[p], J, H, Hp, V, t, e)
-        if model == A4:
-            st, d1, d2, stretch = _state(psi1, psi2, Delta, c[p], c1[p], c2[p], h[p], A, m)
-        else:
-            live = Delta > 0 or model == A3_KEEP
-            st, d1, d2, stretch = (1, 0.0, 0.0, Delta) if live else (10, psi1, psi2, Delta)
-            A[:, :] = 0.0
-            if live:
-                for i in range(3):
-                    A[i, i] = 1.0
+        st, d1, d2, tension = _plate_law(model, psi1, psi2, Delta, c[p], c1[p], c2[p], h[p], A, m)
         z1, z2 = psi1 - d1, psi2 - d2
-        tension = c[p] * (max(stretch, 0.0) if model != A3_KEEP else stretch)
-        if st == 10:
-            tension = 0.0
         M1, M2 = c1[p] * z1 + c2[p] * z2, c2[p] * z1 + c1[p] * z2
         for i in range(3):
             ed[i] = 0.0
