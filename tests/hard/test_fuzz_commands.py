@@ -108,7 +108,9 @@ def _check(data):
             Path("s.toml").write_text(tomli_w.dumps(doc))
         except (TypeError, ValueError, OverflowError):   # not representable in TOML: nothing to test
             return
-        code, _ = _main([command, "s.toml", *COMMANDS[command][1]], doc)
+        # Floquet stability (3 of the 4 s of a periodic call here) runs in one example of ten
+        extra = ["--no-stability"] if command == "periodic" and data.draw(st.integers(0, 9)) else []
+        code, _ = _main([command, "s.toml", *COMMANDS[command][1], *extra], doc)
         if command == "run" and code == 0:
             from cvtfem.io.results import read_results
 
