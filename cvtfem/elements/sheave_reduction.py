@@ -65,7 +65,8 @@ def ring_dofs(model: HarmonicSheave, radius: float) -> np.ndarray:
     """The three DOFs (r, theta, z) of the contact-face vertex nearest ``radius`` (m)."""
     sec = model.section
     if not sec.hub_radius <= radius <= sec.outer_radius:
-        raise InputError("ring_radius", radius, f"a radius on the contact face, {sec.hub_radius:g}..{sec.outer_radius:g} m")
+        raise InputError("ring_radius", radius,
+                         f"a radius on the contact face, {sec.hub_radius:g}..{sec.outer_radius:g} m")
     locs = model.basis.doflocs
     on_face = np.isclose(locs[1], sec.face_height(locs[0]), rtol=0, atol=1e-9 * sec.outer_radius)
     target = np.flatnonzero(on_face)[np.argmin(abs(locs[0, on_face] - radius))]

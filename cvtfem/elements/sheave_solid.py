@@ -210,7 +210,8 @@ class HarmonicSheave:
         def stiffness(u, v, w):  # noqa: ANN001, ANN202
             r = w.x[0]
             a, b = parts(u, r), parts(v, r)
-            normal = lam * (a[0] + a[1] + a[2]) * (b[0] + b[1] + b[2]) + 2 * mu * (a[0] * b[0] + a[1] * b[1] + a[2] * b[2])
+            normal = (lam * (a[0] + a[1] + a[2]) * (b[0] + b[1] + b[2])
+                      + 2 * mu * (a[0] * b[0] + a[1] * b[1] + a[2] * b[2]))
             return (w_a * (normal + mu * a[3] * b[3]) + w_t * mu * (a[4] * b[4] + a[5] * b[5])) * r
 
         @BilinearForm

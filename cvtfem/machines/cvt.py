@@ -257,7 +257,8 @@ def chain_loop(scene: Scene):
         raise InputError("cvt.effects.friction", False, "must be true for a chain transmission: the chain "
                          "transmits torque only by pin-sheave friction")
     check_ratio_range(scene)
-    F_appl = Clamping(band_params(scene), rg.clamping_safety, rg.clamping_split, rg.min_clamping_force).forces(rg.torque, rg.ratio)
+    clamping = Clamping(band_params(scene), rg.clamping_safety, rg.clamping_split, rg.min_clamping_force)
+    F_appl = clamping.forces(rg.torque, rg.ratio)
     overrides = {} if eff.damping else {"damping_ratio": 0.0}
     return from_scene(scene, chain_geometry(scene), F_appl, model=model, **overrides)
 

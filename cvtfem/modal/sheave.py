@@ -54,7 +54,8 @@ def mode_shape(section: SheaveSection, n: int, family: str, k: int,
     return model, shape / np.abs(shape).max(), float(f[k])
 
 
-def wedge_opening(section: SheaveSection, force: float, mesh: tuple[int, int] = (24, 2)) -> tuple[HarmonicSheave, np.ndarray]:
+def wedge_opening(section: SheaveSection, force: float,
+                  mesh: tuple[int, int] = (24, 2)) -> tuple[HarmonicSheave, np.ndarray]:
     """Model and displacement (m) of the sheave, bore clamped, pushed back (towards ``-z``, away from the chain)
     by an axial ring load ``force`` (N) spread over its rim: the opening of the wedge, per sheave."""
     if not (np.isfinite(force) and 0.0 < abs(force) < 1e9):

@@ -36,8 +36,8 @@ def revolved_grid(model: HarmonicSheave, u: np.ndarray, n_theta: int = 96):  # n
     lo = np.arange(n_theta)[:, None] * nv
     hi = ((np.arange(n_theta) + 1) % n_theta)[:, None] * nv
     t = mesh.t
-    cells = np.hstack([np.full((n_theta * t.shape[1], 1), 6),
-                       np.column_stack([(lo + t[k]).ravel() for k in range(3)] + [(hi + t[k]).ravel() for k in range(3)])])
+    corners = [(lo + t[k]).ravel() for k in range(3)] + [(hi + t[k]).ravel() for k in range(3)]
+    cells = np.hstack([np.full((n_theta * t.shape[1], 1), 6), np.column_stack(corners)])
     grid = pv.UnstructuredGrid(cells.ravel(), np.full(len(cells), pv.CellType.WEDGE, dtype=np.uint8), points)
     grid.point_data["displacement"] = disp
     return grid
