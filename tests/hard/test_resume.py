@@ -39,6 +39,24 @@ def _series_equal(a, b) -> bool:
         np.array_equal(a.series[n], b.series[n], equal_nan=True) for n in a.series)
 
 
+def _difference(a, b) -> str:
+    """Where two results first differ (series, row, time, largest relative difference) and their solver
+    statistics: what a failed bitwise comparison reports, since the files do not outlive the test."""
+    lines = []
+    for name in sorted(a.series):
+        x, y = np.asarray(a.series[name]), np.asarray(b.series.get(name, np.array([])))
+        if x.shape != y.shape:
+            lines.append(f"{name}: shapes {x.shape} and {y.shape}")
+        elif not np.array_equal(x, y, equal_nan=True):
+            rows = np.flatnonzero(np.any((x != y).reshape(len(x), -1), axis=1))
+            rel = np.max(np.abs(x - y) / np.maximum(np.abs(x), 1e-300))
+            lines.append(f"{name}: first row {rows[0]} (t = {a.time[rows[0]]:.6g} s), {len(rows)} rows, "
+                         f"largest relative difference {rel:.3g}")
+    keys = sorted(k for k in set(a.stats) | set(b.stats) if k.startswith(("solver_", "resumed")))
+    stats = {k: (a.stats.get(k), b.stats.get(k)) for k in keys}
+    return "; ".join(lines[:5]) + f"; stats (reference, resumed) {stats}"
+
+
 #: implicit runs: a ratio change 2.4 -> 1.0 over the whole run at rtol 1e-7 keeps every method busy
 #: (0.2 s simulated: 1.3 s wall BDF .. 3.3 s trapezoidal), so the kill (<= 0.3 s after checkpoint 2 of 10) comes first
 IMPLICIT_UNTIL, IMPLICIT_INTERVAL = 0.2, 0.02
@@ -119,7 +137,7 @@ def test_killed_implicit_run_resumes_bitwise(tmp_path, cli, method):
     text = IMPLICIT_SCENE.format(method=method, interval=IMPLICIT_INTERVAL)
     ref, res, where = _kill_and_resume(tmp_path, cli, text, IMPLICIT_UNTIL, IMPLICIT_INTERVAL,
                                        round(IMPLICIT_UNTIL / 1e-3) + 1)
-    assert _series_equal(ref, res), where
+    assert _series_equal(ref, res), f"{where}: {_difference(ref, res)}"
     for key in ("solver_steps", "solver_nfev", "solver_njev", "solver_nlu"):
         assert res.stats[key] == ref.stats[key], (key, where)
 
