@@ -66,7 +66,7 @@ def ring_dofs(model: HarmonicSheave, radius: float) -> np.ndarray:
     sec = model.section
     if not sec.hub_radius <= radius <= sec.outer_radius:
         raise InputError("ring_radius", radius,
-                         f"a radius on the contact face, {sec.hub_radius:g}..{sec.outer_radius:g} m")
+                         f"must be a radius on the contact face, {sec.hub_radius:g}..{sec.outer_radius:g} m")
     locs = model.basis.doflocs
     on_face = np.isclose(locs[1], sec.face_height(locs[0]), rtol=0, atol=1e-9 * sec.outer_radius)
     target = np.flatnonzero(on_face)[np.argmin(abs(locs[0, on_face] - radius))]
@@ -105,7 +105,7 @@ def craig_bampton(model: HarmonicSheave, n_modes: int, ring_radius: float | None
         np.zeros((len(interior), 0))
     if n_modes > 0:
         if n_modes >= len(interior):
-            raise InputError("n_modes", n_modes, f"fewer than the {len(interior)} interior DOFs")
+            raise InputError("n_modes", n_modes, f"must be fewer than the {len(interior)} interior DOFs")
         try:
             lam, phi = spla.eigsh(Kii, k=n_modes, M=Mii, sigma=0.0, which="LM")
         except (spla.ArpackNoConvergence, RuntimeError) as exc:

@@ -66,19 +66,21 @@ class SheaveSection:
     def __post_init__(self):
         if not 0.0 < self.bore_radius <= self.hub_radius < self.outer_radius:
             raise InputError("sheave.radii", (self.bore_radius, self.hub_radius, self.outer_radius),
-                             "0 < bore_radius <= hub_radius < outer_radius")
+                             "must satisfy 0 < bore_radius <= hub_radius < outer_radius")
         if self.hub_length < 0.0 or (self.hub_length > 0.0 and self.hub_radius == self.bore_radius):
-            raise InputError("sheave.hub_length", self.hub_length, ">= 0, and 0 when hub_radius = bore_radius")
+            raise InputError("sheave.hub_length", self.hub_length, "must be >= 0, and 0 when hub_radius = bore_radius")
         if not (self.rim_thickness > 0.0 and 0.0 <= self.flank_angle < np.pi / 2):
             raise InputError("sheave.rim_thickness/flank_angle", (self.rim_thickness, self.flank_angle),
-                             "rim_thickness > 0 and 0 <= flank_angle < pi/2")
+                             "must satisfy rim_thickness > 0 and 0 <= flank_angle < pi/2")
         if self.face not in ("conical", "toroidal"):
-            raise InputError("sheave.face", self.face, "'conical' or 'toroidal'")
+            raise InputError("sheave.face", self.face, "must be 'conical' or 'toroidal'")
         chord = np.hypot(self.outer_radius - self.hub_radius, self.hub_face - self.rim_thickness)
         if self.face == "toroidal" and not self.torus_radius > chord / 2:
-            raise InputError("sheave.torus_radius", self.torus_radius, f"> half the face chord, {chord / 2:g} m")
+            raise InputError("sheave.torus_radius", self.torus_radius,
+                             f"must exceed half the face chord, {chord / 2:g} m")
         if not (0.0 < self.E and -1.0 < self.nu < 0.5 and 0.0 < self.rho):
-            raise InputError("sheave.material", (self.E, self.nu, self.rho), "E > 0, -1 < nu < 0.5, rho > 0")
+            raise InputError("sheave.material", (self.E, self.nu, self.rho),
+                             "must satisfy E > 0, -1 < nu < 0.5, rho > 0")
 
     @property
     def hub_face(self) -> float:
@@ -126,7 +128,7 @@ def _linear_section_mesh(section: SheaveSection, n_r: int, n_z: int):  # noqa: A
     from skfem import MeshTri1
 
     if n_r < 2 or n_z < 1:
-        raise InputError("section_mesh", (n_r, n_z), "n_r >= 2 and n_z >= 1")
+        raise InputError("section_mesh", (n_r, n_z), "must satisfy n_r >= 2 and n_z >= 1")
     s = section
     span = s.outer_radius - s.bore_radius
     n_hub = max(1, int(round(n_r * (s.hub_radius - s.bore_radius) / span))) if s.hub_radius > s.bore_radius else 0
@@ -145,7 +147,8 @@ def _linear_section_mesh(section: SheaveSection, n_r: int, n_z: int):  # noqa: A
         a, b = a[na - shared:], b[nb - shared:]
         quads += [(a[k], b[k], b[k + 1], a[k + 1]) for k in range(len(a) - 1)]
     q = np.array(quads).T
-    return MeshTri1(np.array(points).T, np.hstack([q[[0, 1, 2]], q[[0, 2, 3]]]))
+    triangles = np.hstack([q[[0, 1, 2]], q[[0, 2, 3]]])
+    return MeshTri1(np.ascontiguousarray(np.array(points).T), np.ascontiguousarray(triangles))
 
 
 def _theta_weights(n: int, family: str) -> tuple[float, float]:
@@ -177,9 +180,9 @@ class HarmonicSheave:
 
     def __post_init__(self):
         if self.family not in ("cos", "sin"):
-            raise InputError("family", self.family, "'cos' or 'sin'")
+            raise InputError("family", self.family, "must be 'cos' or 'sin'")
         if self.n < 0:
-            raise InputError("n", self.n, "a number of nodal diameters >= 0")
+            raise InputError("n", self.n, "must be a number of nodal diameters >= 0")
 
     @cached_property
     def basis(self):  # noqa: ANN201 - skfem Basis
@@ -242,7 +245,7 @@ class HarmonicSheave:
         from skfem import LinearForm, asm
 
         if (self.n, self.family) != (0, "cos"):
-            raise InputError("centrifugal_displacement", (self.n, self.family), "the n = 0 'cos' model")
+            raise InputError("centrifugal_displacement", (self.n, self.family), "must be the n = 0 'cos' model")
         rho = self.section.rho
 
         @LinearForm
@@ -319,7 +322,7 @@ class HarmonicSheave:
         from skfem import FacetBasis, LinearForm, asm
 
         if self.n != 0:
-            raise InputError("rim_load", self.n, "a ring load excites only the n = 0 harmonic")
+            raise InputError("rim_load", self.n, "must be 0: a ring load excites only the n = 0 harmonic")
         sec = self.section
         mesh = self.basis.mesh
         facets = mesh.facets_satisfying(lambda x: np.isclose(x[0], sec.outer_radius, rtol=0,
@@ -359,7 +362,7 @@ def _lowest_modes(K, M, free, count, definite):  # noqa: ANN001, ANN202
     """Lowest modes of ``K x = w^2 M x`` on ``free`` DOFs by shift-invert Lanczos (scipy ARPACK)."""
     Kf, Mf = K[free][:, free].tocsc(), M[free][:, free].tocsc()
     if count >= len(free):
-        raise InputError("count", count, f"fewer than the {len(free)} free DOFs")
+        raise InputError("count", count, f"must be fewer than the {len(free)} free DOFs")
     # a clamped disc is definite: shift at 0; a free one has rigid modes: shift slightly below 0
     scale = abs(Kf.diagonal()).max() / abs(Mf.diagonal()).max()
     sigma = 0.0 if definite else -1e-6 * scale
@@ -379,7 +382,7 @@ def solid_mesh(section: SheaveSection, n_r: int = 12, n_z: int = 2, n_theta: int
     from skfem import MeshTet1
 
     if n_theta < 8:
-        raise InputError("solid_mesh.n_theta", n_theta, ">= 8 cells around")
+        raise InputError("solid_mesh.n_theta", n_theta, "must be >= 8 cells around")
     m = _linear_section_mesh(section, n_r, n_z)
     n2 = m.p.shape[1]
     th = 2 * np.pi * np.arange(n_theta) / n_theta
@@ -395,7 +398,7 @@ def solid_mesh(section: SheaveSection, n_r: int = 12, n_z: int = 2, n_theta: int
     d = p[:, t[1:]] - p[:, t[0]][:, None, :]
     neg = np.einsum("ij,ij->j", d[:, 0], np.cross(d[:, 1], d[:, 2], axis=0)) < 0
     t[1:3, neg] = t[2:0:-1, neg]                        # orient every tetrahedron positively
-    return MeshTet1(p, t)
+    return MeshTet1(np.ascontiguousarray(p), np.ascontiguousarray(t))
 
 
 @dataclass(frozen=True, eq=False)

@@ -19,7 +19,7 @@ MAX_DIAMETERS, MAX_MODES = 40, 50
 def harmonics(diameters: int) -> list[tuple[int, str]]:
     """``(n, family)`` of a spectrum: ``n = 0`` in both families (umbrella/axial and torsion), ``n >= 1`` once."""
     if not 0 <= diameters <= MAX_DIAMETERS:
-        raise InputError("--diameters", diameters, f"0..{MAX_DIAMETERS} nodal diameters")
+        raise InputError("--diameters", diameters, f"must be 0..{MAX_DIAMETERS} nodal diameters")
     return [(0, "cos"), (0, "sin")] + [(n, "cos") for n in range(1, diameters + 1)]
 
 
@@ -28,9 +28,9 @@ def sheave_spectrum(section: SheaveSection, diameters: int = 4, count: int = 2, 
     """The ``count`` lowest modes of every harmonic up to ``diameters`` nodal diameters, as rows
     ``{n, family, k, rotating_hz, forward_hz, backward_hz}`` sorted by frequency; ``speed`` in rad/s."""
     if not 1 <= count <= MAX_MODES:
-        raise InputError("--modes", count, f"1..{MAX_MODES} modes per nodal diameter")
+        raise InputError("--modes", count, f"must be 1..{MAX_MODES} modes per nodal diameter")
     if not (np.isfinite(speed) and speed >= 0.0):
-        raise InputError("--speed", speed, "a finite spin speed >= 0")
+        raise InputError("--speed", speed, "must be a finite spin speed >= 0")
     prestress = None
     if speed > 0.0:
         axisym = HarmonicSheave(section, 0, "cos", *mesh)
@@ -59,6 +59,6 @@ def wedge_opening(section: SheaveSection, force: float,
     """Model and displacement (m) of the sheave, bore clamped, pushed back (towards ``-z``, away from the chain)
     by an axial ring load ``force`` (N) spread over its rim: the opening of the wedge, per sheave."""
     if not (np.isfinite(force) and 0.0 < abs(force) < 1e9):
-        raise InputError("--load", force, "a finite axial force in N, 0 < |F| < 1e9")
+        raise InputError("--load", force, "must be a finite axial force in N with 0 < |F| < 1e9")
     model = HarmonicSheave(section, 0, "cos", *mesh)
     return model, model.static(model.rim_load(-force))
