@@ -131,6 +131,15 @@ class DynamicStiffness:
                                  component="modal.forced") from None
 
 
+def _direct(M, K, C, G, inputs, outputs: OutputMap):
+    """What a direct solve needs, restricted to the DOFs the inputs reach: the dynamic stiffness, the inputs
+    and the output maps on those DOFs."""
+    M, K, C, G = _check(M, K, C, G)
+    F = _inputs(inputs, M.shape[0])
+    dofs = reached(M, K, C, G, F)
+    return DynamicStiffness(M, K, C, G, dofs), F[dofs], outputs.D[:, dofs], outputs.V[:, dofs]
+
+
 def frf_direct(M, K, C, G, inputs, outputs: OutputMap, omegas, speed: float = 0.0) -> np.ndarray:
     """Receptances by one sparse solve per frequency.
 
@@ -148,15 +157,11 @@ def frf_direct(M, K, C, G, inputs, outputs: OutputMap, omegas, speed: float = 0.
     -------
     complex array (w, p, m): output per unit input.
     """
-    M, K, C, G = _check(M, K, C, G)
-    F = _inputs(inputs, M.shape[0])
+    Z, F, D, V = _direct(M, K, C, G, inputs, outputs)
     w = _omegas(omegas)
-    dofs = reached(M, K, C, G, F)
-    Z = DynamicStiffness(M, K, C, G, dofs)
-    D, V = outputs.D[:, dofs], outputs.V[:, dofs]
     H = np.zeros((len(w), D.shape[0], F.shape[1]), dtype=complex)
     for i, wi in enumerate(w):
-        X = Z.solve(wi, speed, F[dofs])
+        X = Z.solve(wi, speed, F)
         H[i] = D @ X + 1j * wi * (V @ X)
     return H
 
@@ -309,15 +314,11 @@ def unbalance_response(M, K, C, G, load, outputs: OutputMap, speeds) -> np.ndarr
     -------
     complex array (s, p): output amplitudes.
     """
-    M, K, C, G = _check(M, K, C, G)
-    F = _inputs(load, M.shape[0])
+    Z, F, D, V = _direct(M, K, C, G, load, outputs)
     s = _omegas(speeds)
-    dofs = reached(M, K, C, G, F)
-    Z = DynamicStiffness(M, K, C, G, dofs)
-    D, V = outputs.D[:, dofs], outputs.V[:, dofs]
     out = np.zeros((len(s), D.shape[0]), dtype=complex)
     for i, w in enumerate(s):
-        X = Z.solve(w, w, w * w * F[dofs])[:, 0]
+        X = Z.solve(w, w, w * w * F)[:, 0]
         out[i] = D @ X + 1j * w * (V @ X)
     return out
 

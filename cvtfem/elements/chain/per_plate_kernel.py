@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from cvtfem.elements.chain.plates_kernel import _plate_law, _strains
+from cvtfem.elements.chain.plates_kernel import _plate_law, _strain_rates, _strains
 from cvtfem.elements.jit import njit
 
 
@@ -74,12 +74,7 @@ def plate_jacobians_kernel(q, qdot, link, xi, l, L, c, c1, c2, h, beta_ext, beta
             for j in range(3):
                 D[i, j] = sc * K[i, j]
         # g = -A^T (stress + D A epsdot): generalized forces on the strains (plates.strain_forces)
-        for i in range(3):
-            ed[i] = 0.0
-            for j in range(20):
-                ed[i] += J[i, j] * qdot[p, j]
-        for i in range(3):
-            r[i] = A[i, 0] * ed[0] + A[i, 1] * ed[1] + A[i, 2] * ed[2]
+        _strain_rates(J, qdot[p], A, ed, r)
         s0 = c1[p] * z1 + c2[p] * z2 + D[0, 0] * r[0] + D[0, 1] * r[1]
         s1 = c2[p] * z1 + c1[p] * z2 + D[1, 0] * r[0] + D[1, 1] * r[1]
         s2 = tension + D[2, 2] * r[2]

@@ -62,6 +62,17 @@ def _strains(q, xi, l, L, J, H, Hp, V, t, e):
 
 
 @njit(cache=True)
+def _strain_rates(J, qdot, A, ed, r):
+    """Strain rates ``ed = J qdot`` of one plate and their state projection ``r = A ed`` (written in place)."""
+    for i in range(3):
+        ed[i] = 0.0
+        for j in range(20):
+            ed[i] += J[i, j] * qdot[j]
+    for i in range(3):
+        r[i] = A[i, 0] * ed[0] + A[i, 1] * ed[1] + A[i, 2] * ed[2]
+
+
+@njit(cache=True)
 def _plate_law(model, psi1, psi2, Delta, c, c1, c2, h, A, m):
     """State, corner angles and tension (N) of one plate under ``model`` (A4: the ten-state law; A3: clamped,
     a compressed plate dropped, or kept with ``A3_KEEP``); fills the state Jacobian ``A``."""
@@ -165,12 +176,7 @@ def plate_forces_kernel(q, qdot, xi, l, L, c, c1, c2, h, beta_ext, beta_shear, m
         st, d1, d2, tension = _plate_law(model, psi1, psi2, Delta, c[p], c1[p], c2[p], h[p], A, m)
         z1, z2 = psi1 - d1, psi2 - d2
         M1, M2 = c1[p] * z1 + c2[p] * z2, c2[p] * z1 + c1[p] * z2
-        for i in range(3):
-            ed[i] = 0.0
-            for j in range(20):
-                ed[i] += J[i, j] * qdot[p, j]
-        for i in range(3):
-            r[i] = A[i, 0] * ed[0] + A[i, 1] * ed[1] + A[i, 2] * ed[2]
+        _strain_rates(J, qdot[p], A, ed, r)
         stress[0] = M1 + beta_shear * (c1[p] * r[0] + c2[p] * r[1])
         stress[1] = M2 + beta_shear * (c2[p] * r[0] + c1[p] * r[1])
         stress[2] = tension + beta_ext * c[p] * r[2]
