@@ -296,7 +296,7 @@ class ChainCVT(ModelBase):
 
     def outputs(self, t: float, x) -> dict[str, Any]:
         """Named outputs of :attr:`output_specs` at ``(t, x)``."""
-        dx, diag = self.evaluate(t, x)
+        dx, diag = self.evaluate(t, x, slip=False)      # the contact details come below
         q, v, _, W = self.split(x)
         nc = self._idx[0]
         n = self.family.n
