@@ -18,6 +18,7 @@ import numpy as np
 
 from cvtfem.analysis.steppers import make_stepper
 from cvtfem.analysis.summary import EFFICIENCY_WINDOW, RunSummary, summarise
+from cvtfem.blas import single_thread_blas
 from cvtfem.errors import InputError, NumericalError
 
 #: Stall guard: a run fails when STALL_STEPS consecutive accepted steps each advance time by less than
@@ -56,7 +57,8 @@ def run_scene(scene, until: float | None = None, results: str | Path | None = No
     if not (math.isfinite(t_end) and t_end > 0):
         raise InputError("--until", t_end, "must be a positive, finite number of simulated seconds")
     run = _Run(scene, t_end)
-    x0, report = run.loop.start(**(start or {}))
+    with single_thread_blas():   # the same bits on every machine (cvtfem.blas)
+        x0, report = run.loop.start(**(start or {}))
     run.x_start = x0
     run.start_note = report.get("warning", report["kind"] if "residual" not in report else
                                 f"steady (relative Newton correction {report['residual']:.1e})")
@@ -67,7 +69,8 @@ def run_scene(scene, until: float | None = None, results: str | Path | None = No
 
         writer = ResultsWriter(results, scene.to_toml(), "run", run.specs, scene.output.flush_interval, overwrite,
                                checkpoint=run.layout() if run.interval > 0 else None)
-    return run.drive_with_policy(writer, 0.0, x0, None, show_progress, on_checkpoint)
+    with single_thread_blas():
+        return run.drive_with_policy(writer, 0.0, x0, None, show_progress, on_checkpoint)
 
 
 def resume_run(results: str | Path, show_progress: bool = True,
@@ -117,8 +120,9 @@ def resume_run(results: str | Path, show_progress: bool = True,
         writer.close("failed", f"resume: {err}")
         raise
     run.retry, run.x_start = int(values["retry"][0]), run.loop.initial_state()
-    return run.drive_with_policy(writer, float(values["t"][0]), values["x"], (seq, values), show_progress,
-                                 on_checkpoint)
+    with single_thread_blas():
+        return run.drive_with_policy(writer, float(values["t"][0]), values["x"], (seq, values), show_progress,
+                                     on_checkpoint)
 
 
 #: Scene keys a resume may change without ``--resume-changed`` (free text without effect on the run).

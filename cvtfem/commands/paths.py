@@ -31,7 +31,7 @@ def check_output_file(where: str, value: str) -> Path:
     path = Path(value)
     if len(os.fsencode(path.name)) > NAME_MAX:
         raise InputError(where, value, f"must have a file name of at most {NAME_MAX} bytes")
-    if path.is_dir():
+    if path.is_dir() or os.path.basename(value) in ("", ".", ".."):   # "d/" names a folder, existing or not
         raise InputError(where, value, "must be a file path, not a folder")
     _check_creatable(where, value, path.parent)
     if path.exists() and not os.access(path, os.W_OK):

@@ -12,6 +12,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from cvtfem.blas import single_thread_blas
 from cvtfem.errors import InputError, NumericalError
 from cvtfem.integrate.events import EVENT_SAMPLES
 from cvtfem.integrate.methods import METHODS, SCIPY_METHODS, IgnoredOptionWarning
@@ -134,28 +135,29 @@ def solve(fun, t_span, y0, method: str = "dopri45", h: float | None = None, rtol
             if val != default:
                 warnings.warn(f"option `{key}` is ignored by scipy method {method!r}",
                               IgnoredOptionWarning, stacklevel=2)
-    engine = make_engine(method, system, t0, y0, tf, rtol, atol, h, adaptive, error_check, options=options,
-                         controller=controller)
-    run = Stepping(engine, t0, y0, tf, growth_limit=growth_limit, event_location=event_location,
-                   event_samples=event_samples, max_steps=max_steps, max_events=max_events)
-    wall = time.perf_counter()
-    ts, ys = ([t0], [y0.copy()]) if t_eval is None else ([], [])
-    i_eval = 0
-    while run.status == "running":
-        if not run.step():
-            break
-        t1 = run.last.t1
-        if t_eval is not None:
-            while i_eval < len(t_eval) and t_eval[i_eval] <= t1:
-                ts.append(t_eval[i_eval])
-                ys.append(run.dense(t_eval[i_eval]))
-                i_eval += 1
-        else:
-            ts.append(t1)
-            ys.append(run.last.x1.copy())
-    stats = engine.stats
-    stats.times["t_total"] = time.perf_counter() - wall
-    engine.counts()   # scipy's own counters into stats
+    with single_thread_blas():   # the same bits on every machine (cvtfem.blas)
+        engine = make_engine(method, system, t0, y0, tf, rtol, atol, h, adaptive, error_check, options=options,
+                             controller=controller)
+        run = Stepping(engine, t0, y0, tf, growth_limit=growth_limit, event_location=event_location,
+                       event_samples=event_samples, max_steps=max_steps, max_events=max_events)
+        wall = time.perf_counter()
+        ts, ys = ([t0], [y0.copy()]) if t_eval is None else ([], [])
+        i_eval = 0
+        while run.status == "running":
+            if not run.step():
+                break
+            t1 = run.last.t1
+            if t_eval is not None:
+                while i_eval < len(t_eval) and t_eval[i_eval] <= t1:
+                    ts.append(t_eval[i_eval])
+                    ys.append(run.dense(t_eval[i_eval]))
+                    i_eval += 1
+            else:
+                ts.append(t1)
+                ys.append(run.last.x1.copy())
+        stats = engine.stats
+        stats.times["t_total"] = time.perf_counter() - wall
+        engine.counts()   # scipy's own counters into stats
     status = {"finished": 0, "event": 1, "failed": -1}[run.status]
     message = MESSAGES[status] if status >= 0 else run.message
     extra = engine.report()

@@ -19,11 +19,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from cvtfem.blas import single_thread_blas
 from cvtfem.elements.torsional import TorsionalNetwork
 from cvtfem.errors import InputError, NumericalError
 from cvtfem.periodic.blocktri import solve_mixed
 from cvtfem.periodic.hb import (PeriodicSolution, _symmetrize, default_samples, linearize_mixed, load_harmonics,
-                                newton, prepare, single_thread_blas, solve_periodic)
+                                newton, prepare, solve_periodic)
 
 #: Corrector iterations the step control aims at: ``ds *= clip(TARGET_ITERATIONS / its, 1/2, 2)``.
 TARGET_ITERATIONS = 4

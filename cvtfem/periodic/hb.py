@@ -13,26 +13,17 @@ through the block sweep.
 from __future__ import annotations
 
 import logging
-from contextlib import nullcontext
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from cvtfem.assembly.numbering import Topology, through_numbering
+from cvtfem.blas import single_thread_blas
 from cvtfem.elements.torsional import TorsionalNetwork, link_force
 from cvtfem.errors import InputError, NumericalError
 from cvtfem.periodic.blocktri import check_grounded, solve_blocks, solve_mixed
 
 log = logging.getLogger(__name__)
-
-
-def single_thread_blas():
-    """Context limiting BLAS to one thread: small blocks lose badly to thread start-up and contention."""
-    try:
-        from threadpoolctl import threadpool_limits
-    except ImportError:  # optional dependency
-        return nullcontext()
-    return threadpool_limits(limits=1, user_api="blas")
 
 
 def default_samples(N: int) -> int:

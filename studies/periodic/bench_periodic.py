@@ -21,6 +21,7 @@ import numpy as np
 
 from cvtfem.analysis.timing import machine
 from cvtfem.assembly.numbering import through_numbering
+from cvtfem.blas import single_thread_blas
 from cvtfem.elements.torsional import build_network
 from cvtfem.machines.torsional import build
 from cvtfem.periodic import blocktri, hb, transient
@@ -126,7 +127,7 @@ def scaling(quick: bool) -> dict:
             L = (L + L.conj().transpose(0, 1, 3, 2)) / 2
             g = rng.normal(size=(S, 1, K)) + 0j
             topo = through_numbering(S, i, j)
-            with hb.single_thread_blas():
+            with single_thread_blas():
                 t, a = median_time(lambda: blocktri.block_sweep(topo, Nb, L, i, j, g), 1 if quick and S > 1000 else 3)
             res = np.linalg.norm(blocktri.apply(Nb, L, i, j, a) - g) / np.linalg.norm(g)
             print(f"block sweep {shape:5s} S={S:6d}, blocks {K}x{K}: {t:8.4f} s median, "

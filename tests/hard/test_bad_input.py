@@ -76,6 +76,9 @@ def test_run_counts_bounded_up_front(tmp_path, cli, output, needles):
     (("modes", "friswell_5_9_1", "--json", "{long}.json"), ("`--json`", "255 bytes")),
     (("docs", "scenes", "--out", "{file}/scenes.md"), ("`--out`",)),
     (("demo", "--out", "{file}"), ("`--out`", "must be a folder")),
+    # a path ending in "/" names a folder even when none exists yet (open() then fails after the study)
+    (("study", "heat", "--N", "20", "--csv", "{dir}/new/"), ("`--csv`", "not a folder")),
+    (("study", "order", "--csv", "{dir}/."), ("`--csv`", "not a folder")),
 ])
 def test_output_paths_checked_before_the_work(tmp_path, cli, argv, needles):
     """Each of these used to end in a traceback after the work was done (the work lost)."""
