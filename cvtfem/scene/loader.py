@@ -1,7 +1,8 @@
 """Scene files (TOML) -> validated, immutable :class:`Scene`.
 
-A scene may start from a preset (``preset = "NAME"``) and override keys:
-tables merge key by key, arrays of tables are replaced whole.
+A scene may start from a preset (``preset = "NAME"``), or from a preset combined with parts such as a
+regime (``preset = ["chain-S2", "regime-A"]``, merged in order), and override keys: tables merge key by
+key, arrays of tables are replaced whole.
 """
 from __future__ import annotations
 
@@ -20,6 +21,8 @@ from cvtfem.scene.schema import SCENE, scene_kind
 from cvtfem.scene.schema.base import validate
 
 PRESET_PACKAGE = "cvtfem.scene.presets"
+#: Sub-folder of the partial scenes (regimes, chain patterns) combined with a preset.
+PARTS = "parts"
 
 
 @dataclass(frozen=True)
@@ -79,19 +82,32 @@ def merge(base: Mapping[str, Any], override: Mapping[str, Any]) -> dict[str, Any
 
 
 def preset_names() -> list[str]:
-    """Names of the built-in presets, sorted."""
-    files = resources.files(PRESET_PACKAGE).iterdir()
-    return sorted(f.name[:-5] for f in files if f.name.endswith(".toml"))
+    """Names of the built-in presets (complete scenes), sorted."""
+    return _names(resources.files(PRESET_PACKAGE))
+
+
+def part_names() -> list[str]:
+    """Names of the built-in parts: partial scenes (a regime, a chain pattern) to combine with a preset,
+    ``preset = ["chain-S2", "regime-A"]``."""
+    return _names(resources.files(PRESET_PACKAGE).joinpath(PARTS))
+
+
+def _names(folder) -> list[str]:
+    return sorted(f.name[:-5] for f in folder.iterdir() if f.name.endswith(".toml"))
 
 
 def preset_text(name: str) -> str:
-    """TOML text of a built-in preset (with its provenance comments)."""
-    if name not in preset_names():
+    """TOML text of a built-in preset or part (with its provenance comments)."""
+    folder = resources.files(PRESET_PACKAGE)
+    if name in part_names():
+        folder = folder.joinpath(PARTS)
+    elif name not in preset_names():
         from cvtfem.scene.schema.base import _suggest
 
-        raise InputError("preset", name, "must name a built-in preset (see `cvtfem scenes`)",
-                         _suggest(name, preset_names()) or "available: " + ", ".join(preset_names()))
-    return resources.files(PRESET_PACKAGE).joinpath(f"{name}.toml").read_text(encoding="utf-8")
+        known = preset_names() + part_names()
+        raise InputError("preset", name, "must name a built-in preset or part (see `cvtfem scenes`)",
+                         _suggest(name, known) or "available: " + ", ".join(known))
+    return folder.joinpath(f"{name}.toml").read_text(encoding="utf-8")
 
 
 def _parse(text: str, source: str) -> dict[str, Any]:
@@ -123,19 +139,35 @@ def _read_scene_file(path: Path) -> str:
 
 
 def resolve_presets(data: Mapping[str, Any], seen: tuple[str, ...] = ()) -> dict[str, Any]:
-    """Expand ``preset = "NAME"`` (recursively) into a plain merged document."""
-    name = data.get("preset")
-    if name is None or name == "":
+    """Expand ``preset = "NAME"`` or ``preset = ["NAME", "PART", ...]`` (recursively) into a plain merged
+    document: the presets and parts merged in order, then the scene's own keys; the resolved document keeps
+    the names as one comma-separated string."""
+    if data.get("preset") in (None, ""):
         return dict(data)
-    if not isinstance(name, str):
-        raise InputError("preset", name, "must be a string naming a built-in preset")
-    if name in seen:
-        raise InputError("preset", name, "must not form a cycle", " -> ".join(seen + (name,)))
-    base = resolve_presets(_parse(preset_text(name), f"preset {name}"), seen + (name,))
-    body = {k: v for k, v in data.items() if k != "preset"}
-    merged = merge(base, body)
-    merged["preset"] = name
+    merged: dict[str, Any] = {}
+    names = _preset_list(data["preset"])
+    for name in names:
+        if name in seen:
+            raise InputError("preset", name, "must not form a cycle", " -> ".join(seen + (name,)))
+        merged = merge(merged, resolve_presets(_parse(preset_text(name), f"preset {name}"), seen + (name,)))
+    merged = merge(merged, {k: v for k, v in data.items() if k != "preset"})
+    merged["preset"] = ", ".join(names)
     return merged
+
+
+def _preset_list(value: Any) -> list[str]:
+    """The preset names of a ``preset`` value: a name, a list of names, or names separated by commas."""
+    if isinstance(value, str):
+        names = value.split(",")
+    elif isinstance(value, list) and value and all(isinstance(v, str) for v in value):
+        names = value
+    else:
+        raise InputError("preset", value, "must be a preset name or a list of preset and part names "
+                         "(merged in order; see `cvtfem scenes`)")
+    names = [n.strip() for n in names]
+    if not all(names):
+        raise InputError("preset", value, "must not hold an empty name")
+    return names
 
 
 def scene_from_dict(data: Mapping[str, Any], source: str = "<dict>") -> Scene:
@@ -151,7 +183,8 @@ def load_scene(spec: str | Path, overrides: Mapping[str, Any] | None = None) -> 
     Parameters
     ----------
     spec : str or Path
-        A path to a ``.toml`` file, or the name of a built-in preset.
+        A path to a ``.toml`` file, the name of a built-in preset, or a preset and parts separated by
+        commas (``"band-6+2n,regime-A"``).
     overrides : mapping, optional
         Nested keys merged over the file's content before validation.
     """
@@ -167,6 +200,12 @@ def load_scene(spec: str | Path, overrides: Mapping[str, Any] | None = None) -> 
                              "see `cvtfem scenes` for presets")
         data, source = _parse(_read_scene_file(path), str(path)), str(path)
     else:
-        preset_text(str(spec))  # raises a clear error for an unknown name
+        names = _preset_list(str(spec))
+        for name in names:
+            preset_text(name)  # raises a clear error for an unknown name
+        if not set(names) & set(preset_names()):
+            raise InputError("SCENE", str(spec), "must name a preset (a complete scene), alone or with parts: "
+                             f"{', '.join(names)} {'is a part' if len(names) == 1 else 'are parts'}",
+                             f"e.g. chain-S2,{names[0]}")
         data, source = {"preset": str(spec)}, f"preset:{spec}"
     return scene_from_dict(merge(data, overrides or {}), source=source)
