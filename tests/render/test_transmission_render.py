@@ -1,0 +1,88 @@
+"""The chain transmission as drawn: the drawn faces and pin ends are the model's contact geometry."""
+import numpy as np
+import pytest
+
+from cvtfem.errors import InputError
+from cvtfem.machines.cvt import chain_loop
+from cvtfem.render import transmission as tr
+from cvtfem.scene.loader import load_scene
+
+
+@pytest.fixture(scope="module")
+def running():
+    model = chain_loop(load_scene("chain-S2"))
+    x0, _ = model.start()
+    return model, x0
+
+
+def test_drawn_pin_ends_penetrate_the_drawn_faces_by_the_model_penetration(running):
+    """The drawn face is x3 = z + s(r) of the band models' Sheave (s = -z0 of the face through the axis), and
+    each pin end lies beyond it by exactly the penetration the contact model reports."""
+    model, x = running
+    u, u3, z = tr.axial_positions(model, x)
+    delta = model.outputs(0.0, x)["contact.penetration"].reshape(-1, 2)
+    contact = model.contact
+    checked = 0
+    for k in range(2):
+        c, face = contact.centres[k], contact.faces[k]
+        flat = type(face)(face.profile, face.gamma, face.R, face.y, 0.0)   # w = 0: the face through the axis
+
+        def s(r):
+            return -flat.z0(r)
+        pts = np.asarray(tr.sheave_surface(face, c, z[k], -1.0, 0.01, contact.r_outer).points)
+        np.testing.assert_allclose(pts[:, 2], -(z[k] + s(np.hypot(pts[:, 0] - c[0], pts[:, 1] - c[1]))),
+                                   rtol=1e-12, atol=1e-15)
+        r_pin = np.hypot(*(u - c).T)
+        on = np.flatnonzero((r_pin < contact.r_outer) & (delta[:, k] > 0))
+        np.testing.assert_allclose(u3[on] - (z[k] + s(r_pin[on])), delta[on, k], rtol=1e-9, atol=1e-15)
+        checked += on.size
+    assert checked > 20      # both arcs
+
+
+def test_axial_exaggeration_about_a_reference(running):
+    model, x = running
+    y = x.copy()
+    y[2 * model.family.n:3 * model.family.n] += 1e-5            # every pin end 10 um further out
+    y[model._idx[2]] += 2e-6
+    _, u3, z = tr.axial_positions(model, y, reference=x, axial_scale=50.0)
+    _, u3_0, z_0 = tr.axial_positions(model, x)
+    np.testing.assert_allclose(u3 - u3_0, 5e-4, rtol=1e-9)
+    np.testing.assert_allclose(z - z_0, 1e-4, rtol=1e-9)
+
+
+def test_links_are_ribbons_between_their_pins(running):
+    model, x = running
+    u, u3, _ = tr.axial_positions(model, x)
+    pins, links = tr.chain_meshes(u, u3, 1e-3)
+    n = len(u)
+    assert links.n_cells == n
+    corners = np.asarray(links.points).reshape(n, 4, 3)
+    np.testing.assert_array_equal(corners[:, 0, :2], u)
+    np.testing.assert_array_equal(corners[:, 2, :2], np.roll(u, -1, axis=0))
+    np.testing.assert_allclose(corners[:, 1, 2], tr.PACK_FRACTION * u3)
+    assert pins.n_points > 0
+
+
+def test_colours_per_link_and_per_pin(running):
+    model, x = running
+    out = model.outputs(0.0, x)
+    v, per_link = tr.colour_values(model, out, "contact.normal_force")
+    assert not per_link and v.shape == (model.family.n,)
+    np.testing.assert_allclose(v.sum(), out["contact.normal_force"].sum())
+    assert tr.colour_values(model, out, "chain.link_tension")[1]
+    with pytest.raises(InputError, match="--color"):
+        tr.check_colour(model, "driving.speed")
+
+
+def test_png_through_the_cli(cli, tmp_path):
+    from PIL import Image
+
+    png = tmp_path / "t.png"
+    res = cli("render", "chain-S2", "--png", str(png), "--color", "contact.normal_force", timeout=300)
+    assert res.returncode == 0, res.stderr
+    img = np.asarray(Image.open(png).convert("RGB")).astype(int)
+    assert img.shape == (800, 1400, 3)
+    coloured = np.abs(img - img.mean(axis=2, keepdims=True)).sum(axis=2) > 60     # not grey/white: the colour map
+    assert coloured.mean() > 0.01
+    bad = cli("render", "chain-S2", "--png", str(png), "--mode", "1")
+    assert bad.returncode == 2 and "`--mode`" in bad.stderr
