@@ -8,7 +8,7 @@ from pathlib import Path
 from cvtfem.errors import InputError
 
 #: Argument destinations that name an output file, in every command that has them.
-OUTPUT_FILES = ("results", "summary_json", "json", "csv", "png")
+OUTPUT_FILES = ("results", "summary_json", "json", "csv", "png", "spectrum_png")
 #: Longest file name most file systems take, bytes.
 NAME_MAX = 255
 
@@ -19,8 +19,9 @@ def check_output_args(args: argparse.Namespace) -> None:
         value = getattr(args, dest, None)
         if value is not None and not (dest == "results" and str(value).lower() == "none"):
             check_output_file(f"--{dest.replace('_', '-')}", value)
-        if dest == "png" and value is not None and Path(value).suffix.lower() != ".png":
-            raise InputError("--png", value, "must name a .png file (the figure's format follows the suffix)")
+        if dest.endswith("png") and value is not None and Path(value).suffix.lower() != ".png":
+            raise InputError(f"--{dest.replace('_', '-')}", value,
+                             "must name a .png file (the figure's format follows the suffix)")
     out = getattr(args, "out", None)
     if out is not None and out != "-":
         (check_output_dir if args.command == "demo" else check_output_file)("--out", out)

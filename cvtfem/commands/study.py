@@ -1,4 +1,4 @@
-"""``cvtfem study stability|order|work|heat``: integrator studies (PNG + CSV).
+"""``cvtfem study stability|order|work|heat|accuracy-cost``: integrator studies (PNG + CSV).
 
 Method specs are ``NAME[:key=value...]``, e.g. ``gbs-smooth:stages=2`` or ``sw24:d=0.5``.
 ``order`` and ``work`` also run on a band-model scene (``--scene band-6+2n --until 0.05``): its
@@ -11,6 +11,8 @@ import argparse
 import math
 import platform
 from pathlib import Path
+
+from cvtfem.commands import accuracy_cost
 
 DEFAULT_STABILITY = ("euler,rk4,dopri45,dopri56,dopri78,gbs:stages=2,gbs-smooth:stages=2,"
                      "euler-extrapolation:stages=4,sw24:d=0.5,w1:d=1.0,w1-extrapolation:d=0.5:stages=4,"
@@ -32,7 +34,7 @@ DEFAULT_ORDER = ("euler,rk4,dopri45,dopri56,dopri78,gbs:stages=2,sw24,trapezoida
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("study", help="integrator studies: stability regions, effective order, "
-                                     "work-precision, heat-equation benchmark")
+                                     "work-precision, heat-equation benchmark, accuracy-cost on a chain")
     s = p.add_subparsers(dest="study", metavar="STUDY", required=True)
     a = s.add_parser("stability", help="stability regions of methods on the complex h*lambda plane")
     a.add_argument("--methods", default=DEFAULT_STABILITY, help="comma-separated method specs")
@@ -62,6 +64,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     d.add_argument("--repeats", type=int, default=3)
     d.add_argument("--methods", default="", help="subset (default: the issue's list)")
     d.add_argument("--csv", default="out/studies/heat_benchmark.csv")
+    accuracy_cost.add_subparser(s)
     p.set_defaults(func=run)
 
 
@@ -188,6 +191,8 @@ def run(args: argparse.Namespace) -> int:
     from cvtfem.integrate.methods import METHODS
     from cvtfem.post import integrators as plots
 
+    if args.study == "accuracy-cost":
+        return accuracy_cost.run(args)
     methods = [parse_method(m) for m in getattr(args, "methods", "").split(",") if m.strip()]
     _check_args(args, methods)
     problem = _problem(args.problem, args) if args.study in ("order", "work") else None

@@ -1,0 +1,76 @@
+"""Figures of the accuracy-cost study (issue 16): Jacobian spectra on the signed-log plane, and the global
+error of the pin force against wall time and RHS calls."""
+from __future__ import annotations
+
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+from cvtfem.integrate.study import signed_log  # noqa: E402
+
+#: Linear part of the signed-log axes, 1/s: eigenvalues below it in modulus are drawn linearly.
+X_STAR = 1.0
+
+
+def _log_ticks(ax, axis: str, top: float) -> None:
+    """Ticks at 0 and +-10^k (1/s) on a signed-log axis reaching ``top``."""
+    powers = 10.0 ** np.arange(0, int(np.ceil(np.log10(max(top, 10.0)))) + 1, 2)
+    values = np.concatenate([-powers[::-1], [0.0], powers])
+    labels = [("-" if v < 0 else "") + (f"1e{int(np.log10(abs(v)))}" if v else "0") for v in values]
+    getattr(ax, f"set_{axis}ticks")(signed_log(values, X_STAR), labels, fontsize=7)
+
+
+def plot_spectra(spectra: dict, path: str | Path, title: str = "") -> Path:
+    """Eigenvalues (1/s) of each ``label -> array`` on the signed-log plane (spec section 2.3, x* = 1/s)."""
+    fig, ax = plt.subplots(figsize=(7.5, 5.5))
+    top = 10.0
+    for (label, lam), (marker, colour, size) in zip(spectra.items(), (("o", "C0", 40), ("+", "C3", 18),
+                                                                       ("x", "C2", 18), ("^", "C1", 18))):
+        lam = np.asarray(lam)
+        top = max(top, float(np.max(np.abs(lam.real))), float(np.max(np.abs(lam.imag))))
+        style = {"facecolors": "none", "edgecolors": colour} if marker == "o" else {"color": colour}
+        ax.scatter(signed_log(lam.real, X_STAR), signed_log(lam.imag, X_STAR), s=size, marker=marker, **style,
+                   label=f"{label}: min Re {lam.real.min():.3g}, max |Im| {np.abs(lam.imag).max():.3g} 1/s")
+    _log_ticks(ax, "x", top)
+    _log_ticks(ax, "y", top)
+    ax.axvline(0.0, color="grey", lw=0.6)
+    ax.axhline(0.0, color="grey", lw=0.6)
+    ax.set_xlabel("Re lambda, 1/s (signed log beyond 1)")
+    ax.set_ylabel("Im lambda, 1/s (signed log beyond 1)")
+    ax.set_title(title or "Jacobian eigenvalues", fontsize=9)
+    ax.legend(fontsize=7, loc="upper left")
+    ax.grid(alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return Path(path)
+
+
+def plot_accuracy_cost(rows, path: str | Path, accept: float, title: str = "") -> Path:
+    """Global error E of each run against wall time (left) and RHS calls (right), one line per method, each
+    point labelled with its step or tolerance; the acceptance ``E = accept`` dashed."""
+    fig, axes = plt.subplots(1, 2, figsize=(12, 5), sharey=True)
+    finite = [r for r in rows if np.isfinite(r["error"]) and r["error"] > 0]
+    for (ax, key, xlabel) in ((axes[0], "time", "wall time, s (median)"), (axes[1], "nfev", "RHS calls")):
+        for label in dict.fromkeys(r["label"] for r in finite):
+            pts = sorted((r for r in finite if r["label"] == label), key=lambda r: r[key])
+            line, = ax.loglog([r[key] for r in pts], [r["error"] for r in pts], "o-", ms=4, label=label)
+            for r in pts:
+                ax.annotate(r["setting"], (r[key], r["error"]), fontsize=6, color=line.get_color(),
+                            xytext=(3, 3), textcoords="offset points")
+        ax.axhline(accept, color="k", ls="--", lw=0.8)
+        ax.set_xlabel(xlabel)
+        ax.grid(alpha=0.3, which="both")
+    axes[0].set_ylabel("E = max|P - P*| / max|P*| over the window")
+    axes[1].legend(fontsize=7, loc="lower left")
+    failed = sorted({f"{r['label']} {r['setting']}" for r in rows if not np.isfinite(r["error"])})
+    note = f"; failed or unstable: {', '.join(failed)}" if failed else ""
+    fig.suptitle((title or "accuracy against cost") + note, fontsize=9)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return Path(path)
