@@ -15,22 +15,12 @@ import sys
 import numpy as np
 
 from cvtfem.io.results import read_results
-
-SCENE = """preset = "band-4dof"
-[solver]
-method = "{method}"
-rtol = 1e-7
-atol = 1e-9
-[cvt.regime]
-kind = "ratio-change"
-end_value = 1.0
-ramp_time = 0.2
-"""
+from tests.hard.test_resume import IMPLICIT_SCENE
 
 
 def _run(tmp_path, method: str, threads: int):
     scene = tmp_path / f"{method}.toml"
-    scene.write_text(SCENE.format(method=method), encoding="utf-8")
+    scene.write_text(IMPLICIT_SCENE.format(method=method, interval=0.0), encoding="utf-8")   # no checkpoints
     path = tmp_path / f"{method}-{threads}.h5"
     env = {**os.environ, "OPENBLAS_NUM_THREADS": str(threads)}
     proc = subprocess.run([sys.executable, "-m", "cvtfem.cli", "run", str(scene), "--until", "0.05",
