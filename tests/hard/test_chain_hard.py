@@ -72,7 +72,7 @@ def test_grazing_contact_onset(reference):
     model, x0 = reference
     out0 = model.outputs(0.0, x0)
     k = int(np.argmax(out0["contact.normal_force"]))
-    pin, shaft = divmod(k, 2)
+    pin = k // 2
     x = x0.copy()
     x[model.family.dof_index[pin, 2]] -= out0["contact.penetration"][k]
     out = model.outputs(0.0, x)
@@ -96,11 +96,12 @@ def test_grazing_contact_onset(reference):
     # onset: log-log slope of N(t) over 0.2..0.6 us is 3 (t^2 penetration), less the cosine's bend (~1 %)
     early = (res.t >= 2e-7 - 1e-15) & (res.t <= 6e-7 + 1e-15)
     slope = np.polyfit(np.log(res.t[early]), np.log(N[early]), 1)[0]
+    balance = _balance(model, x, res.y[:, -1])
     print(f"grazing: N slope {slope:.3f}, steps {res.stats['nsteps']} vs {base.stats['nsteps']}, "
-          f"largest N {N.max():.0f} N, penetration {P.max() * 1e6:.1f} um, balance {_balance(model, x, res.y[:, -1]):.2e}")
+          f"largest N {N.max():.0f} N, penetration {P.max() * 1e6:.1f} um, balance {balance:.2e}")
     assert slope == pytest.approx(3.0, abs=0.1)
     assert res.stats["nsteps"] <= 3 * base.stats["nsteps"]
-    assert abs(_balance(model, x, res.y[:, -1])) < 1e-6
+    assert abs(balance) < 1e-6
 
 
 def test_entry_at_high_speed(high_speed):
@@ -174,9 +175,9 @@ def test_friction_eigenvalue_near_minus_1e8_at_zero_slip(reference):
 
 def test_unstable_chain_run_fails_naming_time_pin_and_coordinate(cli, tmp_path, reference):
     """The stiff-friction chain (``cvt.friction.v0`` as above) with RK4 at a fixed 10 us step through
-    ``cvtfem run``: exit 3, one line on stderr naming the time, the pin (at or next to a sheave
-    contact at the start: pin 6, the first span pin after the driving arc) and the coordinate, no traceback; the results file says "failed"
-    with that message and keeps its finite rows."""
+    ``cvtfem run``: exit 3, one line on stderr naming the time, the pin (at or next to a sheave contact at
+    the start: pin 6, the first span pin after the driving arc) and the coordinate, no traceback; the
+    results file says "failed" with that message and keeps its finite rows."""
     scene = tmp_path / "unstable.toml"
     scene.write_text(f'preset = "chain-S2"\n[solver]\nmethod = "rk4"\nh = 1e-5\n[cvt.friction]\nv0 = {V0_STIFF}\n',
                      encoding="utf-8")
@@ -238,3 +239,26 @@ def test_grazing_onset_of_a_whole_arc(reference):
           f"balance {_balance(model, x, res.y[:, -1]):.2e}")
     assert res.stats["nsteps"] <= 5 * base.stats["nsteps"]
     assert abs(_balance(model, x, res.y[:, -1])) < 1e-6
+
+
+def test_state_labels_name_every_state_once(reference):
+    """``state_label`` is one-to-one over the state: each pin coordinate and velocity, the shafts, loops and
+    work integrals (so a failure message names one state); a free S3 chain labels its five per-pin coordinates."""
+    from cvtfem.elements.chain.geometry import REFERENCE_SECTION, chain_geometry
+    from cvtfem.elements.chain.symmetric import ChainS3
+    from cvtfem.machines.chain import FreeChain
+
+    model, _ = reference
+    labels = [model.state_label(i) for i in range(model.size)]
+    assert len(set(labels)) == model.size
+    d = model.family.dof_index
+    assert labels[d[17, 2]] == "pin 17, u3" and labels[model.n2 + d[17, 0]] == "pin 17, du1/dt"
+    assert labels[model.family.size + 1] == "driven shaft, phi" and labels[-2] == "work: dissipated"
+    n = 6
+    family = ChainS3(chain_geometry(n, 0.033, 0.009, 12, 1.4e9, n * 0.0179, REFERENCE_SECTION, c_pin=2.0e8,
+                                    closed=False))
+    free = FreeChain(family, np.zeros(family.size))
+    free_labels = [free.state_label(i) for i in range(free.size)]
+    assert len(set(free_labels)) == free.size
+    assert free_labels[family.dof_index[4, 4]] == "pin 4, u'2"
+    assert free_labels[free.n2 + family.dof_index[4, 3]] == "pin 4, du'1/dt"
