@@ -262,3 +262,21 @@ def test_state_labels_name_every_state_once(reference):
     assert len(set(free_labels)) == free.size
     assert free_labels[family.dof_index[4, 4]] == "pin 4, u'2"
     assert free_labels[free.n2 + family.dof_index[4, 3]] == "pin 4, du'1/dt"
+
+
+def test_failure_without_a_component_names_the_fastest_pin_state(reference):
+    """A stepper failure that names no component (step-size underflow, scipy's messages): ``cvtfem run`` adds
+    the fastest state at the last accepted step; a pin end pushed 5 um further into the sheave (Hertz force
+    +~40 %, pin axial acceleration ~1e5 m/s^2) is the one named."""
+    from types import SimpleNamespace
+
+    from cvtfem.analysis.run import _failure
+
+    model, x0 = reference
+    k = int(np.argmax(model.outputs(0.0, x0)["contact.normal_force"]))
+    x = x0.copy()
+    x[model.family.dof_index[k // 2, 2]] += 5e-6
+    run = SimpleNamespace(message="step size underflow (h = 1e-15 s) at t = 0 s", t=0.0, x=x)
+    text = _failure(model, "Radau", run, 1e-3, 1e-6)
+    assert text.startswith("Radau failed: step size underflow")
+    assert f"fastest state: component {model.n2 + model.family.dof_index[k // 2, 2]} (pin {k // 2}, du3/dt)" in text
