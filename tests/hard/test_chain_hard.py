@@ -280,3 +280,28 @@ def test_failure_without_a_component_names_the_fastest_pin_state(reference):
     text = _failure(model, "Radau", run, 1e-3, 1e-6)
     assert text.startswith("Radau failed: step size underflow")
     assert f"fastest state: component {model.n2 + model.family.dof_index[k // 2, 2]} (pin {k // 2}, du3/dt)" in text
+
+
+@pytest.mark.slow
+def test_entries_and_exits_over_two_ms_at_high_speed():
+    """6000 rpm for 2 ms (about five pitches per arc end, 1 us samples, Radau rtol 1e-3): every pin end
+    that enters or leaves an arc switches once, each exit's last force obeys the Hertz bound of
+    :func:`test_pin_leaving_the_arc`, every state stays finite, the energy balance closes (~10 s)."""
+    scene = load_scene("chain-S2").replace({"cvt": {"regime": {"input_speed": 6000 * np.pi / 30}}})
+    model = chain_loop(scene)
+    x0 = model.start()[0]
+    res = _radau(model, x0, 2e-3, 1e-3, t_eval=np.linspace(0.0, 2e-3, 2001))
+    assert res.status == 0 and np.isfinite(res.y).all()
+    P, N = _series(model, res, "contact.penetration"), _series(model, res, "contact.normal_force")
+    on, off = _switches(N)
+    assert all(len(a) <= 1 and len(b) <= 1 for a, b in zip(on, off))
+    exits = [(k, i) for k in range(N.shape[1]) for i in off[k]]
+    dt = res.t[1] - res.t[0]
+    worst = 0.0
+    for k, i in exits:
+        speed = -(P[i + 1, k] - P[i - 1, k]) / (2 * dt)
+        worst = max(worst, N[i, k] / (model.contact.c[k % 2] * (speed * dt) ** 1.5))
+    print(f"2 ms at 6000 rpm: {sum(map(len, on))} entries, {len(exits)} exits, last force / Hertz bound at most "
+          f"{worst:.2f}, {res.stats['nsteps']} steps, balance {_balance(model, x0, res.y[:, -1]):.2e}")
+    assert len(exits) >= 8 and worst <= 1.5
+    assert abs(_balance(model, x0, res.y[:, -1])) < 1e-6
