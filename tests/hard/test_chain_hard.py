@@ -307,3 +307,20 @@ def test_entries_and_exits_over_two_ms_at_high_speed():
           f"{worst:.2f}, {res.stats['nsteps']} steps, balance {_balance(model, x0, res.y[:, -1]):.2e}")
     assert len(exits) >= 8 and worst <= 1.5
     assert abs(_balance(model, x0, res.y[:, -1])) < 1e-6
+
+
+@pytest.mark.slow
+def test_rk4_beyond_its_friction_limit_is_bounded_and_warned(cli, tmp_path):
+    """The preset (``v0 = 0.02 m/s``: friction eigenvalue -1.75e6 1/s) with RK4 at a fixed 2 us step,
+    ``h lambda = -3.5`` beyond RK4's real stability limit -2.79: the saturating friction law keeps the run
+    bounded (no growth-guard stop, finite results, exit 0), so its only alarm is the local-error monitor's
+    warning line (estimate > 1 x the tolerance) (~5 s)."""
+    scene = tmp_path / "rk4.toml"
+    scene.write_text('preset = "chain-S2"\n[solver]\nmethod = "rk4"\nh = 2e-6\n', encoding="utf-8")
+    h5 = tmp_path / "r.h5"
+    r = cli("run", str(scene), "--until", "3e-3", "--results", str(h5), timeout=600)
+    assert r.returncode == 0, r.stderr
+    assert "fixed step too large for the tolerance: estimated local error" in r.stderr
+    with h5py.File(h5) as f:
+        assert f.attrs["status"] == "finished" and f["stats"].attrs["solver_err_check_max"] > 1.0
+        assert all(np.isfinite(f["series"][name][:]).all() for name in f["series"])
