@@ -34,6 +34,7 @@ def _balance(model, x0, x1):
 
 
 def _series(model, res, name):
+    """Output ``name`` at every sample of ``res``, (samples, size)."""
     return np.array([model.outputs(t, y)[name] for t, y in zip(res.t, res.y.T)])
 
 
