@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import logging
 import math
+import re
 import time
 from collections.abc import Callable
 from pathlib import Path
@@ -331,7 +332,9 @@ class _Run:
         def emit(t: float, x) -> None:
             nonlocal k, last, x_window
             if not np.all(np.isfinite(x)):
-                raise NumericalError("state became non-finite", t=t, component="band model")
+                bad = int(np.flatnonzero(~np.isfinite(x))[0])
+                raise NumericalError(_labelled(loop, f"state became non-finite in component {bad}"), t=t,
+                                     component=component)
             last = (float(t), np.array(x))
             if k == self.j_window:
                 x_window = np.array(x)
@@ -358,7 +361,7 @@ class _Run:
         if bar is not None and t0 > 0:
             bar.update(t0)
         status, message = "finished", ""
-        component = f"band model {scene.cvt.model}"
+        component = f"{'chain' if scene.cvt.model.startswith('chain') else 'band'} model {scene.cvt.model}"
         retry_stats = {"retries": self.retry, "retry_log": "\n".join(self.retry_log)} if self.retry_log else {}
         try:
             while k < len(t_out) and t_out[k] <= run.t:  # t = 0
@@ -367,17 +370,17 @@ class _Run:
                 t_prev = run.t
                 taken = run.step()
                 if run.failure == "stall":
-                    raise NumericalError(_stall_message(loop, method, run.t, run.x, run.t - t_prev,
-                                                        run.stall_h), t=run.t, component=component)
+                    raise NumericalError(_stall_message(loop, method, run.t, run.x, run.t - t_prev, run.stall_h)
+                                         + _fastest(loop, run.t, run.x, rtol, atol), t=run.t, component=component)
                 if not taken:
-                    raise NumericalError(f"{method} failed: {run.message}", t=run.t_fail, component=component)
+                    raise NumericalError(_failure(loop, method, run, rtol, atol), t=run.t_fail, component=component)
                 steps += 1
                 if steps > sol.max_steps:
                     raise NumericalError(f"step budget `solver.max_steps` = {sol.max_steps} exhausted", t=run.t)
                 while k < len(t_out) and t_out[k] <= run.t:
                     emit(t_out[k], run.dense(t_out[k]))
                 if run.status == "failed":
-                    raise NumericalError(f"{method} failed: {run.message}", t=run.t_fail, component=component)
+                    raise NumericalError(_failure(loop, method, run, rtol, atol), t=run.t_fail, component=component)
                 if checkpoints and run.status == "running" and run.t >= next_ck:
                     while next_ck <= run.t:
                         next_ck += self.interval
@@ -465,3 +468,39 @@ def _stall_message(loop, method: str, t: float, x, h: float, h_stall: float) -> 
             "Likely cause: a non-smooth right-hand side the solver cannot step over (anti-windup switching of the "
             "control loops, gross slip under a vanishing clamping force at near-zero torque); raise the torque "
             "or the clamping safety factor, or try another `solver.method`")
+
+
+def _labelled(loop, message: str) -> str:
+    """``message`` with each ``component K`` followed by what state ``K`` is (``loop.state_label``, e.g.
+    ``component 212 (pin 44, u3)``), for models that label their states."""
+    label = getattr(loop, "state_label", None)
+    if label is None:
+        return message
+    return re.sub(r"component (\d+)", lambda m: f"component {m[1]} ({label(int(m[1]))})", message)
+
+
+def _fastest(loop, t: float, x, rtol: float, atol: float) -> str:
+    """``"; fastest state: component K (pin 17, du3/dt) ..."``: the coordinate or velocity whose rate is largest
+    against its tolerance at ``(t, x)`` (the one that holds the step size down or blows up; the first-order
+    states, loops and work integrals, only follow), for models that label their states."""
+    if getattr(loop, "state_label", None) is None or not np.all(np.isfinite(x)):
+        return ""
+    n = 2 * loop.n2
+    with np.errstate(all="ignore"):
+        rate = np.abs(loop.rhs(t, x)[:n]) / (atol + rtol * np.abs(x[:n]))
+    if not np.all(np.isfinite(rate)):
+        return ""
+    k = int(np.argmax(rate))
+    return _labelled(loop, f"; fastest state: component {k}, |dx/dt| / (atol + rtol |x|) = {rate[k]:.3g} 1/s")
+
+
+def _failure(loop, method: str, run, rtol: float, atol: float) -> str:
+    """The failure text of a stepper with the failing component named: the component its message names, and
+    unless that is a pin coordinate (a work integral grows fastest in a blow-up) the fastest state at the last
+    accepted step."""
+    message = f"{method} failed: {run.message}"
+    named = re.search(r"component (\d+)", message)
+    label = getattr(loop, "state_label", None)
+    if named and label is not None and label(int(named[1])).startswith("pin "):
+        return _labelled(loop, message)
+    return _labelled(loop, message) + _fastest(loop, run.t, run.x, rtol, atol)

@@ -23,6 +23,25 @@ from cvtfem.assembly.model import Linearization, ModelBase, StateLayout
 from cvtfem.outputs import OutputSpec
 
 
+#: Names of a pin's coordinates in the column order of a family's ``dof_index``, by coordinates per pin:
+#: S1/S2/S3 (``u'`` the S3 end tangent) and the whole-pin A families (``u_0..u_3`` in-plane, ``w_0, w_1`` axial).
+PIN_COORDINATES = {2: ("u1", "u2"), 3: ("u1", "u2", "u3"), 5: ("u1", "u2", "u3", "u'1", "u'2"),
+                   10: ("u0_1", "u0_2", "u1_1", "u1_2", "u2_1", "u2_2", "u3_1", "u3_2", "w0", "w1")}
+
+
+def pin_coordinate_label(family, j: int, rate: bool = False) -> str:
+    """``"pin 17, u3"`` for coordinate ``j`` of a chain family's ``q`` (``"pin 17, du3/dt"`` for its
+    velocity with ``rate``); ``"chain coordinate j"`` where the family has no per-pin index."""
+    index = getattr(family, "dof_index", None)
+    hit = np.argwhere(index == j) if index is not None else np.empty((0, 2))
+    if not len(hit):
+        return f"chain coordinate {j}" + (" rate" if rate else "")
+    pin, col = (int(c) for c in hit[0])
+    names = PIN_COORDINATES.get(index.shape[1])
+    name = names[col] if names else f"coordinate {col}"
+    return f"pin {pin}, " + (f"d{name}/dt" if rate else name)
+
+
 def _first_order(dq: sp.csr_matrix, dv: sp.csr_matrix) -> sp.csr_matrix:
     """CSR ``[[0, I], [dq, dv]]`` of ``x = [q, q']`` from the accelerations' blocks (n x n each), built directly
     (``sp.bmat`` passes through COO and costs as much as the blocks themselves here)."""
@@ -72,6 +91,10 @@ class FreeChain(ModelBase):
     def _split(self, x):
         n = self.n2
         return x[:n], x[n:]
+
+    def state_label(self, i: int) -> str:
+        """What state component ``i`` is, for failure messages: ``"pin 17, u3"`` or ``"pin 17, du3/dt"``."""
+        return pin_coordinate_label(self.family, int(i) % self.n2, rate=int(i) >= self.n2)
 
     def rhs(self, t: float, x: np.ndarray) -> np.ndarray:
         """``[q', M^-1 Q(q, q')]``."""

@@ -35,6 +35,7 @@ from cvtfem.elements.chain.placement import place_on_path
 from cvtfem.elements.chain.sheave_contact import N_IN, SheaveContact, hertz_constant
 from cvtfem.elements.chain.symmetric import ChainS2, ChainS3, damping_from_ratio
 from cvtfem.errors import InputError, NumericalError
+from cvtfem.machines.chain import pin_coordinate_label
 from cvtfem.outputs import OutputSpec
 
 FAMILIES = {"chain-S2": ChainS2, "chain-S3": ChainS3}
@@ -80,6 +81,24 @@ class ChainCVT(ModelBase):
         """Views ``q, v, z_control, W`` of a state vector."""
         n, nz = self.n2, self.control.size
         return x[:n], x[n:2 * n], x[2 * n:2 * n + nz], x[2 * n + nz:]
+
+    def state_label(self, i: int) -> str:
+        """What state component ``i`` is, for failure messages: ``"pin 17, u3"``, ``"pin 17, du3/dt"``,
+        ``"driven shaft, dphi/dt"``, ``"driving sheave, z"``, ``"control.speed[1]"``, ``"work: dissipated"``."""
+        i, n2, nc = int(i), self.n2, self._idx[0]
+        if i < 2 * n2:
+            j, rate = i % n2, i >= n2
+            if j < nc:
+                return pin_coordinate_label(self.family, j, rate)
+            shaft, coord = ("driving", "driven")[(j - nc) % 2], ("phi", "z")[(j - nc) // 2]
+            part = "shaft" if coord == "phi" else "sheave"
+            return f"{shaft} {part}, " + (f"d{coord}/dt" if rate else coord)
+        j = i - 2 * n2
+        for b in self.control.blocks:
+            if j < b.size:
+                return f"{b.name}[{j}]"
+            j -= b.size
+        return "work: " + ("input", "output", "dissipated", "clamping")[j]
 
     @cached_property
     def output_specs(self) -> tuple[OutputSpec, ...]:
