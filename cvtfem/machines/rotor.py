@@ -54,6 +54,9 @@ class RotorModel(ModelBase):
         Spin speed of the time-domain model (:meth:`rhs`); modal analyses take theirs from the caller.
     seats : tuple of int (n_disks,)
         Shaft node each disk sits on (its own node when elastically connected is ``disks.nodes``).
+    extra_kinds : tuple of int
+        Node DOF kind of each DOF after the nodes' (the modal coordinates of flexible sheaves,
+        :func:`cvtfem.machines.sheave.flexible_sheaves`).
     """
 
     M: sp.csr_matrix
@@ -67,6 +70,7 @@ class RotorModel(ModelBase):
     profiles: tuple = ()
     speed: float = 0.0
     seats: tuple = ()
+    extra_kinds: tuple = ()
 
     @property
     def n_dof(self) -> int:
@@ -161,8 +165,13 @@ class RotorModel(ModelBase):
 
     @property
     def dof_kind(self) -> np.ndarray:
-        """Index into :data:`DOF_NAMES` of every DOF."""
-        return np.tile(np.arange(6), self.n_dof // 6)
+        """Index into :data:`DOF_NAMES` of every DOF (flexible sheaves' modal coordinates: the kind they move)."""
+        return np.concatenate([np.tile(np.arange(6), self.n_node_dofs // 6), np.array(self.extra_kinds, int)])
+
+    @property
+    def n_node_dofs(self) -> int:
+        """DOFs of the nodes (6 each), before the flexible sheaves' modal coordinates."""
+        return self.n_dof - len(self.extra_kinds)
 
 
 def _shaft_arrays(scene: Scene) -> dict[str, np.ndarray]:
@@ -258,8 +267,18 @@ def build_model(scene: Scene) -> RotorModel:
         conn = connection_stiffness(*(np.array([d[k] for d in ds]) for k in ("c_u", "c_theta", "c_3", "c_phi")))
         shaft_nodes = np.array([d.node for d in ds], dtype=np.int64)
         conn_dofs = np.concatenate([shaft_nodes[:, None] * 6 + np.arange(6), disks.dofs[elastic]], axis=1)
-    M = assemble(n, [(beam.mass(), beam.dofs), (disks.mass(), disks.dofs), (bearings.mass(), bearings.dofs)])
-    K = assemble(n, [(Kshaft, beam.dofs), (bearings.stiffness(), bearings.dofs), (conn, conn_dofs)])
+    rigid = np.ones(len(scene.disk), bool)
+    flexible = None
+    if scene.sheave is not None and scene.sheave.flexibility != "rigid":
+        from cvtfem.machines.sheave import flexible_sheaves
+
+        flexible = flexible_sheaves(scene, disk_nodes, n)
+        rigid[list(flexible.disks)] = False
+        n += len(flexible.kinds)
+    M = assemble(n, [(beam.mass(), beam.dofs), (disks.mass()[rigid], disks.dofs[rigid]),
+                     (bearings.mass(), bearings.dofs), *(flexible.mass if flexible else ())])
+    K = assemble(n, [(Kshaft, beam.dofs), (bearings.stiffness(), bearings.dofs), (conn, conn_dofs),
+                     *(flexible.stiffness if flexible else ())])
     beta = opts.damping_beta if opts else 0.0
     C = assemble(n, [(bearings.damping(), bearings.dofs), (beta * Kshaft, beam.dofs)])
     G = assemble(n, [(beam.gyroscopic(), beam.dofs), (disks.gyroscopic(), disks.dofs),
@@ -267,7 +286,7 @@ def build_model(scene: Scene) -> RotorModel:
     z = np.concatenate([[0.0], np.cumsum(arrays["L"]), np.zeros(len(elastic))])
     z[n_shaft:] = z[[scene.disk[i].node for i in elastic]]
     return RotorModel(M, K, C, G, z, beam, disks, bearings, profiles, opts.speed if opts else 0.0,
-                      tuple(d.node for d in scene.disk))
+                      tuple(d.node for d in scene.disk), tuple(flexible.kinds) if flexible else ())
 
 
 def layout(scene: Scene) -> tuple[Layout, ...]:
