@@ -53,8 +53,18 @@ def run(args: argparse.Namespace) -> int:
     for i in range(len(modes.wd)):
         print(f"  {i:>3} {modes.wn[i]:>12.6g} {modes.wd[i]:>12.6g} {modes.wd[i] / (2 * np.pi):>10.5g} "
               f"{modes.damping_ratio[i]:>10.3g} {modes.log_dec[i]:>10.3g}  {modes.whirl[i]}")
+    from cvtfem.commands.sheave import own_waves
+
+    waves = own_waves(scene, np.array([speed]))
+    for label, hz in waves:
+        print(f"  {label:<24} {hz[0]:>10.5g} Hz  (the sheave's own wave: not coupled with the shaft)")
     if args.json:
+        if model.extra_kinds:                 # shapes per node: the sheaves' modal coordinates are left out
+            from dataclasses import replace
+
+            modes = replace(modes, shapes=modes.shapes[:model.n_node_dofs])
         with open(args.json, "w") as fh:
-            json.dump({"scene": scene.source, "backend": problem.method, **modes.to_dict(shapes=args.shapes)}, fh, indent=1)
+            json.dump({"scene": scene.source, "backend": problem.method, **modes.to_dict(shapes=args.shapes),
+                       "sheave_waves": [{"label": lab, "hz": float(hz[0])} for lab, hz in waves]}, fh, indent=1)
         print(f"wrote {args.json}")
     return 0

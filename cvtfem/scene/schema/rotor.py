@@ -55,6 +55,8 @@ SHEAVE = Table("sheave", "Sheave disks (`[[disk]]` with geometry = 'sheave') as 
         "-", 6, ge=1, le=200),
     Key("cells_radial", "int", "Section mesh: quadratic-triangle columns from bore to rim.", "-", 24, ge=4, le=400),
     Key("cells_axial", "int", "Section mesh: layers from the back face to the contact face.", "-", 2, ge=1, le=40),
+    Key("diameters", "int", "The sheaves' own waves of n = 2..diameters nodal diameters drawn by `cvtfem campbell` "
+        "(forward and backward; they do not couple with the shaft).", "-", 4, ge=1, le=40),
 ), optional=True)
 
 DISK = TableArray("disk", "Rigid disks / sheaves on shaft nodes.", Table("disk", "A rigid disk or sheave.", (
