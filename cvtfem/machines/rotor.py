@@ -300,6 +300,14 @@ def layout(scene: Scene) -> tuple[Layout, ...]:
         extra = sum(d.connection == "elastic" for d in scene.disk)
         parts.append(Layout("disks", "rigid-disk", 6 * extra,
                             note=f"{len(scene.disk)} disks on shaft nodes, {extra} elastically connected"))
+    flexibility = scene.sheave.flexibility if scene.sheave is not None else "rigid"
+    if flexibility != "rigid":
+        count = sum(d.geometry == "sheave" for d in scene.disk)
+        size = 4 * scene.sheave.modes * count if flexibility == "reduced" else None
+        parts.append(Layout("sheaves", f"craig-bampton-sheave ({flexibility})",
+                            size if size is not None else build_model(scene).n_dof - 6 * nodes - 6 * sum(
+                                d.connection == "elastic" for d in scene.disk),
+                            note=f"{count} sheaves: modal coordinates of n = 0 (axial, torsion) and n = 1 (x, y)"))
     if scene.bearing:
         parts.append(Layout("bearings", "bearing", 0, outputs=bearings,
                             note=f"{len(scene.bearing)} bearings on shaft nodes"))

@@ -47,7 +47,7 @@ ROTOR = Table("rotor", "Rotor model options (beam theory, switches, damping, ana
 ), optional=True)
 
 SHEAVE = Table("sheave", "Sheave disks (`[[disk]]` with geometry = 'sheave') as rigid bodies or flexible solids.", (
-    Key("flexibility", "str", "rigid: the disk's mass properties only (no sheave FE code runs); reduced: a "
+    Key("flexibility", "str", "Rigid: the disk's mass properties only (no sheave FE code runs); reduced: a "
         "solid model per nodal-diameter harmonic n = 0, 1 on the shaft node, Craig-Bampton reduced; full: the "
         "same with every fixed-interface mode (the reference of reduced).", "", "rigid",
         choices=("rigid", "reduced", "full")),
