@@ -37,7 +37,7 @@ for name, flexibility, modes, cells in CASES:
           f"{solve * 1e3:7.1f} ms, rhs {rhs:8.1f} us")
 band = results["full"] < 10e3
 for name in results:
-    if name not in ("rigid", "full") and results[name].shape == results["full"].shape:
+    if name not in ("rigid", "full") and "24x2" not in name:          # the same 12 x 2 section mesh as "full"
         gap = np.abs(results[name][band] / results["full"][band] - 1).max()
         print(f"{name:>16}: Campbell (13 speeds, 0..12000 rpm, modes below 10 kHz) against full: {gap:.2e}")
 scene = load_scene("cvt_sheave_shaft")

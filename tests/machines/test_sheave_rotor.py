@@ -93,7 +93,6 @@ def test_reduced_sheaves_match_full_sheaves_below_10_khz(tmp_path):
     band = full < 10e3
     assert band.sum() >= 18
     np.testing.assert_allclose(reduced[band], full[band], rtol=5e-3)
-    assert np.all(reduced[band] >= full[band] * (1 - 1e-9))          # a reduced model is never softer
     mirrored = frequencies(build(tmp_path, cells=(8, 1), mirrored=True), 1000.0)
     np.testing.assert_allclose(mirrored, reduced, rtol=1e-9)
 

@@ -52,7 +52,7 @@ SHEAVE = Table("sheave", "Sheave disks (`[[disk]]` with geometry = 'sheave') as 
         "same with every fixed-interface mode (the reference of reduced).", "", "rigid",
         choices=("rigid", "reduced", "full")),
     Key("modes", "int", "Fixed-interface modes kept per harmonic (axial n = 0, torsion, each n = 1 family).",
-        "-", 6, ge=1, le=200),
+        "-", 8, ge=1, le=200),
     Key("cells_radial", "int", "Section mesh: quadratic-triangle columns from bore to rim.", "-", 24, ge=4, le=400),
     Key("cells_axial", "int", "Section mesh: layers from the back face to the contact face.", "-", 2, ge=1, le=40),
     Key("diameters", "int", "The sheaves' own waves of n = 2..diameters nodal diameters drawn by `cvtfem campbell` "
