@@ -47,3 +47,15 @@ for i in sheave_indices(scene):
     total += -model.rim_mean(u)
     print(f"disk {i}: the rim moves back {-model.rim_mean(u) * 1e6:.1f} um under {CLAMPING / 1e3:.0f} kN (bore clamped)")
 print(f"the wedge opens by {total * 1e6:.1f} um at the rim, both sheaves")
+
+# the extra right-hand-side cost of the default reduced sheaves (8 modes), rigid and reduced calls interleaved
+pair = {f: build_model(load_scene("cvt_sheave_shaft", {"sheave": {"flexibility": f, "cells_radial": 12}}))
+        for f in ("rigid", "reduced")}
+states = {f: np.random.default_rng(1).standard_normal(2 * m.n_dof) * 1e-6 for f, m in pair.items()}
+times = {f: [] for f in pair}
+for _ in range(7):
+    for f, m in pair.items():
+        times[f].append(median_us(lambda: m.rhs(0.0, states[f]), 2000, warm_up=True))
+rigid_us, reduced_us = np.median(times["rigid"]), np.median(times["reduced"])
+print(f"rhs: rigid {rigid_us:.1f} us ({pair['rigid'].n_dof} DOF), reduced (8 modes) {reduced_us:.1f} us "
+      f"({pair['reduced'].n_dof} DOF): {100 * (reduced_us / rigid_us - 1):+.0f} %")
