@@ -168,6 +168,21 @@ class RotorModel(ModelBase):
         """Index into :data:`DOF_NAMES` of every DOF (flexible sheaves' modal coordinates: the kind they move)."""
         return np.concatenate([np.tile(np.arange(6), self.n_node_dofs // 6), np.array(self.extra_kinds, int)])
 
+    def sheave_share(self, shapes: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Per mode shape (columns): the share of its strain energy ``x^H K x`` in the flexible sheaves (their
+        fixed-interface modes ``q``: ``q^H K_qq q``, an exact split because Craig–Bampton leaves no stiffness
+        between them and the nodes), and the nodal-diameter number (0 or 1) of the sheave mode storing most;
+        ``(0, -1)`` for rotors without flexible sheaves."""
+        k = shapes.shape[1]
+        if not self.extra_kinds:
+            return np.zeros(k), np.full(k, -1)
+        q = shapes[self.n_node_dofs:]
+        Kqq = self.K[self.n_node_dofs:, self.n_node_dofs:]
+        energy = np.real(q.conj() * (Kqq @ q))
+        share = energy.sum(axis=0) / np.real(np.sum(shapes.conj() * (self.K @ shapes), axis=0))
+        kinds = np.array(self.extra_kinds)
+        return share, np.where(np.isin(kinds[np.argmax(energy, axis=0)], (2, 5)), 0, 1)
+
     @property
     def n_node_dofs(self) -> int:
         """DOFs of the nodes (6 each), before the flexible sheaves' modal coordinates."""

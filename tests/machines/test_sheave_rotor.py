@@ -122,6 +122,23 @@ def test_a_stiff_sheave_tends_to_the_rigid_sheave(tmp_path):
     assert abs(slope + 1) < 0.15 and gaps[1] < 0.015, (gaps, slope)
 
 
+def test_strain_energy_share_of_the_sheaves(tmp_path):
+    """`RotorModel.sheave_share`: Craig–Bampton leaves no stiffness between the nodes and the sheave modes, so
+    the sheave's part of ``x^H K x`` is a clean split in [0, 1]; the sheave-rocking modes (n = 1) are found among
+    the modes, and a sheave 48 times as stiff as steel stores less than 1 % in the 8 lowest modes (up to 2.3 kHz)."""
+    from cvtfem.modal import ModalProblem
+
+    for E, low, high in ((2.1e11, 0.0, 1.0), (1e13, 0.0, 0.01)):
+        m = build(tmp_path, E_sheave=E)
+        modes = ModalProblem(m.M, m.K, m.C, m.G, m.dof_kind).solve(1000.0, 8 if E > 1e12 else 30)
+        share, diameters = m.sheave_share(modes.shapes)
+        assert np.all((share >= low - 1e-12) & (share <= high + 1e-12)), share
+        if E < 1e12:
+            assert np.any((share > 0.5) & (diameters == 1)) and np.any((share > 0.5) & (diameters == 0))
+    rigid = build(tmp_path, flexibility="rigid")
+    assert np.all(rigid.sheave_share(np.ones((rigid.n_dof, 3)))[0] == 0.0)
+
+
 def test_rigid_sheaves_run_no_sheave_code():
     """``flexibility = "rigid"`` (the default) builds the rotor without importing the solid sheave modules."""
     code = ("import sys; from cvtfem.machines.rotor import build_model; from cvtfem.scene.loader import load_scene;"
