@@ -296,8 +296,8 @@ def build_model(scene: Scene) -> RotorModel:
                      *(flexible.stiffness if flexible else ())])
     beta = opts.damping_beta if opts else 0.0
     C = assemble(n, [(bearings.damping(), bearings.dofs), (beta * Kshaft, beam.dofs)])
-    G = assemble(n, [(beam.gyroscopic(), beam.dofs), (disks.gyroscopic(), disks.dofs),
-                     (bearings.gyroscopic(), bearings.dofs)])
+    G = assemble(n, [(beam.gyroscopic(), beam.dofs), (disks.gyroscopic()[rigid], disks.dofs[rigid]),
+                     (bearings.gyroscopic(), bearings.dofs), *(flexible.gyroscopic if flexible else ())])
     z = np.concatenate([[0.0], np.cumsum(arrays["L"]), np.zeros(len(elastic))])
     z[n_shaft:] = z[[scene.disk[i].node for i in elastic]]
     return RotorModel(M, K, C, G, z, beam, disks, bearings, profiles, opts.speed if opts else 0.0,

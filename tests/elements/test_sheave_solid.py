@@ -264,3 +264,34 @@ def test_solid_reference_with_coriolis_matches_harmonic_travelling_waves():
             assert f3[pick][s3[pick] == sense][0] == pytest.approx(fh[sh == sense][0], rel=0.015)
         split3 = f3[pick][s3[pick] < 0][0] - f3[pick][s3[pick] > 0][0]
         assert split3 == pytest.approx(fh[sh < 0][0] - fh[sh > 0][0], rel=0.05)
+
+
+@pytest.mark.parametrize("n", (1, 2))
+def test_fixed_frame_form_of_the_spinning_disc_sees_the_waves_shifted_by_n_omega(n, axisymmetric_plate):
+    """The fixed-frame equation the rotor uses for flexible sheaves: amplitudes turned by ``n Omega t`` between
+    the families obey ``M y'' + Omega (G_c - 2 n M J) y' + (K_t - n Omega^2 (n M + G_c J)) y = 0`` with
+    ``J = [[0, -P], [P, 0]]`` (``P`` flips ``U_theta``).  Solved directly (bore clamped, 600 rad/s), its
+    frequencies are the rotating-frame waves of :meth:`travelling_modes` shifted by ``+- n Omega / 2 pi``,
+    forward up and backward down, to 1e-7."""
+    from cvtfem.elements.sheave_solid import _gyroscopic_modes
+    import scipy.sparse as sp
+
+    omega = 600.0
+    m0 = axisymmetric_plate
+    prestress = m0.stress(m0.centrifugal_displacement(omega))
+    cos, sin = HarmonicSheave(PLATE, n, "cos", 60, 2), HarmonicSheave(PLATE, n, "sin", 60, 2)
+    free = cos.free_dofs()
+    assert np.array_equal(free, sin.free_dofs())
+    P = np.ones(cos.basis.N)
+    P[cos.basis.split_indices()[1]] = -1.0
+    P = sp.diags(P)
+    B = cos.coriolis
+    Kt = [m.matrices[0] + m.geometric_stiffness(prestress) - omega ** 2 * m.spin_softening for m in (cos, sin)]
+    M1, M2 = cos.matrices[1], sin.matrices[1]
+    K = sp.block_diag([Kt[0] - n * omega ** 2 * (n * M1 + B @ P), Kt[1] - n * omega ** 2 * (n * M2 - B @ P)])
+    G = sp.bmat([[None, B + 2 * n * M1 @ P], [B - 2 * n * P @ M1, None]])
+    both = np.concatenate([free, cos.basis.N + free])
+    fixed, _ = _gyroscopic_modes(K.tocsr()[both][:, both], sp.block_diag([M1, M2]).tocsr()[both][:, both],
+                                 omega * G.tocsr()[both][:, both], 1)
+    f, sense = cos.travelling_modes(omega, prestress, 1)
+    np.testing.assert_allclose(np.sort(fixed), np.sort(f + sense * n * omega / (2 * np.pi)), rtol=1e-7)
