@@ -169,3 +169,28 @@ def test_flexible_sheaves_need_a_sheave_disk():
 
     with pytest.raises(InputError, match="sheave.flexibility"):
         load_scene("friswell_5_9_1", {"sheave": {"flexibility": "reduced"}})
+
+
+def test_reduced_fixed_frame_sheave_on_a_clamped_bore_sees_its_waves_shifted_by_omega():
+    """The projected gyroscopic matrix on the sheave's own n = 1 modes (``C = Phi^T B P Phi + 2 M_r``), bore
+    held: the two lowest fixed-frame frequencies at 6000 rpm are the Coriolis-coupled rotating-frame waves of
+    the unreduced model shifted by ``-+ Omega / 2 pi`` to 1e-3; the ``Omega^2`` stiffness left out moves them by
+    ``(n^2 - lambda) Omega^2 / 2 w`` (observed 1.7e-4)."""
+    from cvtfem.elements.sheave_solid import HarmonicSheave
+    from cvtfem.machines.sheave import reduced_harmonics, sheave_section
+    from cvtfem.scene.loader import load_scene
+
+    section = sheave_section(load_scene("cvt_sheave_shaft"), 0)
+    reduced, gyro = reduced_harmonics(section, 8, (12, 2), 0.0)
+    red, omega = reduced[(1, "cos")], 6000 * np.pi / 30
+    m = red.M.shape[0]
+    own = np.r_[2:m, m + 2:2 * m]                               # the modes of the cos model and of its twin
+    M, K = (np.kron(np.eye(2), X)[np.ix_(own, own)] for X in (red.M, red.K))
+    n = len(own)
+    A = np.block([[np.zeros((n, n)), np.eye(n)], [-np.linalg.solve(M, K), -np.linalg.solve(M, omega * gyro[1][np.ix_(own, own)])]])
+    lam = np.linalg.eigvals(A)
+    fixed = np.sort(lam.imag[lam.imag > 0])[:2] / (2 * np.pi)
+    axisym = HarmonicSheave(section, 0, "cos", 12, 2)
+    f, sense = HarmonicSheave(section, 1, "cos", 12, 2).travelling_modes(
+        omega, axisym.stress(axisym.centrifugal_displacement(omega)), 1)
+    np.testing.assert_allclose(fixed, np.sort(f + sense * omega / (2 * np.pi)), rtol=1e-3)
