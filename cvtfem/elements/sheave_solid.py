@@ -297,7 +297,7 @@ class HarmonicSheave:
     def spinning_modes(self, omega: float, prestress, count: int = 6) -> tuple[np.ndarray, np.ndarray]:
         """Natural frequencies (Hz, in the rotating frame) and shapes of the disc spinning at ``omega`` (rad/s),
         bore clamped: ``K + K_sigma - omega^2 M_c`` with ``prestress`` the stress at ``omega`` (:meth:`stress`).
-        Coriolis coupling of the two families is left out (it acts on in-plane motion only)."""
+        Without the Coriolis coupling of the two families (:meth:`travelling_modes` has it)."""
         K, M = self.matrices
         Kt = K + self.geometric_stiffness(prestress) - omega ** 2 * self.spin_softening
         return _lowest_modes(Kt.tocsr(), M, self.free_dofs(), count, True)
