@@ -38,6 +38,30 @@ def _orders(args: argparse.Namespace) -> tuple[tuple[str, float], ...]:
     return lines
 
 
+def _sheave_waves(scene, speeds, orders):  # noqa: ANN001, ANN202
+    """Flexible sheaves' own waves (n >= 2) as Campbell lines, printed with their order crossings."""
+    import numpy as np
+
+    from cvtfem.commands.sheave import own_waves
+
+    out = own_waves(scene, speeds)
+    if out:
+        print("sheaves' own waves (bore on the shaft, not coupled with it), fixed frame:")
+    for label, hz in out:
+        cross = [f"{name} at {s * 30 / np.pi:.5g} rpm" for name, k in orders
+                 for s in _roots(speeds, hz - k * speeds / (2 * np.pi))]
+        print(f"  {label:<20} {hz[0]:9.1f} .. {hz[-1]:9.1f} Hz  {', '.join(cross)}")
+    return out
+
+
+def _roots(x, y):  # noqa: ANN001, ANN202
+    """Where the piecewise-linear ``y(x)`` changes sign."""
+    import numpy as np
+
+    i = np.flatnonzero(np.sign(y[:-1]) * np.sign(y[1:]) < 0)
+    return x[i] - y[i] * (x[i + 1] - x[i]) / (y[i + 1] - y[i])
+
+
 def run(args: argparse.Namespace) -> int:
     import json
 
@@ -66,9 +90,11 @@ def run(args: argparse.Namespace) -> int:
     for jump in result.jumps:
         print(f"  warning: tracked mode {jump['mode']} changed identity at {jump['speed_rad_s']:.4g} rad/s "
               f"(MAC {jump['mac']:.2f} with the previous speed): refine the speeds there")
+    waves = _sheave_waves(scene, speeds, result.orders)
     if args.json:
         with open(args.json, "w") as fh:
-            json.dump({"scene": scene.source, "backend": problem.method, **result.to_dict()}, fh)
+            json.dump({"scene": scene.source, "backend": problem.method, **result.to_dict(),
+                       "sheave_waves": [{"label": lab, "hz": hz.tolist()} for lab, hz in waves]}, fh)
         print(f"wrote {args.json}")
     if args.csv:
         result.write_csv(args.csv)
@@ -76,6 +102,6 @@ def run(args: argparse.Namespace) -> int:
     if args.png:
         from cvtfem.post.campbell import plot_campbell
 
-        plot_campbell(result, args.png, title=scene.title or scene.source, fmax=args.fmax)
+        plot_campbell(result, args.png, title=scene.title or scene.source, fmax=args.fmax, lines=waves)
         print(f"wrote {args.png}")
     return 0

@@ -1,5 +1,6 @@
 """``cvtfem sheave SCENE [--disk I] [--diameters N] [--modes K] [--speed S] [--load F] [--json OUT] [--png OUT]``:
-modes of a rotor scene's sheave as a solid body, per nodal diameter, and the wedge opening under a ring load."""
+modes of a rotor scene's sheave as a solid body, per nodal diameter (spinning: forward and backward travelling
+waves, Coriolis-coupled), and the wedge opening under a ring load."""
 from __future__ import annotations
 
 import argparse
@@ -34,6 +35,21 @@ def _pair(text: str, where: str, low: tuple[int, int], high: tuple[int, int]) ->
     return a, b
 
 
+def own_waves(scene, speeds):  # noqa: ANN001, ANN201 - Scene, array -> list of (label, array)
+    """Fixed-frame Hz over ``speeds`` (rad/s) of the own waves (n = 2..[sheave].diameters) of each flexible
+    sheave of a rotor scene, labelled ``"disk I sheave n=2 fw"``; none when the sheaves are rigid."""
+    if scene.sheave is None or scene.sheave.flexibility == "rigid":
+        return []
+    from cvtfem.machines.sheave import sheave_indices, sheave_section
+    from cvtfem.modal.sheave import sheave_waves
+
+    opts, out = scene.sheave, []
+    for i in sheave_indices(scene):
+        lines = sheave_waves(sheave_section(scene, i), opts.diameters, speeds, (opts.cells_radial, opts.cells_axial))
+        out += [(f"disk {i} {label}", hz) for label, hz in lines]
+    return out
+
+
 def run(args: argparse.Namespace) -> int:
     import json
     from pathlib import Path
@@ -51,10 +67,9 @@ def run(args: argparse.Namespace) -> int:
     rows = sheave_spectrum(section, args.diameters, args.modes, speed, mesh)
     print(f"{scene.title or scene.source}: sheave of outer diameter {2e3 * section.outer_radius:.0f} mm, "
           f"bore clamped, {args.diameters + 1} nodal diameters at {speed:g} rad/s")
-    print(f"  {'n':>3} {'family':<7} {'k':>2} {'rotating Hz':>12} {'forward Hz':>11} {'backward Hz':>12}")
+    print(f"  {'n':>3} {'wave':<9} {'rotating Hz':>12} {'fixed-frame Hz':>15}")
     for r in rows:
-        print(f"  {r['n']:>3} {r['family']:<7} {r['k']:>2} {r['rotating_hz']:12.1f} {r['forward_hz']:11.1f} "
-              f"{r['backward_hz']:12.1f}")
+        print(f"  {r['n']:>3} {r['wave']:<9} {r['rotating_hz']:12.1f} {r['fixed_hz']:15.1f}")
     out = {"scene": scene.source, "speed_rad_s": speed, "modes": rows}
     if args.load is not None:
         model, u = wedge_opening(section, args.load, mesh)
@@ -69,7 +84,7 @@ def run(args: argparse.Namespace) -> int:
 
         family = "cos"
         model, shape, f = mode_shape(section, n_draw, family, k_draw, mesh)
-        print(f"wrote {render_sheave(model, shape, args.png, f'n = {n_draw}, mode {k_draw}: {f:.1f} Hz')}")
+        print(f"wrote {render_sheave(model, shape, args.png, f'n = {n_draw}, mode {k_draw} at rest: {f:.1f} Hz')}")
         if args.load is not None:
             png = Path(args.png)
             load_png = png.with_name(f"{png.stem}_load{png.suffix}")

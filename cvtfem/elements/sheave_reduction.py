@@ -14,6 +14,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+import scipy.linalg as sla
 import scipy.sparse.linalg as spla
 
 from cvtfem.elements.sheave_solid import HarmonicSheave
@@ -77,10 +78,11 @@ def ring_dofs(model: HarmonicSheave, radius: float) -> np.ndarray:
     return same[np.argsort(comp[same])]
 
 
-def craig_bampton(model: HarmonicSheave, n_modes: int, ring_radius: float | None = None,
+def craig_bampton(model: HarmonicSheave, n_modes: int | None, ring_radius: float | None = None,
                   tilt_centre: float = 0.0) -> ReducedSheave:
     """Reduce ``model`` to its rigid bore motions, the contact ring (if ``ring_radius``, m) and ``n_modes``
-    fixed-interface modes; tilts turn about the axis point ``z = tilt_centre`` (m, the shaft node)."""
+    fixed-interface modes (``None``: all of them, a change of coordinates of the unreduced model with a rigid
+    bore); tilts turn about the axis point ``z = tilt_centre`` (m, the shaft node)."""
     K, M = model.matrices
     keep = model.free_dofs(clamped=False)
     locs = model.basis.doflocs
@@ -103,7 +105,10 @@ def craig_bampton(model: HarmonicSheave, n_modes: int, ring_radius: float | None
     lu = spla.splu(Kii)
     static = -lu.solve(np.asarray((K[interior][:, boundary] @ T[boundary]), float)) if labels else \
         np.zeros((len(interior), 0))
-    if n_modes > 0:
+    if n_modes is None:                                   # every interior mode: the unreduced model, exactly
+        lam, phi = sla.eigh(Kii.toarray(), Mii.toarray())
+        n_modes = len(lam)
+    elif n_modes > 0:
         if n_modes >= len(interior):
             raise InputError("n_modes", n_modes, f"must be fewer than the {len(interior)} interior DOFs")
         try:

@@ -297,10 +297,62 @@ class HarmonicSheave:
     def spinning_modes(self, omega: float, prestress, count: int = 6) -> tuple[np.ndarray, np.ndarray]:
         """Natural frequencies (Hz, in the rotating frame) and shapes of the disc spinning at ``omega`` (rad/s),
         bore clamped: ``K + K_sigma - omega^2 M_c`` with ``prestress`` the stress at ``omega`` (:meth:`stress`).
-        Coriolis coupling of the two families is left out (it acts on in-plane motion only)."""
+        Without the Coriolis coupling of the two families (:meth:`travelling_modes` has it)."""
         K, M = self.matrices
         Kt = K + self.geometric_stiffness(prestress) - omega ** 2 * self.spin_softening
         return _lowest_modes(Kt.tocsr(), M, self.free_dofs(), count, True)
+
+    @cached_property
+    def coriolis(self) -> sp.csr_matrix:
+        """``B`` (kg): per unit spin the Coriolis force ``-2 rho Omega e_z x u'`` couples this family with its twin
+        (the other family of the same ``n``, on the same mesh); over ``[cos; sin]`` amplitudes the gyroscopic
+        matrix is ``G = [[0, B], [B, 0]]`` with ``B`` skew, from ``int 2 rho (u_r v_theta - u_theta v_r) dV``
+        (each product integrates to ``pi`` over a revolution, ``2 pi`` at ``n = 0``)."""
+        from skfem import BilinearForm, asm
+
+        rho = self.section.rho
+        weight = 2 * np.pi if self.n == 0 else np.pi
+
+        @BilinearForm
+        def form(u, v, w):  # noqa: ANN001, ANN202
+            return 2 * rho * weight * (u[0] * v[1] - u[1] * v[0]) * w.x[0]
+
+        return asm(form, self.basis).tocsr()
+
+    def travelling_modes(self, omega: float, prestress, count: int = 6) -> tuple[np.ndarray, np.ndarray]:
+        """Frequencies (Hz, rotating frame) and travelling sense of the ``2 count`` lowest waves of ``n`` diameters
+        spinning at ``omega`` (rad/s), bore clamped, with Coriolis coupling of the two families:
+        ``M q'' + omega G q' + (K + K_sigma - omega^2 M_c) q = 0`` over ``[cos; sin]`` amplitudes
+        (``prestress`` at ``omega``, :meth:`stress`).  Sense ``+1``: the wave runs with the spin relative to the
+        disc (a fixed observer sees ``f + n omega / 2 pi``), ``-1`` against it (``f - n omega / 2 pi``); ``0`` for
+        ``n = 0``, whose waves do not travel."""
+        if not omega > 0.0:
+            raise InputError("omega", omega, "must be a spin speed > 0 rad/s (at rest the waves stand)")
+        pair = (self, replace(self, family="sin" if self.family == "cos" else "cos"))
+        Ks, Ms, frees = [], [], []
+        for m in pair:
+            K, M = m.matrices
+            Ks.append(K + m.geometric_stiffness(prestress) - omega ** 2 * m.spin_softening)
+            Ms.append(M)
+            frees.append(m.free_dofs())
+        n_a = len(frees[0])
+        B = self.coriolis
+        Kf = sp.block_diag([Ks[0][frees[0]][:, frees[0]], Ks[1][frees[1]][:, frees[1]]], format="csc")
+        Mf = sp.block_diag([Ms[0][frees[0]][:, frees[0]], Ms[1][frees[1]][:, frees[1]]], format="csc")
+        Gf = sp.bmat([[None, B[frees[0]][:, frees[1]]], [B[frees[1]][:, frees[0]], None]], format="csc")
+        f, X = _gyroscopic_modes(Kf, Mf, omega * Gf, count)
+        if self.n == 0:
+            return f, np.zeros(len(f))
+        # the r and z amplitudes of both families: a cos n theta + b sin n theta runs forward when Im(conj a b) < 0
+        a_fam, b_fam = (0, 1) if self.family == "cos" else (1, 0)
+        comp = np.empty(self.basis.N, int)
+        for c, idx in enumerate(self.basis.split_indices()):
+            comp[idx] = c
+        rz = [np.isin(comp[frees[k]], (0, 2)) for k in (0, 1)]
+        slot = [np.flatnonzero(rz[0]), n_a + np.flatnonzero(rz[1])]
+        w = self.matrices[1].diagonal()[frees[0]][rz[0]]
+        a, b = X[slot[a_fam]], X[slot[b_fam]]
+        return f, -np.sign(np.sum(w[:, None] * np.imag(a.conj() * b), axis=0))
 
     def bore_dofs(self) -> np.ndarray:
         """All DOFs on the bore surface ``r = bore_radius`` (a sheave clamped to its shaft)."""
@@ -374,6 +426,29 @@ def _lowest_modes(K, M, free, count, definite):  # noqa: ANN001, ANN202
     shapes = np.zeros((K.shape[0], count))
     shapes[free] = vec[:, order]
     return np.sqrt(np.maximum(lam[order], 0.0)) / (2 * np.pi), shapes
+
+
+def _gyroscopic_modes(K, M, G, count):  # noqa: ANN001, ANN202
+    """The ``2 count`` lowest frequencies (Hz, ascending) and displacement shapes of ``M q'' + G q' + K q = 0``
+    (K definite, G skew): ARPACK on ``A^-1 B`` of the first-order form ``A = [[0, I], [-K, -G]]``,
+    ``B = diag(I, M)``, whose eigenvalues are ``1 / lambda``; applying it needs one LU of ``K``."""
+    n = K.shape[0]
+    k = min(4 * count, 2 * n - 2)
+    lu = spla.splu(K.tocsc())
+
+    def apply(y):  # noqa: ANN001, ANN202
+        y1, y2 = y[:n], y[n:]
+        return np.concatenate([-lu.solve(M @ y2 + G @ y1), y1])
+
+    op = spla.LinearOperator((2 * n, 2 * n), matvec=apply, dtype=float)
+    try:
+        mu, vec = spla.eigs(op, k=k, which="LM")
+    except (spla.ArpackNoConvergence, RuntimeError) as exc:
+        raise NumericalError(f"sheave travelling waves: ARPACK did not converge ({exc})") from None
+    lam = 1.0 / mu
+    up = lam.imag > 0
+    order = np.argsort(lam.imag[up])[:2 * count]
+    return lam.imag[up][order] / (2 * np.pi), vec[:n, up][:, order]
 
 
 def solid_mesh(section: SheaveSection, n_r: int = 12, n_z: int = 2, n_theta: int = 72):  # noqa: ANN201
@@ -472,3 +547,71 @@ class SolidSheave:
         K, M = self.matrices
         free = np.setdiff1d(np.arange(K.shape[0]), self.bore_dofs()) if clamped else np.arange(K.shape[0])
         return _lowest_modes(K, M, free, count, clamped)
+
+    def _free(self) -> np.ndarray:
+        K, _ = self.matrices
+        return np.setdiff1d(np.arange(K.shape[0]), self.bore_dofs())
+
+    def spin_matrices(self, omega: float) -> tuple[sp.csr_matrix, sp.csr_matrix]:
+        """Tangent stiffness ``K + K_sigma - omega^2 M_c`` (N/m) of the sheave spinning at ``omega`` (rad/s) about
+        ``z``, bore clamped (``K_sigma`` of the linear centrifugal prestress, ``M_c`` the centrifugal force of
+        motion in the x-y plane), and the gyroscopic matrix per unit spin ``G`` (kg) of the Coriolis force,
+        ``int 2 rho (u_x v_y - u_y v_x) dV``, all assembled by scikit-fem on the tetrahedra."""
+        from skfem import BilinearForm, LinearForm, asm
+
+        lam, mu = self.section.lame
+        rho = self.section.rho
+        K, _ = self.matrices
+        free = self._free()
+
+        @LinearForm
+        def body(v, w):  # noqa: ANN001, ANN202
+            return rho * omega ** 2 * (w.x[0] * v[0] + w.x[1] * v[1])
+
+        u0 = np.zeros(K.shape[0])
+        u0[free] = spla.spsolve(K[free][:, free].tocsc(), asm(body, self.basis)[free])
+
+        @BilinearForm
+        def geometric(u, v, w):  # noqa: ANN001, ANN202
+            g = w.u0.grad
+            eps = [[0.5 * (g[i][j] + g[j][i]) for j in range(3)] for i in range(3)]
+            tr = eps[0][0] + eps[1][1] + eps[2][2]
+            total = 0.0
+            for i in range(3):
+                for j in range(3):
+                    sigma = 2 * mu * eps[i][j] + (lam * tr if i == j else 0.0)
+                    total = total + sigma * sum(u.grad[k][i] * v.grad[k][j] for k in range(3))
+            return total
+
+        @BilinearForm
+        def softening(u, v, w):  # noqa: ANN001, ANN202
+            return rho * (u[0] * v[0] + u[1] * v[1])
+
+        @BilinearForm
+        def coriolis(u, v, w):  # noqa: ANN001, ANN202
+            return 2 * rho * (u[0] * v[1] - u[1] * v[0])
+
+        Kt = K + asm(geometric, self.basis, u0=self.basis.interpolate(u0)) - omega ** 2 * asm(softening, self.basis)
+        return Kt.tocsr(), asm(coriolis, self.basis).tocsr()
+
+    def travelling_modes(self, omega: float, count: int = 6) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The ``2 count`` lowest frequencies (Hz, rotating frame) of the sheave spinning at ``omega`` (rad/s) with
+        prestress, spin softening and Coriolis coupling, each with its nodal-diameter number (the largest
+        harmonic of ``u_z`` on the face nodes) and travelling sense (``+1`` with the spin, ``-1`` against it, ``0``
+        for ``n = 0``), as :meth:`HarmonicSheave.travelling_modes` gives them."""
+        Kt, G = self.spin_matrices(omega)
+        _, M = self.matrices
+        free = self._free()
+        f, X = _gyroscopic_modes(Kt[free][:, free], M[free][:, free].tocsc(), omega * G[free][:, free], count)
+        shapes = np.zeros((Kt.shape[0], X.shape[1]), complex)
+        shapes[free] = X
+        uz = self.basis.split_indices()[2]
+        x = self.basis.doflocs[:, uz]
+        theta = np.arctan2(x[1], x[0])
+        orders = np.arange(9)
+        a = np.cos(np.outer(orders, theta)) @ shapes[uz]          # (orders, modes) cos and sin contents
+        b = np.sin(np.outer(orders, theta)) @ shapes[uz]
+        n = np.argmax(np.abs(a) ** 2 + np.abs(b) ** 2, axis=0)
+        cols = np.arange(X.shape[1])
+        sense = np.where(n > 0, -np.sign(np.imag(a[n, cols].conj() * b[n, cols])), 0.0)
+        return f, n, sense

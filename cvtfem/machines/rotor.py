@@ -54,6 +54,9 @@ class RotorModel(ModelBase):
         Spin speed of the time-domain model (:meth:`rhs`); modal analyses take theirs from the caller.
     seats : tuple of int (n_disks,)
         Shaft node each disk sits on (its own node when elastically connected is ``disks.nodes``).
+    extra_kinds : tuple of int
+        Node DOF kind of each DOF after the nodes' (the modal coordinates of flexible sheaves,
+        :func:`cvtfem.machines.sheave.flexible_sheaves`).
     """
 
     M: sp.csr_matrix
@@ -67,6 +70,7 @@ class RotorModel(ModelBase):
     profiles: tuple = ()
     speed: float = 0.0
     seats: tuple = ()
+    extra_kinds: tuple = ()
 
     @property
     def n_dof(self) -> int:
@@ -161,8 +165,28 @@ class RotorModel(ModelBase):
 
     @property
     def dof_kind(self) -> np.ndarray:
-        """Index into :data:`DOF_NAMES` of every DOF."""
-        return np.tile(np.arange(6), self.n_dof // 6)
+        """Index into :data:`DOF_NAMES` of every DOF (flexible sheaves' modal coordinates: the kind they move)."""
+        return np.concatenate([np.tile(np.arange(6), self.n_node_dofs // 6), np.array(self.extra_kinds, int)])
+
+    def sheave_share(self, shapes: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Per mode shape (columns): the share of its strain energy ``x^H K x`` in the flexible sheaves (their
+        fixed-interface modes ``q``: ``q^H K_qq q``, an exact split because Craig–Bampton leaves no stiffness
+        between them and the nodes), and the nodal-diameter number (0 or 1) of the sheave mode storing most;
+        ``(0, -1)`` for rotors without flexible sheaves."""
+        k = shapes.shape[1]
+        if not self.extra_kinds:
+            return np.zeros(k), np.full(k, -1)
+        q = shapes[self.n_node_dofs:]
+        Kqq = self.K[self.n_node_dofs:, self.n_node_dofs:]
+        energy = np.real(q.conj() * (Kqq @ q))
+        share = energy.sum(axis=0) / np.real(np.sum(shapes.conj() * (self.K @ shapes), axis=0))
+        kinds = np.array(self.extra_kinds)
+        return share, np.where(np.isin(kinds[np.argmax(energy, axis=0)], (2, 5)), 0, 1)
+
+    @property
+    def n_node_dofs(self) -> int:
+        """DOFs of the nodes (6 each), before the flexible sheaves' modal coordinates."""
+        return self.n_dof - len(self.extra_kinds)
 
 
 def _shaft_arrays(scene: Scene) -> dict[str, np.ndarray]:
@@ -258,16 +282,26 @@ def build_model(scene: Scene) -> RotorModel:
         conn = connection_stiffness(*(np.array([d[k] for d in ds]) for k in ("c_u", "c_theta", "c_3", "c_phi")))
         shaft_nodes = np.array([d.node for d in ds], dtype=np.int64)
         conn_dofs = np.concatenate([shaft_nodes[:, None] * 6 + np.arange(6), disks.dofs[elastic]], axis=1)
-    M = assemble(n, [(beam.mass(), beam.dofs), (disks.mass(), disks.dofs), (bearings.mass(), bearings.dofs)])
-    K = assemble(n, [(Kshaft, beam.dofs), (bearings.stiffness(), bearings.dofs), (conn, conn_dofs)])
+    rigid = np.ones(len(scene.disk), bool)
+    flexible = None
+    if scene.sheave is not None and scene.sheave.flexibility != "rigid":
+        from cvtfem.machines.sheave import flexible_sheaves
+
+        flexible = flexible_sheaves(scene, disk_nodes, n)
+        rigid[list(flexible.disks)] = False
+        n += len(flexible.kinds)
+    M = assemble(n, [(beam.mass(), beam.dofs), (disks.mass()[rigid], disks.dofs[rigid]),
+                     (bearings.mass(), bearings.dofs), *(flexible.mass if flexible else ())])
+    K = assemble(n, [(Kshaft, beam.dofs), (bearings.stiffness(), bearings.dofs), (conn, conn_dofs),
+                     *(flexible.stiffness if flexible else ())])
     beta = opts.damping_beta if opts else 0.0
     C = assemble(n, [(bearings.damping(), bearings.dofs), (beta * Kshaft, beam.dofs)])
-    G = assemble(n, [(beam.gyroscopic(), beam.dofs), (disks.gyroscopic(), disks.dofs),
-                     (bearings.gyroscopic(), bearings.dofs)])
+    G = assemble(n, [(beam.gyroscopic(), beam.dofs), (disks.gyroscopic()[rigid], disks.dofs[rigid]),
+                     (bearings.gyroscopic(), bearings.dofs), *(flexible.gyroscopic if flexible else ())])
     z = np.concatenate([[0.0], np.cumsum(arrays["L"]), np.zeros(len(elastic))])
     z[n_shaft:] = z[[scene.disk[i].node for i in elastic]]
     return RotorModel(M, K, C, G, z, beam, disks, bearings, profiles, opts.speed if opts else 0.0,
-                      tuple(d.node for d in scene.disk))
+                      tuple(d.node for d in scene.disk), tuple(flexible.kinds) if flexible else ())
 
 
 def layout(scene: Scene) -> tuple[Layout, ...]:
@@ -281,6 +315,14 @@ def layout(scene: Scene) -> tuple[Layout, ...]:
         extra = sum(d.connection == "elastic" for d in scene.disk)
         parts.append(Layout("disks", "rigid-disk", 6 * extra,
                             note=f"{len(scene.disk)} disks on shaft nodes, {extra} elastically connected"))
+    flexibility = scene.sheave.flexibility if scene.sheave is not None else "rigid"
+    if flexibility != "rigid":
+        count = sum(d.geometry == "sheave" for d in scene.disk)
+        size = 4 * scene.sheave.modes * count if flexibility == "reduced" else None
+        parts.append(Layout("sheaves", f"craig-bampton-sheave ({flexibility})",
+                            size if size is not None else build_model(scene).n_dof - 6 * nodes - 6 * sum(
+                                d.connection == "elastic" for d in scene.disk),
+                            note=f"{count} sheaves: modal coordinates of n = 0 (axial, torsion) and n = 1 (x, y)"))
     if scene.bearing:
         parts.append(Layout("bearings", "bearing", 0, outputs=bearings,
                             note=f"{len(scene.bearing)} bearings on shaft nodes"))

@@ -6,7 +6,12 @@ follows from the material's ``E`` and ``G``.
 """
 from __future__ import annotations
 
-from cvtfem.elements.sheave_solid import SheaveSection
+from dataclasses import dataclass
+
+import numpy as np
+
+from cvtfem.elements.sheave_reduction import ReducedSheave, craig_bampton
+from cvtfem.elements.sheave_solid import HarmonicSheave, SheaveSection
 from cvtfem.errors import InputError
 from cvtfem.scene.loader import Scene
 
@@ -30,3 +35,118 @@ def sheave_section(scene: Scene, index: int | None = None) -> SheaveSection:
                          outer_radius=d.outer_diameter / 2, hub_length=d.hub_length, rim_thickness=d.rim_thickness,
                          flank_angle=d.cone_angle, face=d.face, torus_radius=d.torus_radius, E=mat.E,
                          nu=mat.E / (2 * mat.G) - 1.0, rho=mat.rho)
+
+
+#: Per harmonic of a flexible sheave: ``(n, family, node DOFs of the rigid interface, their signs for a sheave
+#: facing +z)``.  The second ``n = 1`` entry is the ``sin`` twin of
+#: the first, the ``cos`` model turned by 90 degrees about the axis (x -> y, a tilt about y -> one about -x):
+#: the same matrices, so it is not built again.  Node DOF kinds as in the rotor: u1 u2 u3 theta1 theta2 phi.
+HARMONICS = ((0, "cos", (2,), (1.0,)), (0, "sin", (5,), (1.0,)), (1, "cos", (0, 4), (1.0, 1.0)),
+             (1, "twin", (1, 3), (1.0, -1.0)))
+
+
+@dataclass(frozen=True)
+class FlexibleSheaves:
+    """Craig–Bampton sheaves for a rotor model: blocks to add to its M and K, over its node DOFs and the modal
+    coordinates appended after them.
+
+    Attributes
+    ----------
+    mass, stiffness, gyroscopic : list of (blocks (1, m, m), dofs (1, m))
+        Families for :func:`cvtfem.assembly.assemble` (kg, kg m, kg m^2; N/m, N m/rad; per unit spin speed;
+        modal coordinates of unit modal mass).
+    kinds : int array (n_extra,)
+        Node DOF kind (0..5) given to each modal coordinate: ``n = 1`` modes as u1 (``cos``) and u2 (the twin,
+        interleaved so that each pair is one orbit), ``n = 0`` modes as u3 (umbrella/axial) and phi (torsion).
+    disks : tuple of int
+        The ``[[disk]]`` indices made flexible.
+    """
+
+    mass: list
+    stiffness: list
+    gyroscopic: list
+    kinds: np.ndarray
+    disks: tuple[int, ...]
+
+
+def reduced_harmonics(section: SheaveSection, n_modes: int | None, cells: tuple[int, int],
+                      tilt_centre: float) -> tuple[dict[tuple[int, str], ReducedSheave], dict[int, np.ndarray]]:
+    """Craig–Bampton models of the harmonics ``n = 0`` (both families) and ``n = 1`` (``cos``) of ``section``,
+    bore rigid on the shaft node at ``z = tilt_centre`` (m, section coordinates); ``n_modes`` fixed-interface
+    modes each (``None``: all, the unreduced model); and per ``n`` the reduced fixed-frame gyroscopic matrix per
+    unit spin (kg, kg m, kg m^2) over ``[cos coordinates, sin (n = 0) or twin (n = 1) coordinates]``.
+
+    In the frame turning with the sheave, Coriolis forces couple the two families of ``n``
+    (:attr:`HarmonicSheave.coriolis`, ``G_c = [[0, B], [B, 0]]``).  A fixed observer's amplitudes are those
+    turned by ``n Omega t`` between the families, ``y = exp(n Omega t J) x`` with ``J = [[0, -P], [P, 0]]``
+    (``P`` flips ``U_theta``); the matrices of an axisymmetric body commute with ``J``, so the fixed-frame
+    equation is ``M y'' + Omega (G_c - 2 n M J) y' + (K_t - n Omega^2 (n M + G_c J)) y = 0``.  The gyroscopic
+    matrix ``G_c - 2 n M J`` is what this returns; the ``Omega^2`` stiffness (zero for rigid motions, the spin
+    stiffening of a few per mille for the sheave's own) is left out.  With the twin ``P Phi`` of the ``cos``
+    basis ``Phi`` and ``M_r = Phi^T M Phi`` the ``n = 1`` block is ``[[0, C], [-C^T, 0]]``,
+    ``C = Phi^T B P Phi + 2 M_r``; at ``n = 0`` it is the Coriolis coupling of axial/radial and torsional
+    motion."""
+    models = {key: HarmonicSheave(section, key[0], key[1], *cells) for key in ((0, "cos"), (0, "sin"), (1, "cos"))}
+    reduced = {key: craig_bampton(m, n_modes, tilt_centre=tilt_centre) for key, m in models.items()}
+    gyro = {}
+    for n, other in ((0, (0, "sin")), (1, (1, "cos"))):
+        model, Phi = models[(n, "cos")], reduced[(n, "cos")].basis
+        B = model.coriolis
+        if n == 0:
+            C = Phi.T @ (B @ reduced[other].basis)
+        else:
+            flip = np.ones(model.basis.N)
+            flip[model.basis.split_indices()[1]] = -1.0                 # P: the twin has U_theta turned over
+            C = Phi.T @ (B @ (flip[:, None] * Phi)) + 2 * n * reduced[(n, "cos")].M
+        a, b = C.shape
+        gyro[n] = np.block([[np.zeros((a, a)), C], [-C.T, np.zeros((b, b))]])
+    return reduced, gyro
+
+
+def flexible_sheaves(scene: Scene, nodes: np.ndarray, first_extra: int) -> FlexibleSheaves:
+    """The scene's sheave disks as Craig–Bampton bodies (``[sheave] flexibility = "reduced"``, or ``"full"``:
+    all fixed-interface modes), each attached to the node it sits on (``nodes[i]`` for disk ``i``: its shaft
+    node, or its own node when elastically connected) at its centre of mass, the modal coordinates numbered
+    from ``first_extra``.  The interface block is the sheave's rigid inertia, so the rotor drops the rigid
+    disk's mass and gyroscopic matrix for these disks: the fixed-frame gyroscopic matrix of the harmonics
+    (:func:`reduced_harmonics`) holds the rigid sheave's ``Ip`` and the spin of its own modes."""
+    from cvtfem.elements.disk import axisymmetric_properties, sheave_profile
+
+    opts = scene.sheave
+    n_modes = None if opts.flexibility == "full" else opts.modes
+    mass, stiffness, gyroscopic, kinds = [], [], [], []
+    nxt = first_extra
+    for i in sheave_indices(scene):
+        d = scene.disk[i]
+        section = sheave_section(scene, i)
+        zc = axisymmetric_properties(*sheave_profile(d.inner_diameter, d.outer_diameter, d.hub_diameter,
+                                                     d.hub_length, d.rim_thickness, d.cone_angle, d.face,
+                                                     d.torus_radius, n_arc=256), section.rho).zc
+        models, gyro = reduced_harmonics(section, n_modes, (opts.cells_radial, opts.cells_axial), zc)
+        facing = -1.0 if d.facing == "-z" else 1.0
+        n_axial, n_torsion, n_lateral = (models[key].M.shape[0] - r for key, r in
+                                         (((0, "cos"), 1), ((0, "sin"), 1), ((1, "cos"), 2)))
+        own_dofs = {"cos0": nxt + np.arange(n_axial), "sin0": nxt + n_axial + np.arange(n_torsion),
+                    # cos and twin coordinates interleaved: each pair is one orbit for the whirl sense
+                    "cos1": nxt + n_axial + n_torsion + 2 * np.arange(n_lateral)}
+        own_dofs["twin1"] = own_dofs["cos1"] + 1
+        pair_dofs, pair_signs = {0: [], 1: []}, {0: [], 1: []}
+        for n, family, node_dofs, signs in HARMONICS:
+            red = models[(n, "cos" if family == "twin" else family)]
+            own = own_dofs[f"{family}{n}"]
+            n_own = len(own)
+            # the z mirror of a -z-facing sheave turns its axial motion and its tilts (not x, y or the spin)
+            flip = np.array([facing if dof in (2, 3, 4) else 1.0 for dof in node_dofs]) * np.array(signs)
+            S = np.concatenate([flip, np.ones(n_own)])
+            dofs = np.concatenate([6 * nodes[i] + np.array(node_dofs), own])
+            mass.append(((S[:, None] * red.M * S)[None], dofs[None]))
+            stiffness.append(((S[:, None] * red.K * S)[None], dofs[None]))
+            pair_dofs[n].append(dofs)
+            pair_signs[n].append(S)
+        for n in (0, 1):
+            # the mirror keeps x, y and the spin's sense from x to y: only the signs S of the coordinates change
+            S = np.concatenate(pair_signs[n])
+            gyroscopic.append(((S[:, None] * gyro[n] * S)[None], np.concatenate(pair_dofs[n])[None]))
+        nxt += n_axial + n_torsion + 2 * n_lateral
+        kinds += [2] * n_axial + [5] * n_torsion + [0, 1] * n_lateral
+    return FlexibleSheaves(mass, stiffness, gyroscopic, np.array(kinds, dtype=np.int64), tuple(sheave_indices(scene)))

@@ -82,13 +82,15 @@ def _crossings(ax, result: Campbell, top: float) -> None:
             text.remove()
 
 
-def plot_campbell(result: Campbell, path: str | Path, title: str = "", fmax: float | None = None) -> Path:
+def plot_campbell(result: Campbell, path: str | Path, title: str = "", fmax: float | None = None,
+                  lines: tuple = ()) -> Path:
     """Tracked damped frequencies (Hz) over speed (rpm), excitation lines and critical speeds.
 
     Curves are coloured by whirl at each speed (forward red, backward blue dashed, torsional green,
     axial grey); crossings carry the marker of their mode's whirl (forward triangle up, backward down,
     torsional square, axial diamond) and an rpm label where it does not collide with another.  ``fmax``
     (Hz) limits the frequency axis.  A second panel shows the damping ratios when any is non-zero.
+    ``lines``: further ``(label, Hz per speed)`` curves (the sheaves' own waves), thin, labelled at their end.
 
     Returns
     -------
@@ -113,6 +115,13 @@ def plot_campbell(result: Campbell, path: str | Path, title: str = "", fmax: flo
     for kind, (color, ls, marker) in _STYLE.items():
         if np.any(result.whirl == kind):
             ax.plot([], [], color=color, ls=ls, marker=marker, mfc="none", label=kind)
+    shown = [(label, line) for label, line in lines if 0 < line[-1] < top]
+    at = spread(np.array([line[-1] for _, line in shown]), 0.025 * top, 0.0, top)
+    for label, line in lines:
+        ax.plot(rpm, line, color="tab:purple", ls="-." if label.endswith("bw") else ":", lw=1.1)
+    for (label, _), y in zip(shown, at):
+        ax.annotate(label, (rpm[-1], y), fontsize=7, color="tab:purple", ha="left", va="center",
+                    annotation_clip=False)
     ax.set_ylim(0, top)
     ax.set_xlim(rpm[0], rpm[-1])
     _order_labels(ax, result, rpm, top)

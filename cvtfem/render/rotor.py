@@ -132,7 +132,8 @@ def render_rotor(model: RotorModel, path: str | Path, size: tuple[int, int] = (1
 
 def mode_scale(model: RotorModel, shape: np.ndarray, fraction: float = 0.08) -> float:
     """Scale so that the largest lateral displacement is ``fraction`` of the shaft length."""
-    lateral = np.abs(shape[(model.dof_kind == 0) | (model.dof_kind == 1)])
+    kind = model.dof_kind[:model.n_node_dofs]                 # node DOFs only (not flexible sheaves' modes)
+    lateral = np.abs(shape[:model.n_node_dofs][(kind == 0) | (kind == 1)])
     return fraction * float(model.z.max()) / max(float(lateral.max()), 1e-300)
 
 

@@ -46,6 +46,19 @@ ROTOR = Table("rotor", "Rotor model options (beam theory, switches, damping, ana
     Key("n_modes", "int", "Default number of modes reported.", "-", 12, ge=1),
 ), optional=True)
 
+SHEAVE = Table("sheave", "Sheave disks (`[[disk]]` with geometry = 'sheave') as rigid bodies or flexible solids.", (
+    Key("flexibility", "str", "Rigid: the disk's mass properties only (no sheave FE code runs); reduced: a "
+        "solid model per nodal-diameter harmonic n = 0, 1 on the shaft node, Craig-Bampton reduced; full: the "
+        "same with every fixed-interface mode (the reference of reduced).", "", "rigid",
+        choices=("rigid", "reduced", "full")),
+    Key("modes", "int", "Fixed-interface modes kept per harmonic (axial n = 0, torsion, each n = 1 family).",
+        "-", 8, ge=1, le=200),
+    Key("cells_radial", "int", "Section mesh: quadratic-triangle columns from bore to rim.", "-", 24, ge=4, le=400),
+    Key("cells_axial", "int", "Section mesh: layers from the back face to the contact face.", "-", 2, ge=1, le=40),
+    Key("diameters", "int", "The sheaves' own waves of n = 2..diameters nodal diameters drawn by `cvtfem campbell` "
+        "(forward and backward; they do not couple with the shaft).", "-", 4, ge=1, le=40),
+), optional=True)
+
 DISK = TableArray("disk", "Rigid disks / sheaves on shaft nodes.", Table("disk", "A rigid disk or sheave.", (
     Key("node", "int", "Shaft node the disk sits on.", "-", ge=0),
     Key("mass", "float", "Mass (0: from `geometry`).", "kg", 0.0, ge=0.0),
@@ -149,9 +162,13 @@ def check_rotor(scene: Mapping[str, Any], path: str) -> None:
             if entry["node"] >= n_nodes:
                 raise InputError(f"{table}[{i}].node", entry["node"],
                                  f"must be a shaft node, 0..{n_nodes - 1}")
+    flexibility = (scene.get("sheave") or {}).get("flexibility", "rigid")
+    if flexibility != "rigid" and not any(d["geometry"] == "sheave" for d in scene["disk"]):
+        raise InputError("sheave.flexibility", flexibility, "needs a [[disk]] with geometry = 'sheave' "
+                         "(or flexibility = 'rigid')")
     if (scene["disk"] or scene["bearing"]) and not scene["shaft"]:
         raise InputError("shaft", [], "needs at least one entry when disks or bearings are given")
 
 
-ROOT_ITEMS = (ROTOR, MATERIAL, SHAFT, DISK, BEARING)
+ROOT_ITEMS = (ROTOR, MATERIAL, SHAFT, DISK, BEARING, SHEAVE)
 ROOT_CHECKS = (check_rotor,)
