@@ -171,6 +171,10 @@ def frf_direct(M, K, C, G, inputs, outputs: OutputMap, omegas, speed: float = 0.
 #: (1e-10 dropped directions that carried 1e-3 of a Friswell FRF: keep all but round-off).
 COLUMN_RTOL = 1e-8
 GRAM_RTOL = 1e-13
+#: Shift ``a = RIGID_SHIFT max(diag K) / max(diag M)`` of the static correction ``(K + a M)^{-1} F`` when K is singular
+#: (rigid-body modes in the excited blocks): the correction then carries the rigid-body response, which the
+#: eigen-solvers drop, with the elastic modes' part off by a relative ``a / w_j^2``.
+RIGID_SHIFT = 1e-12
 
 
 def _unit_columns(X: np.ndarray, M) -> np.ndarray:
@@ -195,15 +199,20 @@ class ModalBasis:
         to first order in w): the reduced model is exact at ``w = 0`` and keeps the quasi-static, damping and
         gyroscopic parts of the neglected modes (stiffness-proportional damping gives even far modes a
         response ``~ beta w`` out of phase, which ``K^{-1} F`` alone misses).
-    modes : {"complex", "rest"}
+    modes : {"complex", "rest", "sweep"}
         "complex": per speed, the right and the left complex modes of ``(M, K, C, speed G)`` (the left ones
         as right modes of the transposed matrices).  A Galerkin projection on a space holding both keeps
         each retained mode's eigenvalue and residue ``x y^H / (y^H (2 lam M + D) x)`` exactly: the modal
         FRF differs from the direct one only by the neglected modes.  "rest": the undamped modes of
         ``((K + K^T)/2, M)`` at rest, one eigen-solve for every speed (the classic pseudo-modal method;
-        exact for ``C = G = 0``, approximate when G or non-proportional C couple the modes).
+        exact for ``C = G = 0``, approximate when G or non-proportional C couple the modes).  "sweep": one
+        basis for every speed, spanning the right and left complex modes at ``basis_speeds`` (a global basis for
+        the speed range: exact at those speeds like "complex", close to it between them because the modes turn
+        smoothly with speed); two eigen-solves per basis speed instead of per speed.
     method : str
         Eigen backend of :class:`~cvtfem.modal.eigen.ModalProblem`.
+    basis_speeds : array, rad/s
+        Speeds whose modes span the "sweep" basis (e.g. the ends and the middle of the sweep).
 
     Attributes
     ----------
@@ -212,13 +221,17 @@ class ModalBasis:
     """
 
     def __init__(self, M, K, C, G, inputs, n_modes: int, residual: bool = True, modes: str = "complex",
-                 method: str = "auto") -> None:
+                 method: str = "auto", basis_speeds=()) -> None:
         M, K, C, G = _check(M, K, C, G)
         F = _inputs(inputs, M.shape[0])
         if n_modes < 1:
             raise InputError("n_modes", n_modes, "must be >= 1")
-        if modes not in ("complex", "rest"):
-            raise InputError("modes", modes, "must be 'complex' or 'rest'")
+        if modes not in ("complex", "rest", "sweep"):
+            raise InputError("modes", modes, "must be 'complex', 'rest' or 'sweep'")
+        self.basis_speeds = np.atleast_1d(np.asarray(basis_speeds, dtype=float))
+        if modes == "sweep" and (len(self.basis_speeds) < 1 or not np.all(np.isfinite(self.basis_speeds))):
+            raise InputError("basis_speeds", self.basis_speeds.tolist(), "must be one or more finite speeds (rad/s) "
+                             "for modes='sweep'")
         self.dofs = dofs = reached(M, K, C, G, F)
         self.mats = [X[dofs][:, dofs].tocsr() for X in (M, K, C, G)]
         self.F = F[dofs]
@@ -227,13 +240,19 @@ class ModalBasis:
         self.modes = "rest" if self.mats[2].nnz == 0 and self.mats[3].nnz == 0 else modes
         self.static = self._static() if residual else None
         self._reduced: dict[float, tuple] = {}
+        self._poles: tuple | None = None
 
     def _static(self) -> np.ndarray:
+        K, M = self.mats[1].tocsc(), self.mats[0].tocsc()
         try:
-            lu = spla.splu(self.mats[1].tocsc())
-        except RuntimeError as err:
-            raise NumericalError(f"stiffness singular in the excited blocks ({err}): no static correction "
-                                 "(use residual=False)", component="modal.forced") from None
+            lu = spla.splu(K)
+        except RuntimeError:  # free rigid-body motion (e.g. an unsupported spin): shift, K + a M
+            scale = float(np.max(np.abs(K.diagonal())) / np.max(np.abs(M.diagonal())))
+            try:
+                lu = spla.splu((K + RIGID_SHIFT * scale * M).tocsc())
+            except RuntimeError as err:
+                raise NumericalError(f"stiffness singular in the excited blocks even shifted ({err}): no static "
+                                     "correction (use residual=False)", component="modal.forced") from None
         X = np.hstack([lu.solve(self.F.real), lu.solve(self.F.imag)])
         return np.hstack([X] + [lu.solve(A @ X) for A in (self.mats[0], self.mats[2], self.mats[3]) if A.nnz])
 
@@ -249,12 +268,21 @@ class ModalBasis:
         left = ModalProblem(M.T, K.T, C.T, G.T, self.kind, self.method).solve(speed, self.n_modes)
         return [right.shapes, left.shapes], float(max(right.wn.max(), left.wn.max()))
 
+    def _sweep_shapes(self) -> tuple[list[np.ndarray], float]:
+        """Right and left complex modes at every basis speed, and the lowest of their highest |lambda|."""
+        shapes, tops = [], []
+        for s in self.basis_speeds:
+            group, top = self._shapes(float(s))
+            shapes += group
+            tops.append(top)
+        return shapes, min(tops)
+
     def reduced(self, speed: float) -> tuple[np.ndarray, ...]:
         """``(V, K_r, D_r, F_r, wmax)`` at ``speed``: M-orthonormal basis V (dofs x r), reduced stiffness and
         damping ``V^T (C + speed G) V``, forces; wmax (rad/s) is the highest retained natural frequency."""
-        key = 0.0 if self.modes == "rest" else float(speed)
+        key = float(speed) if self.modes == "complex" else 0.0
         if key not in self._reduced:
-            shapes, wmax = self._shapes(key)
+            shapes, wmax = self._sweep_shapes() if self.modes == "sweep" else self._shapes(key)
             M, K, C, G = self.mats
             groups = [np.hstack([X.real, X.imag]) for X in shapes]
             if self.static is not None:
@@ -272,10 +300,12 @@ class ModalBasis:
         """Highest natural frequency in the basis at ``speed``, rad/s (modal FRFs are meant below it)."""
         return self.reduced(speed)[4]
 
-    def frf(self, outputs: OutputMap, omegas, speed: float = 0.0) -> np.ndarray:
-        """Receptances (w, p, m) by summing the complex modes of the reduced state-space matrix
-        ``A = [[0, I], [-K_r, -D_r]] = Phi diag(lam) Phi^{-1}`` (see :func:`frf_direct`)."""
-        w = _omegas(omegas)
+    def poles(self, speed: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``(lam, X, L)`` at ``speed``: the reduced state-space matrix ``A = [[0, I], [-K_r, -D_r]] =
+        Phi diag(lam) Phi^{-1}``, the modes' displacement shapes ``X = V Phi_q`` (dofs x 2r) and their
+        participations ``L = Phi^{-1} [0; F_r]`` (2r x m).  The last speed's are kept."""
+        if self._poles is not None and self._poles[0] == speed:
+            return self._poles[1]
         V, Kr, Dr, Fr, _ = self.reduced(speed)
         r = V.shape[1]
         A = np.zeros((2 * r, 2 * r))
@@ -287,17 +317,28 @@ class ModalBasis:
         except sla.LinAlgError:
             raise NumericalError(f"reduced state matrix defective at speed {speed:g} rad/s",
                                  component="modal.forced") from None
-        X = V @ Phi[:r]  # (dofs, 2r)
-        Dq, Vq = outputs.D[:, self.dofs] @ X, outputs.V[:, self.dofs] @ X
-        g = 1.0 / (1j * w[:, None] - lam[None, :])  # (w, 2r)
-        return (np.einsum("pk,wk,km->wpm", Dq, g, L)
-                + 1j * w[:, None, None] * np.einsum("pk,wk,km->wpm", Vq, g, L))
+        self._poles = (speed, (lam, V @ Phi[:r], L))
+        return self._poles[1]
+
+    def frf(self, outputs: OutputMap, omegas, speed: float = 0.0, columns=None) -> np.ndarray:
+        """Receptances (w, p, m) by summing the complex modes of the reduced state-space matrix (:meth:`poles`):
+        ``H(w) = (D + i w V) X (i w - lam)^{-1} L``; ``columns`` selects inputs (default all)."""
+        w = _omegas(omegas)
+        lam, X, L = self.poles(speed)
+        if columns is not None:
+            L = L[:, columns]
+        Dq, Vq = outputs.D[:, self.dofs] @ X, outputs.V[:, self.dofs] @ X  # (p, 2r)
+        gL = L[None, :, :] / (1j * w[:, None, None] - lam[None, :, None])  # (w, 2r, m)
+        H = Dq[None] @ gL
+        if Vq.any():
+            H += 1j * w[:, None, None] * (Vq[None] @ gL)
+        return H
 
 
 def frf_modal(M, K, C, G, inputs, outputs: OutputMap, omegas, speed: float = 0.0, n_modes: int = 20,
-              residual: bool = True, modes: str = "complex", method: str = "auto") -> np.ndarray:
+              residual: bool = True, modes: str = "complex", method: str = "auto", basis_speeds=()) -> np.ndarray:
     """Receptances (w, p, m) by modal superposition (one-shot :class:`ModalBasis`)."""
-    return ModalBasis(M, K, C, G, inputs, n_modes, residual, modes, method).frf(outputs, omegas, speed)
+    return ModalBasis(M, K, C, G, inputs, n_modes, residual, modes, method, basis_speeds).frf(outputs, omegas, speed)
 
 
 def unbalance_response(M, K, C, G, load, outputs: OutputMap, speeds) -> np.ndarray:
