@@ -92,7 +92,7 @@ class Spectrum:
     orders : tuple of float
         Lines drawn on the map (shaft orders).
     order_amplitude : array (s, orders)
-        The map's value along each order line.
+        The map's value along each order line (0 at speed 0).
     line_labels : tuple of str (l,)
     line_freqs : array (s, l), rad/s
     line_amplitude : array (s, l)
@@ -311,12 +311,13 @@ def scene_spectrum(scene: Scene, speeds: np.ndarray, node: int, orders: tuple[fl
     basis = ModalBasis(model.M, model.K, model.C, model.G, F, n_modes, modes="sweep",
                        basis_speeds=(speeds[0], (speeds[0] + speeds[-1]) / 2, speeds[-1]))
     out = displacement([6 * node, 6 * node + 1, 6 * node + 2], n, ("u1", "u2", "u3"))
-    freqs = np.linspace(0.0, top, n_freqs)
+    freqs = np.linspace(top / n_freqs, top, n_freqs)  # no 0 Hz line: a static load on a free body has no response
     ko = np.asarray(drawn)
     grid, amp = np.zeros((len(speeds), n_freqs)), np.zeros((len(speeds), len(ko)))
     for i, s in enumerate(speeds):
-        grid[i] = np.linalg.norm(basis.frf(out, freqs, s)[..., 0], axis=1)
-        amp[i] = np.linalg.norm(basis.frf(out, ko * s, s)[..., 0], axis=1)
+        grid[i] = np.linalg.norm(basis.frf(out, freqs, s, columns=[0])[..., 0], axis=1)
+        if s > 0:
+            amp[i] = np.linalg.norm(basis.frf(out, ko * s, s, columns=[0])[..., 0], axis=1)
     problem = ModalProblem(model.M, model.K, model.C, model.G, model.dof_kind)
     diagram = campbell(problem, speeds, n_modes, shaft_orders(drawn))
     res = Spectrum(speeds, node, map_input, freqs, grid, drawn, amp, campbell=diagram)
@@ -339,7 +340,8 @@ def _lines(res: Spectrum, scene: Scene, model: RotorModel, basis: ModalBasis, ou
         col = 0
         for j, src in enumerate(sources, start=1):
             w = src.frequencies(s)
-            y = basis.frf(both, w, s)[..., j] * src.amplitudes(s)[:, None]  # (l, outputs)
+            y = np.zeros((len(w), both.D.shape[0]), dtype=complex)  # a line at 0 Hz is a static load: no vibration
+            y[w > 0] = basis.frf(both, w[w > 0], s, columns=[j])[..., 0] * src.amplitudes(s)[w > 0, None]
             sl = slice(col, col + len(w))
             wl[i, sl], al[i, sl] = w, np.linalg.norm(y[:, :3], axis=1)
             if face is not None:

@@ -175,6 +175,9 @@ GRAM_RTOL = 1e-13
 #: (rigid-body modes in the excited blocks): the correction then carries the rigid-body response, which the
 #: eigen-solvers drop, with the elastic modes' part off by a relative ``a / w_j^2``.
 RIGID_SHIFT = 1e-12
+#: A reduced block whose eigenvector matrix has a reciprocal condition number below this is defective (rigid-body
+#: modes: a Jordan pair at lambda = 0) and is solved by batched reduced solves instead of its modes.
+DEFECTIVE_RCOND = 1e-10
 
 
 def _unit_columns(X: np.ndarray, M) -> np.ndarray:
@@ -235,6 +238,9 @@ class ModalBasis:
         self.dofs = dofs = reached(M, K, C, G, F)
         self.mats = [X[dofs][:, dofs].tocsr() for X in (M, K, C, G)]
         self.F = F[dofs]
+        _, label = connected_components(abs(self.mats[0]) + abs(self.mats[1]) + abs(self.mats[2]) + abs(self.mats[3]),
+                                        directed=False)
+        self.blocks = [np.flatnonzero(label == b) for b in np.unique(label)]
         self.n_modes, self.method = min(n_modes, len(dofs)), method
         self.kind = np.full(len(dofs), 2)  # no whirl pairs needed: labels are not used here
         self.modes = "rest" if self.mats[2].nnz == 0 and self.mats[3].nnz == 0 else modes
@@ -277,62 +283,114 @@ class ModalBasis:
             tops.append(top)
         return shapes, min(tops)
 
-    def reduced(self, speed: float) -> tuple[np.ndarray, ...]:
-        """``(V, K_r, D_r, F_r, wmax)`` at ``speed``: M-orthonormal basis V (dofs x r), reduced stiffness and
-        damping ``V^T (C + speed G) V``, forces; wmax (rad/s) is the highest retained natural frequency."""
-        key = float(speed) if self.modes == "complex" else 0.0
+    def _blocks(self, key: float) -> list[tuple]:
+        """Per independent DOF block (connected component of the pattern among the reached DOFs): ``(rows, V,
+        K_r, C_r, G_r, F_r)`` with V an M-orthonormal basis of the block (kept apart, so the reduced matrices have
+        no round-off coupling between blocks), and the highest retained natural frequency."""
         if key not in self._reduced:
             shapes, wmax = self._sweep_shapes() if self.modes == "sweep" else self._shapes(key)
-            M, K, C, G = self.mats
             groups = [np.hstack([X.real, X.imag]) for X in shapes]
             if self.static is not None:
                 groups.append(self.static)
-            B = np.hstack([_unit_columns(X, M) for X in groups])
-            lam, U = sla.eigh(B.T @ (M @ B))
-            keep = lam > GRAM_RTOL * lam.max()  # drop dependent columns (both halves of a circular pair, ...)
-            V = B @ (U[:, keep] / np.sqrt(lam[keep]))  # M-orthonormal
+            blocks = []
+            for rows in self.blocks:
+                M, K, C, G = (X[rows][:, rows] for X in self.mats)
+                B = np.hstack([_unit_columns(X[rows], M) for X in groups])
+                if B.shape[1] == 0:
+                    continue
+                lam, U = sla.eigh(B.T @ (M @ B))
+                keep = lam > GRAM_RTOL * lam.max()  # drop dependent columns (both halves of a circular pair, ...)
+                V = B @ (U[:, keep] / np.sqrt(lam[keep]))  # M-orthonormal
+                blocks.append((rows, V, V.T @ (K @ V), V.T @ (C @ V), V.T @ (G @ V), V.T @ self.F[rows]))
             self._reduced = {} if self.modes == "complex" else self._reduced  # keep one speed
-            self._reduced[key] = (V, V.T @ (K @ V), V.T @ (C @ V), V.T @ (G @ V), V.T @ self.F, wmax)
-        V, Kr, Cr, Gr, Fr, wmax = self._reduced[key]
-        return V, Kr, Cr + speed * Gr, Fr, wmax
+            self._reduced[key] = (blocks, wmax)
+        return self._reduced[key]
+
+    def reduced(self, speed: float) -> tuple[np.ndarray, ...]:
+        """``(V, K_r, D_r, F_r, wmax)`` at ``speed``: M-orthonormal basis V (dofs x r, block-diagonal over the
+        independent blocks), reduced stiffness and damping ``V^T (C + speed G) V``, forces; wmax (rad/s) is the
+        highest retained natural frequency."""
+        blocks, wmax = self._blocks(float(speed) if self.modes == "complex" else 0.0)
+        V = sla.block_diag(*(b[1] for b in blocks))
+        order = np.concatenate([b[0] for b in blocks])
+        Vd = np.zeros((len(self.dofs), V.shape[1]))
+        Vd[order] = V
+        return (Vd, sla.block_diag(*(b[2] for b in blocks)),
+                sla.block_diag(*(b[3] + speed * b[4] for b in blocks)), np.vstack([b[5] for b in blocks]), wmax)
 
     def wmax(self, speed: float = 0.0) -> float:
         """Highest natural frequency in the basis at ``speed``, rad/s (modal FRFs are meant below it)."""
-        return self.reduced(speed)[4]
+        return self._blocks(float(speed) if self.modes == "complex" else 0.0)[1]
 
-    def poles(self, speed: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """``(lam, X, L)`` at ``speed``: the reduced state-space matrix ``A = [[0, I], [-K_r, -D_r]] =
-        Phi diag(lam) Phi^{-1}``, the modes' displacement shapes ``X = V Phi_q`` (dofs x 2r) and their
-        participations ``L = Phi^{-1} [0; F_r]`` (2r x m).  The last speed's are kept."""
+    def poles(self, speed: float) -> list[tuple]:
+        """Per block at ``speed``: ``("modal", lam, X, L)`` from the reduced state-space matrix
+        ``A = [[0, I], [-K_r, -D_r]] = Phi diag(lam) Phi^{-1}``, the modes' displacement shapes ``X = V Phi_q``
+        (dofs x 2r) and participations ``L = Phi^{-1} [0; F_r]`` (2r x m); or, where Phi is singular (a rigid-body
+        block: a Jordan pair at 0), ``("direct", X, Kr, Dr, Fr)`` with ``X = V`` for batched reduced solves.
+        The last speed's are kept."""
         if self._poles is not None and self._poles[0] == speed:
             return self._poles[1]
-        V, Kr, Dr, Fr, _ = self.reduced(speed)
-        r = V.shape[1]
-        A = np.zeros((2 * r, 2 * r))
-        A[:r, r:] = np.eye(r)
-        A[r:, :r], A[r:, r:] = -Kr, -Dr
-        lam, Phi = sla.eig(A)
-        try:
+        blocks, _ = self._blocks(float(speed) if self.modes == "complex" else 0.0)
+        out = []
+        for rows, V, Kr, Cr, Gr, Fr in blocks:
+            r = V.shape[1]
+            X = np.zeros((len(self.dofs), r))
+            X[rows] = V
+            A = np.zeros((2 * r, 2 * r))
+            A[:r, r:] = np.eye(r)
+            A[r:, :r], A[r:, r:] = -Kr, -(Cr + speed * Gr)
+            lam, Phi = sla.eig(A)
+            if 1.0 / np.linalg.cond(Phi) < DEFECTIVE_RCOND:
+                out.append(("direct", X, Kr, Cr + speed * Gr, Fr))
+                continue
             L = sla.solve(Phi, np.vstack([np.zeros_like(Fr), Fr]))  # (2r, m) modal participations
-        except sla.LinAlgError:
-            raise NumericalError(f"reduced state matrix defective at speed {speed:g} rad/s",
-                                 component="modal.forced") from None
-        self._poles = (speed, (lam, V @ Phi[:r], L))
-        return self._poles[1]
+            out.append(("modal", lam, X @ Phi[:r], L))
+        self._poles = (speed, out)
+        return out
 
     def frf(self, outputs: OutputMap, omegas, speed: float = 0.0, columns=None) -> np.ndarray:
-        """Receptances (w, p, m) by summing the complex modes of the reduced state-space matrix (:meth:`poles`):
-        ``H(w) = (D + i w V) X (i w - lam)^{-1} L``; ``columns`` selects inputs (default all)."""
+        """Receptances (w, p, m), per block by summing the complex modes of the reduced state-space matrix
+        (:meth:`poles`), ``H(w) = (D + i w V) X (i w - lam)^{-1} L``, or by batched reduced solves
+        ``V (K_r - w^2 + i w D_r)^{-1} F_r``; ``columns`` selects inputs (default all)."""
         w = _omegas(omegas)
-        lam, X, L = self.poles(speed)
-        if columns is not None:
-            L = L[:, columns]
-        Dq, Vq = outputs.D[:, self.dofs] @ X, outputs.V[:, self.dofs] @ X  # (p, 2r)
-        gL = L[None, :, :] / (1j * w[:, None, None] - lam[None, :, None])  # (w, 2r, m)
-        H = Dq[None] @ gL
-        if Vq.any():
-            H += 1j * w[:, None, None] * (Vq[None] @ gL)
+        cols = slice(None) if columns is None else columns
+        m = self.F[:, cols].shape[1]
+        D, Vo = outputs.D[:, self.dofs], outputs.V[:, self.dofs]
+        H = np.zeros((len(w), D.shape[0], m), dtype=complex)
+        for part in self.poles(speed):
+            if part[0] == "modal":
+                _, lam, X, L = part
+                gL = L[None, :, cols] / (1j * w[:, None, None] - lam[None, :, None])  # (w, 2r, m)
+            else:
+                _, X, Kr, Dr, Fr = part
+                if not np.any(Fr[:, cols]):
+                    continue
+                Z = Kr[None] - (w * w)[:, None, None] * np.eye(len(Kr)) + 1j * w[:, None, None] * Dr[None]
+                gL = _batched_solve(Z, Fr[:, cols], speed)
+            Dq, Vq = D @ X, Vo @ X
+            H += Dq[None] @ gL
+            if np.any(Vq):
+                H += 1j * w[:, None, None] * (Vq[None] @ gL)
         return H
+
+
+def _batched_solve(Z: np.ndarray, F: np.ndarray, speed: float) -> np.ndarray:
+    """``Z[i]^{-1} F`` for a stack Z (w, r, r); where ``Z[i]`` is singular (w = 0 on a rigid-body block) the static
+    solution orthogonal to the rigid-body modes if F does not load them, else a NumericalError."""
+    try:
+        return np.linalg.solve(Z, np.broadcast_to(F, (len(Z),) + F.shape))
+    except np.linalg.LinAlgError:
+        pass
+    out = np.empty((len(Z),) + F.shape, dtype=complex)
+    for i, Zi in enumerate(Z):
+        try:
+            out[i] = np.linalg.solve(Zi, F)
+        except np.linalg.LinAlgError:
+            out[i] = np.linalg.pinv(Zi) @ F
+            if np.linalg.norm(Zi @ out[i] - F) > 1e-8 * np.linalg.norm(F):
+                raise NumericalError(f"a static (w = 0) load on a free rigid-body mode at speed {speed:g} rad/s "
+                                     "has no steady state", component="modal.forced") from None
+    return out
 
 
 def frf_modal(M, K, C, G, inputs, outputs: OutputMap, omegas, speed: float = 0.0, n_modes: int = 20,
