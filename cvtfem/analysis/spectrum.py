@@ -300,11 +300,12 @@ def scene_spectrum(scene: Scene, speeds: np.ndarray, node: int, orders: tuple[fl
         f_map = np.zeros(n)
         f_map[6 * _body_node(model, fn)] = 1.0
         map_input, drawn = f"x force (N) at node {fn}", list(k)
-    drawn += [float(r.order) for r in ripples or () if r.order not in drawn]
-    if not drawn:
+    drawn += [float(r.order) for r in ripples or ()] + [u.order for u in user or () if u.order > 0]
+    if not drawn and not sources:
         raise InputError("--orders", list(orders), "needs at least one order line or an excitation source")
     drawn = tuple(sorted(set(drawn)))
-    top = max(drawn) * speeds[-1] if fmax is None else float(fmax)
+    fixed = [2 * np.pi * u.freq_hz for u in user or ()]
+    top = max([k * speeds[-1] for k in drawn] + fixed) if fmax is None else float(fmax)
     if not top > 0:
         raise InputError("--fmax", fmax, "must be > 0 (and the speeds must not all be 0)")
     F = np.column_stack([f_map] + [s.force for s in sources])
