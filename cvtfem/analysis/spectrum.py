@@ -23,6 +23,8 @@ from cvtfem.modal.forced import ModalBasis, OutputMap, displacement
 from cvtfem.modal.radiation import Face, erp, power_db, rigid_annulus
 from cvtfem.scene.loader import Scene
 
+#: Highest frequency of a map or an excitation line, rad/s (1 GHz: far above any structural mode).
+FMAX = 2 * np.pi * 1e9
 #: DOF names of a rotor node, in order.
 DOF_NAMES = ("u1", "u2", "u3", "theta1", "theta2", "phi")
 
@@ -184,8 +186,9 @@ def pin_entry_force(scene: Scene, model: RotorModel, pin: PinEntry) -> np.ndarra
     c, s = np.cos(pin.angle), np.sin(pin.angle)
     for i in idx:
         d = scene.disk[i]
-        if pin.radius > d.outer_diameter / 2:
-            raise InputError("--chain radius", pin.radius, f"must lie on the sheave (<= {d.outer_diameter / 2:g} m)")
+        if not d.hub_diameter / 2 <= pin.radius <= d.outer_diameter / 2:
+            raise InputError("--chain radius", pin.radius, f"must lie on the sheave face ({d.hub_diameter / 2:g} .. "
+                             f"{d.outer_diameter / 2:g} m)")
         sigma = 1.0 if d.facing == "+z" else -1.0
         fr, fa = -np.sin(d.cone_angle), -sigma * np.cos(d.cone_angle)
         q = 6 * int(model.disks.nodes[i])
@@ -305,9 +308,11 @@ def scene_spectrum(scene: Scene, speeds: np.ndarray, node: int, orders: tuple[fl
         raise InputError("--orders", list(orders), "needs at least one order line or an excitation source")
     drawn = tuple(sorted(set(drawn)))
     fixed = [2 * np.pi * u.freq_hz for u in user or ()]
+    if max(drawn, default=0.0) > FMAX / speeds[-1]:
+        raise InputError("--orders", list(drawn), f"must keep the lines below {FMAX / 2 / np.pi:g} Hz at the top speed")
     top = max([k * speeds[-1] for k in drawn] + fixed) if fmax is None else float(fmax)
-    if not top > 0:
-        raise InputError("--fmax", fmax, "must be > 0 (and the speeds must not all be 0)")
+    if not 0 < top <= FMAX:
+        raise InputError("--fmax", fmax, f"must be > 0 and <= {FMAX / 2 / np.pi:g} Hz (and the speeds not all 0)")
     F = np.column_stack([f_map] + [s.force for s in sources])
     basis = ModalBasis(model.M, model.K, model.C, model.G, F, n_modes, modes="sweep",
                        basis_speeds=(speeds[0], (speeds[0] + speeds[-1]) / 2, speeds[-1]))

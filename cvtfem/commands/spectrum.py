@@ -36,11 +36,11 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 
 
 def _chain(args: argparse.Namespace):
-    from cvtfem.analysis.spectrum import PinEntry
-    from cvtfem.elements.link_pattern import link_lengths
-    from cvtfem.errors import InputError
-
     import numpy as np
+
+    from cvtfem.analysis.spectrum import PinEntry
+    from cvtfem.errors import InputError
+    from cvtfem.modal.excitation import chain_pattern
 
     rule = "must be R:N:LSHORT:LLONG:FLONG[:SEED] (m, links, m, m, 0..1, integer), e.g. 0.06:84:0.008:0.01:0.5"
     parts = args.chain.split(":")
@@ -61,7 +61,7 @@ def _chain(args: argparse.Namespace):
         raise InputError("--entry-angle", args.entry_angle, "must be a finite angle in deg")
     if not 1 <= args.link_harmonics <= 20:
         raise InputError("--link-harmonics", args.link_harmonics, "must be 1..20")
-    lengths = link_lengths(n, ls, ll, fl, np.random.default_rng(seed))
+    lengths = chain_pattern(n, ls, ll, fl, seed)
     return PinEntry(lengths, r, args.impulse, np.radians(args.entry_angle), args.link_harmonics)
 
 
@@ -83,7 +83,7 @@ def run(args: argparse.Namespace) -> int:
     import numpy as np
 
     from cvtfem.analysis.spectrum import read_user_lines, scene_spectrum, write_results
-    from cvtfem.commands.response import _orders
+    from cvtfem.commands.response import parse_orders
     from cvtfem.errors import InputError
     from cvtfem.scene.loader import load_scene
     from cvtfem.units import parse_speeds
@@ -101,7 +101,7 @@ def run(args: argparse.Namespace) -> int:
     ripples = [_ripple(r) for r in args.ripple]
     user = read_user_lines(args.lines) if args.lines else []
     scene = load_scene(args.scene)
-    res = scene_spectrum(scene, speeds, args.node, _orders(args.orders), pin, ripples, user, args.force_node,
+    res = scene_spectrum(scene, speeds, args.node, parse_orders(args.orders), pin, ripples, user, args.force_node,
                          args.n_freqs, None if args.fmax is None else 2 * np.pi * args.fmax, args.n_modes)
     rpm = res.speeds * 30 / np.pi
     print(f"{scene.title or scene.source}: spectrum at node {res.node}, {len(speeds)} speeds; map input "

@@ -22,6 +22,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from cvtfem.elements.link_pattern import link_lengths as draw_link_lengths
 from cvtfem.errors import InputError
 
 
@@ -37,10 +38,10 @@ class Lines:
     freqs : array (l,), rad/s
         Fixed frequencies (added to ``order x Omega``): 0 for order lines.
     amplitude : complex array (l,)
-        Force amplitude per line, in units of ``force`` (e.g. N s per entry for pin entry, N m for ripple).
+        Line amplitudes: per unit shaft speed (rad/s) when ``scale`` is "speed" (pin entry: ``2 J S_k r / L``, the
+        entry rate grows with the speed), else as they are (N or N m).
     scale : str
-        ``"speed"``: the amplitude grows with the chain speed (pin entry: ``2 J f_chain S_k``, f_chain in Hz per
-        rad/s of shaft speed folded into ``amplitude``); ``"const"``: it does not.
+        "speed" or "const".
     force : complex array (n,)
         Generalised force distribution per unit amplitude (N or N m per unit).
     """
@@ -59,6 +60,12 @@ class Lines:
     def amplitudes(self, speed: float) -> np.ndarray:
         """Line amplitudes at shaft speed ``speed`` (rad/s)."""
         return self.amplitude * (speed if self.scale == "speed" else 1.0)
+
+
+def chain_pattern(n_links: int, pitch_short: float, pitch_long: float, long_fraction: float, seed: int) -> np.ndarray:
+    """Link lengths (m) of a chain: ``round(long_fraction n_links)`` long links placed at random by ``seed``
+    (:func:`cvtfem.elements.link_pattern.link_lengths`; uniform for ``long_fraction`` 0 or equal pitches)."""
+    return draw_link_lengths(n_links, pitch_short, pitch_long, long_fraction, np.random.default_rng(seed))
 
 
 def pin_positions(link_lengths) -> np.ndarray:

@@ -105,7 +105,7 @@ def test_a_weighted_erp_lies_within_the_weights_of_its_lines(randomised):
 
 
 def test_bad_sources(scene, tmp_path):
-    with pytest.raises(InputError, match="must lie on the sheave"):
+    with pytest.raises(InputError, match="must lie on the sheave face"):
         scene_spectrum(scene, SPEEDS, 4, pin=PinEntry(np.full(N, 0.009), 0.5))
     with pytest.raises(InputError, match="sheaves"):
         scene_spectrum(load_scene("friswell_5_9_1"), SPEEDS, 2, pin=PinEntry(np.full(N, 0.009), 0.06))
