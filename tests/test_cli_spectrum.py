@@ -34,7 +34,8 @@ def test_order_map_peaks_sit_on_the_campbell_crossings(tmp_path):
     assert run("spectrum", "cvt_sheave_shaft", "--speeds", SPEEDS, "--node", "4", "--orders", ORDERS, "--n-freqs",
                "20", "--json", str(tmp_path / "x.json")) == 0
     assert run("spectrum", "cvt_sheave_shaft", "--speeds", SPEEDS, "--node", "4", "--orders", ORDERS, "--n-freqs",
-               "20", "--chain", "0.06:84:0.009:0.009:0", "--link-harmonics", "1", "--json", str(tmp_path / "p.json")) == 0
+               "20", "--chain", "0.06:84:0.009:0.009:0", "--link-harmonics", "1", "--json",
+               str(tmp_path / "p.json")) == 0
     for name, whirls, both_ways in (("x.json", ("forward", "backward"), True),
                                     ("p.json", ("forward", "backward", "axial"), False)):
         spec = json.loads((tmp_path / name).read_text())
@@ -55,7 +56,8 @@ def test_spectrum_writes_json_hdf5_and_pngs(cli, tmp_path):
     lines = tmp_path / "lines.csv"
     lines.write_text("node,dof,order,freq_hz,amplitude,phase_deg\n7,u3,0,1500,20,0\n")
     r = cli("spectrum", "cvt_sheave_shaft", "--speeds", "0:6000rpm:13", "--node", "4", "--chain",
-            "0.06:84:0.008:0.01:0.5:3", "--link-harmonics", "1", "--ripple", "4:2:5", "--lines", str(lines), "--n-freqs", "30", "--json",
+            "0.06:84:0.008:0.01:0.5:3", "--link-harmonics", "1", "--ripple", "4:2:5", "--lines", str(lines),
+            "--n-freqs", "30", "--json",
             str(tmp_path / "s.json"), "--results", str(tmp_path / "s.h5"), "--png", str(tmp_path / "s.png"))
     assert r.returncode == 0, r.stderr
     d = json.loads((tmp_path / "s.json").read_text())

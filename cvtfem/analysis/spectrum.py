@@ -309,7 +309,8 @@ def scene_spectrum(scene: Scene, speeds: np.ndarray, node: int, orders: tuple[fl
     drawn = tuple(sorted(set(drawn)))
     fixed = [2 * np.pi * u.freq_hz for u in user or ()]
     if max(drawn, default=0.0) > FMAX / speeds[-1]:
-        raise InputError("--orders", list(drawn), f"must keep the lines below {FMAX / 2 / np.pi:g} Hz at the top speed")
+        raise InputError("--orders", [float(d) for d in drawn],
+                         f"must keep the lines below {FMAX / 2 / np.pi:g} Hz at the top speed")
     top = max([k * speeds[-1] for k in drawn] + fixed) if fmax is None else float(fmax)
     if not 0 < top <= FMAX:
         raise InputError("--fmax", fmax, f"must be > 0 and <= {FMAX / 2 / np.pi:g} Hz (and the speeds not all 0)")

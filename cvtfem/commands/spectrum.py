@@ -111,7 +111,8 @@ def run(args: argparse.Namespace) -> int:
         print(f"  order {k:.5g}: largest response {res.order_amplitude[m, j]:.4g} per unit at {rpm[m]:.5g} rpm")
     print("  Campbell crossings of the order lines:")
     for c in res.campbell.crossings:
-        print(f"    {c['order']:>10} mode {c['mode']:>2} ({c['whirl']:<10}) at {c['speed_rad_s'] * 30 / np.pi:9.5g} rpm")
+        rpm_c = c["speed_rad_s"] * 30 / np.pi
+        print(f"    {c['order']:>10} mode {c['mode']:>2} ({c['whirl']:<10}) at {rpm_c:9.5g} rpm")
     if res.line_labels:
         i = int(np.nanargmax(np.where(np.isfinite(res.erp_a_db), res.erp_a_db, -np.inf)))
         print(f"  {len(res.line_labels)} excitation lines; sheave-face ERP up to {np.nanmax(res.erp_db[1:]):.1f} dB, "

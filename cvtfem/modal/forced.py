@@ -178,6 +178,8 @@ RIGID_SHIFT = 1e-12
 #: A reduced block whose eigenvector matrix has a reciprocal condition number below this is defective (rigid-body
 #: modes: a Jordan pair at lambda = 0) and is solved by batched reduced solves instead of its modes.
 DEFECTIVE_RCOND = 1e-10
+#: Singular values of a static reduced stiffness below this fraction of the largest are rigid-body directions.
+RIGID_RCOND = 1e-9
 
 
 def _unit_columns(X: np.ndarray, M) -> np.ndarray:
@@ -325,8 +327,9 @@ class ModalBasis:
     def poles(self, speed: float) -> list[tuple]:
         """Per block at ``speed``: ``("modal", lam, X, L)`` from the reduced state-space matrix
         ``A = [[0, I], [-K_r, -D_r]] = Phi diag(lam) Phi^{-1}``, the modes' displacement shapes ``X = V Phi_q``
-        (dofs x 2r) and participations ``L = Phi^{-1} [0; F_r]`` (2r x m); or, where Phi is singular (a rigid-body
-        block: a Jordan pair at 0), ``("direct", X, Kr, Dr, Fr)`` with ``X = V`` for batched reduced solves.
+        (dofs x 2r) and participations ``L = Phi^{-1} [0; F_r]`` (2r x m); or, for a block with a rigid-body mode
+        (K_r singular to ``RIGID_RCOND``: a Jordan pair at 0, or two nearly equal poles whose modal sum cancels
+        badly) or a defective Phi, ``("direct", X, Kr, Dr, Fr)`` with ``X = V`` for batched reduced solves.
         The last speed's are kept."""
         if self._poles is not None and self._poles[0] == speed:
             return self._poles[1]
@@ -339,6 +342,10 @@ class ModalBasis:
             A = np.zeros((2 * r, 2 * r))
             A[:r, r:] = np.eye(r)
             A[r:, :r], A[r:, r:] = -Kr, -(Cr + speed * Gr)
+            sv = np.linalg.svd(Kr, compute_uv=False)
+            if sv.min() < RIGID_RCOND * sv.max():  # a rigid-body mode: no modal sum
+                out.append(("direct", X, Kr, Cr + speed * Gr, Fr))
+                continue
             lam, Phi = sla.eig(A)
             if 1.0 / np.linalg.cond(Phi) < DEFECTIVE_RCOND:
                 out.append(("direct", X, Kr, Cr + speed * Gr, Fr))
@@ -366,7 +373,7 @@ class ModalBasis:
                 if not np.any(Fr[:, cols]):
                     continue
                 Z = Kr[None] - (w * w)[:, None, None] * np.eye(len(Kr)) + 1j * w[:, None, None] * Dr[None]
-                gL = _batched_solve(Z, Fr[:, cols], speed)
+                gL = _batched_solve(Z, Fr[:, cols], w, speed)
             Dq, Vq = D @ X, Vo @ X
             H += Dq[None] @ gL
             if np.any(Vq):
@@ -374,22 +381,22 @@ class ModalBasis:
         return H
 
 
-def _batched_solve(Z: np.ndarray, F: np.ndarray, speed: float) -> np.ndarray:
-    """``Z[i]^{-1} F`` for a stack Z (w, r, r); where ``Z[i]`` is singular (w = 0 on a rigid-body block) the static
-    solution orthogonal to the rigid-body modes if F does not load them, else a NumericalError."""
-    try:
-        return np.linalg.solve(Z, np.broadcast_to(F, (len(Z),) + F.shape))
-    except np.linalg.LinAlgError:
-        pass
+def _batched_solve(Z: np.ndarray, F: np.ndarray, w: np.ndarray, speed: float) -> np.ndarray:
+    """``Z[i]^{-1} F`` for a stack Z (w, r, r) of a block with a rigid-body mode.  At w = 0 Z is singular: the
+    static solution orthogonal to the rigid-body modes when F does not load them (pseudo-inverse, singular values
+    below ``RIGID_RCOND`` of the largest dropped), else a NumericalError (no steady state)."""
     out = np.empty((len(Z),) + F.shape, dtype=complex)
-    for i, Zi in enumerate(Z):
-        try:
-            out[i] = np.linalg.solve(Zi, F)
-        except np.linalg.LinAlgError:
-            out[i] = np.linalg.pinv(Zi) @ F
-            if np.linalg.norm(Zi @ out[i] - F) > 1e-8 * np.linalg.norm(F):
-                raise NumericalError(f"a static (w = 0) load on a free rigid-body mode at speed {speed:g} rad/s "
-                                     "has no steady state", component="modal.forced") from None
+    moving = w > 0
+    try:
+        out[moving] = np.linalg.solve(Z[moving], np.broadcast_to(F, (int(moving.sum()),) + F.shape))
+    except np.linalg.LinAlgError:
+        raise NumericalError(f"reduced dynamic stiffness singular at speed {speed:g} rad/s", component="modal.forced"
+                             ) from None
+    for i in np.flatnonzero(~moving):
+        out[i] = np.linalg.pinv(Z[i], rcond=RIGID_RCOND) @ F
+        if np.linalg.norm(Z[i] @ out[i] - F) > 1e-6 * np.linalg.norm(F):
+            raise NumericalError(f"a static (w = 0) load on a free rigid-body mode at speed {speed:g} rad/s has no "
+                                 "steady state", component="modal.forced")
     return out
 
 
