@@ -104,7 +104,7 @@ def plot_spectrum_map(res: Spectrum, path: str | Path, title: str = "") -> Path:
 
 def plot_erp(res: Spectrum, path: str | Path, title: str = "") -> Path:
     """ERP of the sheave faces over speed: total and A-weighted (dB re 1 pW), and the response at the node of the
-    strongest lines (m, log)."""
+    (up to five) lines with the largest ERP (m, log)."""
     plt = _pyplot()
     rpm = res.speeds * 30 / np.pi
     fig, (ax, ax2) = plt.subplots(2, 1, figsize=(8, 7), sharex=True)
@@ -114,15 +114,17 @@ def plot_erp(res: Spectrum, path: str | Path, title: str = "") -> Path:
     ax.set_title(title or "equivalent radiated power")
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8)
-    strongest = np.argsort(res.line_erp.max(axis=0))[::-1][:5]
+    peak = res.line_erp.max(axis=0)
+    strongest = [j for j in np.argsort(peak)[::-1] if peak[j] > 1e-12 * peak.max()][:5]  # lines that radiate
     for j in strongest:
         ax2.semilogy(rpm, np.maximum(res.line_amplitude[:, j], 1e-30), label=res.line_labels[j])
-    ax2.set_ylim(bottom=max(res.line_amplitude[:, strongest].max() * 1e-6, 1e-30))
+    if strongest:
+        ax2.set_ylim(bottom=max(res.line_amplitude[:, strongest].max() * 1e-6, 1e-30))
+        ax2.legend(fontsize=7)
     ax2.set_ylabel(f"|(u1, u2, u3)| at node {res.node} (m)")
     ax2.set_xlabel("shaft speed (rpm)")
-    ax2.set_title("the five lines with the largest ERP", fontsize=9)
+    ax2.set_title(f"the {len(strongest)} lines with the largest ERP", fontsize=9)
     ax2.grid(alpha=0.3, which="both")
-    ax2.legend(fontsize=7)
     fig.tight_layout()
     path = Path(path)
     fig.savefig(path, dpi=120)
