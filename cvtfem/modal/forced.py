@@ -175,10 +175,11 @@ GRAM_RTOL = 1e-13
 #: (rigid-body modes in the excited blocks): the correction then carries the rigid-body response, which the
 #: eigen-solvers drop, with the elastic modes' part off by a relative ``a / w_j^2``.
 RIGID_SHIFT = 1e-12
-#: A reduced block whose eigenvector matrix has a reciprocal condition number below this is defective (rigid-body
-#: modes: a Jordan pair at lambda = 0) and is solved by batched reduced solves instead of its modes.
+#: A reduced block whose eigenvector matrix has a reciprocal condition number below this is (nearly) defective and
+#: is solved by batched reduced solves instead of its modes.
 DEFECTIVE_RCOND = 1e-10
-#: Singular values of a static reduced stiffness below this fraction of the largest are rigid-body directions.
+#: Singular values of a reduced stiffness below this fraction of the largest are rigid-body directions: such a block
+#: (a Jordan pair at lambda = 0) is solved by batched reduced solves too.
 RIGID_RCOND = 1e-9
 
 
