@@ -104,6 +104,9 @@ class Spectrum:
     erp_db, erp_a_db : arrays (s,)
         Total ERP (sum over lines) in dB re 1 pW, and A-weighted.
     campbell : Campbell
+    wmax : float, rad/s
+        Highest natural frequency in the modal basis: lines and map above it rest on the residual vectors alone
+        (raise ``n_modes`` to cover them).
     """
 
     speeds: np.ndarray
@@ -120,6 +123,7 @@ class Spectrum:
     erp_db: np.ndarray = field(default_factory=lambda: np.zeros(0))
     erp_a_db: np.ndarray = field(default_factory=lambda: np.zeros(0))
     campbell: Campbell | None = None
+    wmax: float = 0.0
 
     def to_dict(self) -> dict[str, object]:
         """JSON-ready data (SI units; ERP levels in dB re 1 pW)."""
@@ -128,7 +132,8 @@ class Spectrum:
             "map_freqs_rad_s": self.freqs.tolist(), "map": self.map.tolist(), "orders": list(self.orders),
             "order_amplitude": self.order_amplitude.tolist(), "line_labels": list(self.line_labels),
             "line_freqs_rad_s": self.line_freqs.tolist(), "line_amplitude_m": self.line_amplitude.tolist(),
-            "line_erp_w": self.line_erp.tolist(), "erp_db": _finite(self.erp_db), "erp_a_db": _finite(self.erp_a_db)}
+            "line_erp_w": self.line_erp.tolist(), "erp_db": _finite(self.erp_db), "erp_a_db": _finite(self.erp_a_db),
+            "basis_wmax_rad_s": self.wmax}
         if self.campbell is not None:
             out["crossings"] = list(self.campbell.crossings)
         return out
@@ -143,7 +148,7 @@ def write_results(res: Spectrum, path: str, scene: Scene) -> None:
     from cvtfem.io.results import ResultsWriter
 
     with ResultsWriter(path, scene.to_toml(), "spectrum", ()) as w:
-        w.set_stats({"node": res.node, "map_input": res.map_input})
+        w.set_stats({"node": res.node, "map_input": res.map_input, "basis_wmax_rad_s": res.wmax})
         w.add_array("spectrum/speeds", res.speeds, "rad/s", "Spin speeds.")
         w.add_array("spectrum/map_freqs", res.freqs, "rad/s", "Frequency lines of the order map.")
         w.add_array("spectrum/map", res.map, "m/N", f"|(u1, u2, u3)| at the node per unit {res.map_input}.")
@@ -327,7 +332,7 @@ def scene_spectrum(scene: Scene, speeds: np.ndarray, node: int, orders: tuple[fl
             amp[i] = np.linalg.norm(basis.frf(out, ko * s, s, columns=[0])[..., 0], axis=1)
     problem = ModalProblem(model.M, model.K, model.C, model.G, model.dof_kind)
     diagram = campbell(problem, speeds, n_modes, shaft_orders(drawn))
-    res = Spectrum(speeds, node, map_input, freqs, grid, drawn, amp, campbell=diagram)
+    res = Spectrum(speeds, node, map_input, freqs, grid, drawn, amp, campbell=diagram, wmax=basis.wmax())
     if not sources:
         return res
     return _lines(res, scene, model, basis, out, sources)
@@ -356,7 +361,8 @@ def _lines(res: Spectrum, scene: Scene, model: RotorModel, basis: ModalBasis, ou
             col += len(w)
     weights = 10 ** (a_weighting_db(wl / (2 * np.pi)) / 10)
     return Spectrum(res.speeds, res.node, res.map_input, res.freqs, res.map, res.orders, res.order_amplitude,
-                    labels, wl, al, el, power_db(el.sum(axis=1)), power_db((el * weights).sum(axis=1)), res.campbell)
+                    labels, wl, al, el, power_db(el.sum(axis=1)), power_db((el * weights).sum(axis=1)), res.campbell,
+                    res.wmax)
 
 
 def erp_of(face: Face, w_normal: np.ndarray, omega: np.ndarray) -> np.ndarray:

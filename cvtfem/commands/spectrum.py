@@ -106,6 +106,10 @@ def run(args: argparse.Namespace) -> int:
     rpm = res.speeds * 30 / np.pi
     print(f"{scene.title or scene.source}: spectrum at node {res.node}, {len(speeds)} speeds; map input "
           f"{res.map_input}")
+    top = max(res.freqs[-1], res.line_freqs.max(initial=0.0))
+    print(f"  modal basis up to {res.wmax / 2 / np.pi:.5g} Hz (--n-modes {args.n_modes})"
+          + ("" if top <= res.wmax else f"; lines up to {top / 2 / np.pi:.5g} Hz: above the basis only the residual "
+                                        "vectors carry them, raise --n-modes"))
     for j, k in enumerate(res.orders):
         m = int(np.argmax(res.order_amplitude[:, j]))
         print(f"  order {k:.5g}: largest response {res.order_amplitude[m, j]:.4g} per unit at {rpm[m]:.5g} rpm")
