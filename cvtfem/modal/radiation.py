@@ -30,24 +30,35 @@ class Face:
     N: sp.csr_matrix
 
 
-def rigid_annulus(n_dof: int, dofs, r_in: float, r_out: float, n_rings: int = 8, n_sectors: int = 16) -> Face:
-    """Panels (``n_rings`` x ``n_sectors``, equal radial and angular steps) of the annulus ``r_in < r < r_out`` of a
-    rigid disc whose DOFs ``dofs = (u3, theta1, theta2)`` (indices in 0..n_dof-1) carry its motion."""
+def annulus_panels(r_in: float, r_out: float, n_rings: int = 8, n_sectors: int = 16) -> tuple[np.ndarray, ...]:
+    """Panels of the annulus ``r_in < r < r_out``: ``n_rings`` x ``n_sectors`` with equal radial and angular steps.
+
+    Returns
+    -------
+    r, a, area : arrays (n_rings n_sectors,)
+        Panel point (radius m, angle rad) and area (m^2).  The point sits at the ring's RMS radius, so the panel
+        sum of ``S |w|^2`` is exact for ``w`` linear in x, y (rigid motion) once ``n_sectors >= 3``.
+    """
     if not 0 <= r_in < r_out or not np.isfinite(r_out):
         raise InputError("face radii", (r_in, r_out), "must satisfy 0 <= r_in < r_out (m)")
     if n_rings < 1 or n_sectors < 3:
         raise InputError("face panels", (n_rings, n_sectors), "must be >= 1 ring and >= 3 sectors")
     edges = np.linspace(r_in, r_out, n_rings + 1)
-    # panel point at the ring's RMS radius: the panel sum of |w|^2 is then exact for rigid motion (n_sectors >= 3)
-    r = np.sqrt((edges[1:] ** 2 + edges[:-1] ** 2) / 2)
-    rr = np.repeat(r, n_sectors)
-    aa = np.tile((np.arange(n_sectors) + 0.5) * 2 * np.pi / n_sectors, n_rings)
+    r = np.repeat(np.sqrt((edges[1:] ** 2 + edges[:-1] ** 2) / 2), n_sectors)
+    a = np.tile((np.arange(n_sectors) + 0.5) * 2 * np.pi / n_sectors, n_rings)
     area = np.repeat(np.pi * (edges[1:] ** 2 - edges[:-1] ** 2) / n_sectors, n_sectors)
+    return r, a, area
+
+
+def rigid_annulus(n_dof: int, dofs, r_in: float, r_out: float, n_rings: int = 8, n_sectors: int = 16) -> Face:
+    """The face ``r_in < r < r_out`` (:func:`annulus_panels`) of a rigid disc whose DOFs ``dofs = (u3, theta1,
+    theta2)`` (indices in 0..n_dof-1) carry its motion: ``w = u3 + r (theta1 sin a - theta2 cos a)``."""
+    r, a, area = annulus_panels(r_in, r_out, n_rings, n_sectors)
     u3, t1, t2 = (int(d) for d in dofs)
     p = len(area)
     rows = np.repeat(np.arange(p), 3)
     cols = np.tile([u3, t1, t2], p)
-    vals = np.column_stack([np.ones(p), rr * np.sin(aa), -rr * np.cos(aa)]).ravel()
+    vals = np.column_stack([np.ones(p), r * np.sin(a), -r * np.cos(a)]).ravel()
     return Face(area, sp.csr_matrix((vals, (rows, cols)), shape=(p, n_dof)))
 
 

@@ -139,3 +139,21 @@ def test_user_line_at_fixed_frequency_against_direct(scene, tmp_path):
         assert res.line_amplitude[i, 0] == pytest.approx(np.linalg.norm(y), rel=1e-3)
     assert sheave_faces(scene, model).area.sum() == pytest.approx(
         4 * np.pi * ((0.09**2) - (0.07 / 2) ** 2 / 2 - (0.075 / 2) ** 2 / 2), rel=1e-12)
+
+
+def test_pin_entry_force_is_the_face_normal_impulse_and_its_moment(scene):
+    """On each sheave: F = -(sin(alpha) e_r + facing cos(alpha) e3) at p = R e_r(angle), moment p x F (np.cross);
+    the two sheaves face each other, so the axial forces cancel and the chain pushes them apart."""
+    model = build_model(scene)
+    pin = PinEntry(np.full(N, 0.009), 0.06, 1e-3, 2.2)
+    f = pin_entry_force(scene, model, pin)
+    er = np.array([np.cos(pin.angle), np.sin(pin.angle), 0.0])
+    axial = []
+    for i, d in enumerate(scene.disk):
+        q = 6 * int(model.disks.nodes[i])
+        facing = 1.0 if d.facing == "+z" else -1.0
+        F = -(np.sin(d.cone_angle) * er + facing * np.cos(d.cone_angle) * np.array([0.0, 0.0, 1.0]))
+        Mo = np.cross(pin.radius * er, F)
+        assert np.allclose(f[q: q + 6], np.concatenate([F, Mo]), rtol=0, atol=1e-15)
+        axial.append(F[2])
+    assert axial[0] < 0 < axial[1] and abs(sum(axial)) < 1e-15  # fixed sheave faces +z, movable -z
