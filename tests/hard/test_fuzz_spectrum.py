@@ -47,7 +47,7 @@ def test_spectrum_on_mutated_presets(data):
 
 
 @pytest.mark.slow
-@settings(max_examples=500, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@settings(max_examples=250, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(data=st.data())
 def test_spectrum_on_mutated_presets_long(data):
     _check(data)
