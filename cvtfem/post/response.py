@@ -46,9 +46,10 @@ def plot_bode(res: Response, path: str | Path, title: str = "") -> Path:
     return path
 
 
-def _map(ax, fig, speeds, freqs, values, campbell, orders, label: str) -> None:  # noqa: ANN001 - matplotlib
+def _map(ax, fig, speeds, freqs, values, campbell, orders, label: str,  # noqa: ANN001 - matplotlib
+         whirls: tuple[str, ...]) -> None:
     """Colour map of ``values`` (s, w) in dB over rpm and Hz, order lines (white, labelled), Campbell natural
-    frequencies (black dashed) and the crossings of lateral and axial modes with the order lines (circles)."""
+    frequencies (black dashed) and the crossings of the modes of kinds ``whirls`` with the order lines (circles)."""
     rpm = speeds * 30 / np.pi
     hz = freqs / (2 * np.pi)
     db = 20 * np.log10(np.maximum(values, 1e-300))
@@ -59,7 +60,7 @@ def _map(ax, fig, speeds, freqs, values, campbell, orders, label: str) -> None: 
         for j in range(campbell.wd.shape[1]):
             ax.plot(rpm, campbell.wd[:, j] / (2 * np.pi), color="k", lw=0.7, ls="--")
         for c in campbell.crossings:
-            if c["whirl"] in ("forward", "backward", "axial"):
+            if c["whirl"] in whirls:
                 ax.plot(c["speed_rad_s"] * 30 / np.pi, c["frequency_rad_s"] / (2 * np.pi), "o", mfc="none",
                         mec="w", ms=7)
     for k in orders:
@@ -79,7 +80,7 @@ def plot_order_map(res: Response, path: str | Path, title: str = "") -> Path:
     plt = _pyplot()
     fig, ax = plt.subplots(figsize=(8.5, 6))
     _map(ax, fig, res.speeds, res.freqs, res.map, res.campbell, res.orders,
-         "|(u1, u2)| per unit force (dB re 1 m/N)")
+         "|(u1, u2)| per unit force (dB re 1 m/N)", ("forward", "backward"))
     ax.set_title(f"{title or 'order map'}: force x at node {res.force_node}, response at node {res.node}")
     fig.tight_layout()
     path = Path(path)
@@ -93,7 +94,7 @@ def plot_spectrum_map(res: Spectrum, path: str | Path, title: str = "") -> Path:
     plt = _pyplot()
     fig, ax = plt.subplots(figsize=(8.5, 6))
     _map(ax, fig, res.speeds, res.freqs, res.map, res.campbell, res.orders,
-         "|(u1, u2, u3)| per unit input (dB re 1 m)")
+         "|(u1, u2, u3)| per unit input (dB re 1 m)", ("forward", "backward", "axial"))
     ax.set_title(f"{title or 'order map'}\nresponse at node {res.node} to {res.map_input}", fontsize=10)
     fig.tight_layout()
     path = Path(path)
