@@ -357,7 +357,7 @@ def _lines(res: Spectrum, scene: Scene, model: RotorModel, basis: ModalBasis, ou
             sl = slice(col, col + len(w))
             wl[i, sl], al[i, sl] = w, np.linalg.norm(y[:, :3], axis=1)
             if face is not None:
-                el[i, sl] = erp_of(face, y[:, 3:], w)
+                el[i, sl] = _erp_of(face, y[:, 3:], w)
             col += len(w)
     weights = 10 ** (a_weighting_db(wl / (2 * np.pi)) / 10)
     return Spectrum(res.speeds, res.node, res.map_input, res.freqs, res.map, res.orders, res.order_amplitude,
@@ -365,6 +365,6 @@ def _lines(res: Spectrum, scene: Scene, model: RotorModel, basis: ModalBasis, ou
                     res.wmax)
 
 
-def erp_of(face: Face, w_normal: np.ndarray, omega: np.ndarray) -> np.ndarray:
+def _erp_of(face: Face, w_normal: np.ndarray, omega: np.ndarray) -> np.ndarray:
     """ERP (W) per line from the panels' complex normal displacements ``w_normal`` (lines, panels)."""
     return erp(Face(face.area, sp.identity(len(face.area), format="csr")), w_normal.T, omega)

@@ -53,7 +53,7 @@ def test_torque_ripple_moves_only_the_torsion_block(uniform):
 def test_lines_and_erp_against_direct_solves(scene, randomised):
     """At two speeds between the basis speeds (ends and middle of the sweep) every pin-entry line's response at the
     node and its ERP equal a direct sparse solve with the same force, the ERP from the closed form of rigid faces
-    (two per sheave, hub to rim), to 1e-3."""
+    (two per sheave, hub to rim), to 1e-5 (measured 6e-7 on the amplitudes; the issue asks 1e-3)."""
     pin, res = randomised
     model = build_model(scene)
     n = model.n_dof
@@ -70,15 +70,15 @@ def test_lines_and_erp_against_direct_solves(scene, randomised):
         s = SPEEDS[i]
         w = res.line_freqs[i]
         y = frf_direct(model.M, model.K, model.C, model.G, f, out, w, s)[..., 0] * (amp * s)[:, None]
-        assert np.allclose(res.line_amplitude[i], np.linalg.norm(y[:, :3], axis=1), rtol=1e-3, atol=0)
+        assert np.allclose(res.line_amplitude[i], np.linalg.norm(y[:, :3], axis=1), rtol=1e-5, atol=0)
         power = 0.0
         for j, d in enumerate(scene.disk):
             ri, ro = d.hub_diameter / 2, d.outer_diameter / 2
             u3, t1, t2 = y[:, 3 + 3 * j], y[:, 4 + 3 * j], y[:, 5 + 3 * j]
             power = power + 2 * 0.5 * RHO_AIR * C_AIR * w**2 * (
                 np.pi * (ro**2 - ri**2) * abs(u3) ** 2 + np.pi * (ro**4 - ri**4) / 4 * (abs(t1) ** 2 + abs(t2) ** 2))
-        assert np.allclose(res.line_erp[i], power, rtol=1e-3, atol=0)
-        assert res.erp_db[i] == pytest.approx(10 * np.log10(power.sum() / 1e-12), abs=1e-3)
+        assert np.allclose(res.line_erp[i], power, rtol=1e-5, atol=0)
+        assert res.erp_db[i] == pytest.approx(10 * np.log10(power.sum() / 1e-12), abs=1e-4)
 
 
 def test_randomised_chain_spreads_the_link_line(uniform, randomised):
