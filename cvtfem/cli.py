@@ -17,7 +17,7 @@ from cvtfem.commands.paths import check_output_args
 from cvtfem.errors import CvtfemError
 
 #: Command modules in ``cvtfem.commands``, in the order ``--help`` lists them.
-COMMANDS = ("scenes", "describe", "docs", "show", "run", "modes", "campbell", "response", "render", "sheave",
+COMMANDS = ("scenes", "describe", "docs", "show", "run", "modes", "campbell", "response", "spectrum", "render", "sheave",
             "periodic", "sweep", "report", "study", "bench", "demo")
 
 

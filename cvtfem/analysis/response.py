@@ -163,10 +163,11 @@ def scene_response(scene: Scene, unbalances: list[Unbalance], speeds: np.ndarray
     k = np.asarray(orders, dtype=float)
     if np.any(k <= 0) or not np.all(np.isfinite(k)):
         raise InputError("--orders", list(orders), "must be positive numbers (lines k x speed)")
-    basis = ModalBasis(model.M, model.K, model.C, model.G, f, n_modes)
+    basis = ModalBasis(model.M, model.K, model.C, model.G, f, n_modes, modes="sweep",
+                       basis_speeds=(speeds[0], (speeds[0] + speeds[-1]) / 2, speeds[-1]))
     freqs = np.linspace(0.0, k.max() * speeds[-1], n_freqs)
     amp, grid = np.zeros((len(speeds), len(k))), np.zeros((len(speeds), n_freqs))
-    for i, s in enumerate(speeds):  # |(u1, u2)| per unit force; one modal basis per speed
+    for i, s in enumerate(speeds):  # |(u1, u2)| per unit force; one modal basis for the sweep
         amp[i] = np.linalg.norm(basis.frf(out, k * s, s)[..., 0], axis=1)
         grid[i] = np.linalg.norm(basis.frf(out, freqs, s)[..., 0], axis=1)
     problem = ModalProblem(model.M, model.K, model.C, model.G, model.dof_kind)

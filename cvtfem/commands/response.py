@@ -39,7 +39,7 @@ def _unbalance(text: str):
     return u
 
 
-def _orders(text: str | None) -> tuple[float, ...]:
+def parse_orders(text: str | None) -> tuple[float, ...]:
     from cvtfem.errors import InputError
 
     if not text:
@@ -69,7 +69,7 @@ def run(args: argparse.Namespace) -> int:
         raise InputError("--n-modes", args.n_modes, "must be >= 1")
     unbalances = [_unbalance(u) for u in args.unbalance]
     scene = load_scene(args.scene)
-    res = scene_response(scene, unbalances, speeds, args.node, _orders(args.orders), args.force_node,
+    res = scene_response(scene, unbalances, speeds, args.node, parse_orders(args.orders), args.force_node,
                          n_modes=args.n_modes)
     rpm = res.speeds * 30 / np.pi
     i = int(np.argmax(res.major))

@@ -171,6 +171,16 @@ def frf_direct(M, K, C, G, inputs, outputs: OutputMap, omegas, speed: float = 0.
 #: (1e-10 dropped directions that carried 1e-3 of a Friswell FRF: keep all but round-off).
 COLUMN_RTOL = 1e-8
 GRAM_RTOL = 1e-13
+#: Shift ``a = RIGID_SHIFT max(diag K) / max(diag M)`` of the static correction ``(K + a M)^{-1} F`` when K is singular
+#: (rigid-body modes in the excited blocks): the correction then carries the rigid-body response, which the
+#: eigen-solvers drop, with the elastic modes' part off by a relative ``a / w_j^2``.
+RIGID_SHIFT = 1e-12
+#: A reduced block whose eigenvector matrix has a reciprocal condition number below this is (nearly) defective and
+#: is solved by batched reduced solves instead of its modes.
+DEFECTIVE_RCOND = 1e-10
+#: Singular values of a reduced stiffness below this fraction of the largest are rigid-body directions: such a block
+#: (a Jordan pair at lambda = 0) is solved by batched reduced solves too.
+RIGID_RCOND = 1e-9
 
 
 def _unit_columns(X: np.ndarray, M) -> np.ndarray:
@@ -195,15 +205,20 @@ class ModalBasis:
         to first order in w): the reduced model is exact at ``w = 0`` and keeps the quasi-static, damping and
         gyroscopic parts of the neglected modes (stiffness-proportional damping gives even far modes a
         response ``~ beta w`` out of phase, which ``K^{-1} F`` alone misses).
-    modes : {"complex", "rest"}
+    modes : {"complex", "rest", "sweep"}
         "complex": per speed, the right and the left complex modes of ``(M, K, C, speed G)`` (the left ones
         as right modes of the transposed matrices).  A Galerkin projection on a space holding both keeps
         each retained mode's eigenvalue and residue ``x y^H / (y^H (2 lam M + D) x)`` exactly: the modal
         FRF differs from the direct one only by the neglected modes.  "rest": the undamped modes of
         ``((K + K^T)/2, M)`` at rest, one eigen-solve for every speed (the classic pseudo-modal method;
-        exact for ``C = G = 0``, approximate when G or non-proportional C couple the modes).
+        exact for ``C = G = 0``, approximate when G or non-proportional C couple the modes).  "sweep": one
+        basis for every speed, spanning the right and left complex modes at ``basis_speeds`` (a global basis for
+        the speed range: exact at those speeds like "complex", close to it between them because the modes turn
+        smoothly with speed); two eigen-solves per basis speed instead of per speed.
     method : str
         Eigen backend of :class:`~cvtfem.modal.eigen.ModalProblem`.
+    basis_speeds : array, rad/s
+        Speeds whose modes span the "sweep" basis (e.g. the ends and the middle of the sweep).
 
     Attributes
     ----------
@@ -212,28 +227,41 @@ class ModalBasis:
     """
 
     def __init__(self, M, K, C, G, inputs, n_modes: int, residual: bool = True, modes: str = "complex",
-                 method: str = "auto") -> None:
+                 method: str = "auto", basis_speeds=()) -> None:
         M, K, C, G = _check(M, K, C, G)
         F = _inputs(inputs, M.shape[0])
         if n_modes < 1:
             raise InputError("n_modes", n_modes, "must be >= 1")
-        if modes not in ("complex", "rest"):
-            raise InputError("modes", modes, "must be 'complex' or 'rest'")
+        if modes not in ("complex", "rest", "sweep"):
+            raise InputError("modes", modes, "must be 'complex', 'rest' or 'sweep'")
+        self.basis_speeds = np.atleast_1d(np.asarray(basis_speeds, dtype=float))
+        if modes == "sweep" and (len(self.basis_speeds) < 1 or not np.all(np.isfinite(self.basis_speeds))):
+            raise InputError("basis_speeds", self.basis_speeds.tolist(), "must be one or more finite speeds (rad/s) "
+                             "for modes='sweep'")
         self.dofs = dofs = reached(M, K, C, G, F)
         self.mats = [X[dofs][:, dofs].tocsr() for X in (M, K, C, G)]
         self.F = F[dofs]
+        _, label = connected_components(abs(self.mats[0]) + abs(self.mats[1]) + abs(self.mats[2]) + abs(self.mats[3]),
+                                        directed=False)
+        self.blocks = [np.flatnonzero(label == b) for b in np.unique(label)]
         self.n_modes, self.method = min(n_modes, len(dofs)), method
         self.kind = np.full(len(dofs), 2)  # no whirl pairs needed: labels are not used here
         self.modes = "rest" if self.mats[2].nnz == 0 and self.mats[3].nnz == 0 else modes
         self.static = self._static() if residual else None
         self._reduced: dict[float, tuple] = {}
+        self._poles: tuple | None = None
 
     def _static(self) -> np.ndarray:
+        K, M = self.mats[1].tocsc(), self.mats[0].tocsc()
         try:
-            lu = spla.splu(self.mats[1].tocsc())
-        except RuntimeError as err:
-            raise NumericalError(f"stiffness singular in the excited blocks ({err}): no static correction "
-                                 "(use residual=False)", component="modal.forced") from None
+            lu = spla.splu(K)
+        except RuntimeError:  # free rigid-body motion (e.g. an unsupported spin): shift, K + a M
+            scale = float(np.max(np.abs(K.diagonal())) / np.max(np.abs(M.diagonal())))
+            try:
+                lu = spla.splu((K + RIGID_SHIFT * scale * M).tocsc())
+            except RuntimeError as err:
+                raise NumericalError(f"stiffness singular in the excited blocks even shifted ({err}): no static "
+                                     "correction (use residual=False)", component="modal.forced") from None
         X = np.hstack([lu.solve(self.F.real), lu.solve(self.F.imag)])
         return np.hstack([X] + [lu.solve(A @ X) for A in (self.mats[0], self.mats[2], self.mats[3]) if A.nnz])
 
@@ -249,55 +277,134 @@ class ModalBasis:
         left = ModalProblem(M.T, K.T, C.T, G.T, self.kind, self.method).solve(speed, self.n_modes)
         return [right.shapes, left.shapes], float(max(right.wn.max(), left.wn.max()))
 
-    def reduced(self, speed: float) -> tuple[np.ndarray, ...]:
-        """``(V, K_r, D_r, F_r, wmax)`` at ``speed``: M-orthonormal basis V (dofs x r), reduced stiffness and
-        damping ``V^T (C + speed G) V``, forces; wmax (rad/s) is the highest retained natural frequency."""
-        key = 0.0 if self.modes == "rest" else float(speed)
+    def _sweep_shapes(self) -> tuple[list[np.ndarray], float]:
+        """Right and left complex modes at every basis speed, and the lowest of their highest |lambda|."""
+        shapes, tops = [], []
+        for s in self.basis_speeds:
+            group, top = self._shapes(float(s))
+            shapes += group
+            tops.append(top)
+        return shapes, min(tops)
+
+    def _blocks(self, key: float) -> list[tuple]:
+        """Per independent DOF block (connected component of the pattern among the reached DOFs): ``(rows, V,
+        K_r, C_r, G_r, F_r)`` with V an M-orthonormal basis of the block (kept apart, so the reduced matrices have
+        no round-off coupling between blocks), and the highest retained natural frequency."""
         if key not in self._reduced:
-            shapes, wmax = self._shapes(key)
-            M, K, C, G = self.mats
+            shapes, wmax = self._sweep_shapes() if self.modes == "sweep" else self._shapes(key)
             groups = [np.hstack([X.real, X.imag]) for X in shapes]
             if self.static is not None:
                 groups.append(self.static)
-            B = np.hstack([_unit_columns(X, M) for X in groups])
-            lam, U = sla.eigh(B.T @ (M @ B))
-            keep = lam > GRAM_RTOL * lam.max()  # drop dependent columns (both halves of a circular pair, ...)
-            V = B @ (U[:, keep] / np.sqrt(lam[keep]))  # M-orthonormal
+            blocks = []
+            for rows in self.blocks:
+                M, K, C, G = (X[rows][:, rows] for X in self.mats)
+                B = np.hstack([_unit_columns(X[rows], M) for X in groups])
+                if B.shape[1] == 0:
+                    continue
+                lam, U = sla.eigh(B.T @ (M @ B))
+                keep = lam > GRAM_RTOL * lam.max()  # drop dependent columns (both halves of a circular pair, ...)
+                V = B @ (U[:, keep] / np.sqrt(lam[keep]))  # M-orthonormal
+                blocks.append((rows, V, V.T @ (K @ V), V.T @ (C @ V), V.T @ (G @ V), V.T @ self.F[rows]))
             self._reduced = {} if self.modes == "complex" else self._reduced  # keep one speed
-            self._reduced[key] = (V, V.T @ (K @ V), V.T @ (C @ V), V.T @ (G @ V), V.T @ self.F, wmax)
-        V, Kr, Cr, Gr, Fr, wmax = self._reduced[key]
-        return V, Kr, Cr + speed * Gr, Fr, wmax
+            self._reduced[key] = (blocks, wmax)
+        return self._reduced[key]
+
+    def reduced(self, speed: float) -> tuple[np.ndarray, ...]:
+        """``(V, K_r, D_r, F_r, wmax)`` at ``speed``: M-orthonormal basis V (dofs x r, block-diagonal over the
+        independent blocks), reduced stiffness and damping ``V^T (C + speed G) V``, forces; wmax (rad/s) is the
+        highest retained natural frequency."""
+        blocks, wmax = self._blocks(float(speed) if self.modes == "complex" else 0.0)
+        V = sla.block_diag(*(b[1] for b in blocks))
+        order = np.concatenate([b[0] for b in blocks])
+        Vd = np.zeros((len(self.dofs), V.shape[1]))
+        Vd[order] = V
+        return (Vd, sla.block_diag(*(b[2] for b in blocks)),
+                sla.block_diag(*(b[3] + speed * b[4] for b in blocks)), np.vstack([b[5] for b in blocks]), wmax)
 
     def wmax(self, speed: float = 0.0) -> float:
         """Highest natural frequency in the basis at ``speed``, rad/s (modal FRFs are meant below it)."""
-        return self.reduced(speed)[4]
+        return self._blocks(float(speed) if self.modes == "complex" else 0.0)[1]
 
-    def frf(self, outputs: OutputMap, omegas, speed: float = 0.0) -> np.ndarray:
-        """Receptances (w, p, m) by summing the complex modes of the reduced state-space matrix
-        ``A = [[0, I], [-K_r, -D_r]] = Phi diag(lam) Phi^{-1}`` (see :func:`frf_direct`)."""
-        w = _omegas(omegas)
-        V, Kr, Dr, Fr, _ = self.reduced(speed)
-        r = V.shape[1]
-        A = np.zeros((2 * r, 2 * r))
-        A[:r, r:] = np.eye(r)
-        A[r:, :r], A[r:, r:] = -Kr, -Dr
-        lam, Phi = sla.eig(A)
-        try:
+    def poles(self, speed: float) -> list[tuple]:
+        """Per block at ``speed``: ``("modal", lam, X, L)`` from the reduced state-space matrix
+        ``A = [[0, I], [-K_r, -D_r]] = Phi diag(lam) Phi^{-1}``, the modes' displacement shapes ``X = V Phi_q``
+        (dofs x 2r) and participations ``L = Phi^{-1} [0; F_r]`` (2r x m); or, for a block with a rigid-body mode
+        (K_r singular to ``RIGID_RCOND``: a Jordan pair at 0, or two nearly equal poles whose modal sum cancels
+        badly) or a defective Phi, ``("direct", X, Kr, Dr, Fr)`` with ``X = V`` for batched reduced solves.
+        The last speed's are kept."""
+        if self._poles is not None and self._poles[0] == speed:
+            return self._poles[1]
+        blocks, _ = self._blocks(float(speed) if self.modes == "complex" else 0.0)
+        out = []
+        for rows, V, Kr, Cr, Gr, Fr in blocks:
+            r = V.shape[1]
+            X = np.zeros((len(self.dofs), r))
+            X[rows] = V
+            A = np.zeros((2 * r, 2 * r))
+            A[:r, r:] = np.eye(r)
+            A[r:, :r], A[r:, r:] = -Kr, -(Cr + speed * Gr)
+            sv = np.linalg.svd(Kr, compute_uv=False)
+            if sv.min() < RIGID_RCOND * sv.max():  # a rigid-body mode: no modal sum
+                out.append(("direct", X, Kr, Cr + speed * Gr, Fr))
+                continue
+            lam, Phi = sla.eig(A)
+            if 1.0 / np.linalg.cond(Phi) < DEFECTIVE_RCOND:
+                out.append(("direct", X, Kr, Cr + speed * Gr, Fr))
+                continue
             L = sla.solve(Phi, np.vstack([np.zeros_like(Fr), Fr]))  # (2r, m) modal participations
-        except sla.LinAlgError:
-            raise NumericalError(f"reduced state matrix defective at speed {speed:g} rad/s",
-                                 component="modal.forced") from None
-        X = V @ Phi[:r]  # (dofs, 2r)
-        Dq, Vq = outputs.D[:, self.dofs] @ X, outputs.V[:, self.dofs] @ X
-        g = 1.0 / (1j * w[:, None] - lam[None, :])  # (w, 2r)
-        return (np.einsum("pk,wk,km->wpm", Dq, g, L)
-                + 1j * w[:, None, None] * np.einsum("pk,wk,km->wpm", Vq, g, L))
+            out.append(("modal", lam, X @ Phi[:r], L))
+        self._poles = (speed, out)
+        return out
+
+    def frf(self, outputs: OutputMap, omegas, speed: float = 0.0, columns=None) -> np.ndarray:
+        """Receptances (w, p, m), per block by summing the complex modes of the reduced state-space matrix
+        (:meth:`poles`), ``H(w) = (D + i w V) X (i w - lam)^{-1} L``, or by batched reduced solves
+        ``V (K_r - w^2 + i w D_r)^{-1} F_r``; ``columns`` selects inputs (default all)."""
+        w = _omegas(omegas)
+        cols = slice(None) if columns is None else columns
+        m = self.F[:, cols].shape[1]
+        D, Vo = outputs.D[:, self.dofs], outputs.V[:, self.dofs]
+        H = np.zeros((len(w), D.shape[0], m), dtype=complex)
+        for part in self.poles(speed):
+            if part[0] == "modal":
+                _, lam, X, L = part
+                gL = L[None, :, cols] / (1j * w[:, None, None] - lam[None, :, None])  # (w, 2r, m)
+            else:
+                _, X, Kr, Dr, Fr = part
+                if not np.any(Fr[:, cols]):
+                    continue
+                Z = Kr[None] - (w * w)[:, None, None] * np.eye(len(Kr)) + 1j * w[:, None, None] * Dr[None]
+                gL = _batched_solve(Z, Fr[:, cols], w, speed)
+            Dq, Vq = D @ X, Vo @ X
+            H += Dq[None] @ gL
+            if np.any(Vq):
+                H += 1j * w[:, None, None] * (Vq[None] @ gL)
+        return H
+
+
+def _batched_solve(Z: np.ndarray, F: np.ndarray, w: np.ndarray, speed: float) -> np.ndarray:
+    """``Z[i]^{-1} F`` for a stack Z (w, r, r) of a block with a rigid-body mode.  At w = 0 Z is singular: the
+    static solution orthogonal to the rigid-body modes when F does not load them (pseudo-inverse, singular values
+    below ``RIGID_RCOND`` of the largest dropped), else a NumericalError (no steady state)."""
+    out = np.empty((len(Z),) + F.shape, dtype=complex)
+    moving = w > 0
+    try:
+        out[moving] = np.linalg.solve(Z[moving], np.broadcast_to(F, (int(moving.sum()),) + F.shape))
+    except np.linalg.LinAlgError:
+        raise NumericalError(f"reduced dynamic stiffness singular at speed {speed:g} rad/s", component="modal.forced"
+                             ) from None
+    for i in np.flatnonzero(~moving):
+        out[i] = np.linalg.pinv(Z[i], rcond=RIGID_RCOND) @ F
+        if np.linalg.norm(Z[i] @ out[i] - F) > 1e-6 * np.linalg.norm(F):
+            raise NumericalError(f"a static (w = 0) load on a free rigid-body mode at speed {speed:g} rad/s has no "
+                                 "steady state", component="modal.forced")
+    return out
 
 
 def frf_modal(M, K, C, G, inputs, outputs: OutputMap, omegas, speed: float = 0.0, n_modes: int = 20,
-              residual: bool = True, modes: str = "complex", method: str = "auto") -> np.ndarray:
+              residual: bool = True, modes: str = "complex", method: str = "auto", basis_speeds=()) -> np.ndarray:
     """Receptances (w, p, m) by modal superposition (one-shot :class:`ModalBasis`)."""
-    return ModalBasis(M, K, C, G, inputs, n_modes, residual, modes, method).frf(outputs, omegas, speed)
+    return ModalBasis(M, K, C, G, inputs, n_modes, residual, modes, method, basis_speeds).frf(outputs, omegas, speed)
 
 
 def unbalance_response(M, K, C, G, load, outputs: OutputMap, speeds) -> np.ndarray:
