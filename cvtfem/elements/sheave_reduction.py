@@ -17,6 +17,7 @@ import numpy as np
 import scipy.linalg as sla
 import scipy.sparse.linalg as spla
 
+from cvtfem.blas import arpack_start
 from cvtfem.elements.sheave_solid import HarmonicSheave
 from cvtfem.errors import InputError, NumericalError
 
@@ -112,7 +113,7 @@ def craig_bampton(model: HarmonicSheave, n_modes: int | None, ring_radius: float
         if n_modes >= len(interior):
             raise InputError("n_modes", n_modes, f"must be fewer than the {len(interior)} interior DOFs")
         try:
-            lam, phi = spla.eigsh(Kii, k=n_modes, M=Mii, sigma=0.0, which="LM")
+            lam, phi = spla.eigsh(Kii, k=n_modes, M=Mii, sigma=0.0, which="LM", v0=arpack_start(Kii.shape[0]))
         except (spla.ArpackNoConvergence, RuntimeError) as exc:
             raise NumericalError(f"Craig-Bampton: fixed-interface modes did not converge ({exc})") from None
         order = np.argsort(lam)

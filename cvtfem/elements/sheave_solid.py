@@ -27,6 +27,7 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
+from cvtfem.blas import arpack_start
 from cvtfem.errors import InputError, NumericalError
 
 
@@ -419,7 +420,7 @@ def _lowest_modes(K, M, free, count, definite):  # noqa: ANN001, ANN202
     scale = abs(Kf.diagonal()).max() / abs(Mf.diagonal()).max()
     sigma = 0.0 if definite else -1e-6 * scale
     try:
-        lam, vec = spla.eigsh(Kf, k=count, M=Mf, sigma=sigma, which="LM")
+        lam, vec = spla.eigsh(Kf, k=count, M=Mf, sigma=sigma, which="LM", v0=arpack_start(Kf.shape[0]))
     except (spla.ArpackNoConvergence, RuntimeError) as exc:
         raise NumericalError(f"sheave modes: ARPACK did not converge ({exc})") from None
     order = np.argsort(lam)
@@ -442,7 +443,7 @@ def _gyroscopic_modes(K, M, G, count):  # noqa: ANN001, ANN202
 
     op = spla.LinearOperator((2 * n, 2 * n), matvec=apply, dtype=float)
     try:
-        mu, vec = spla.eigs(op, k=k, which="LM")
+        mu, vec = spla.eigs(op, k=k, which="LM", v0=arpack_start(2 * n))
     except (spla.ArpackNoConvergence, RuntimeError) as exc:
         raise NumericalError(f"sheave travelling waves: ARPACK did not converge ({exc})") from None
     lam = 1.0 / mu

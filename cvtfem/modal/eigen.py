@@ -28,6 +28,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 from scipy.sparse.csgraph import connected_components
 
+from cvtfem.blas import arpack_start
 from cvtfem.errors import InputError, NumericalError
 from cvtfem.modal.whirl import circularize, classify, mac
 
@@ -324,7 +325,8 @@ class ModalProblem:
         k = min(2 * n_modes + 6, 2 * n - 2)
         A = spla.LinearOperator((2 * n, 2 * n), matvec=op, dtype=float)
         try:
-            mu, Z = spla.eigs(A, k=k, which="LM", ncv=min(2 * n, 2 * k + 1), tol=1e-12, maxiter=ARPACK_RESTARTS)
+            mu, Z = spla.eigs(A, k=k, which="LM", ncv=min(2 * n, 2 * k + 1), tol=1e-12, maxiter=ARPACK_RESTARTS,
+                              v0=arpack_start(2 * n))
         except spla.ArpackNoConvergence as err:
             raise NumericalError(f"ARPACK did not converge at Omega = {speed:g} rad/s ({err})",
                                  component="modal.sparse") from None
@@ -337,7 +339,7 @@ class ModalProblem:
         k = min(n_modes + 4, M.shape[0] - 1)
         try:
             w2, X = spla.eigsh(K.tocsc(), k=k, M=M.tocsc(), sigma=-s * s, which="LM", tol=1e-12,
-                               maxiter=ARPACK_RESTARTS)
+                               maxiter=ARPACK_RESTARTS, v0=arpack_start(M.shape[0]))
         except spla.ArpackNoConvergence as err:
             raise NumericalError(f"ARPACK (Lanczos) did not converge ({err})", component="modal.sparse") from None
         return 1j * np.sqrt(np.clip(w2, 0.0, None)), X.astype(complex)
