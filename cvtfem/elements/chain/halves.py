@@ -32,9 +32,9 @@ twist, joint damping (1.80) with the exact gradient, contact normal damping whil
 tension proxies, and regularised Coulomb on the rolling slip of every contact (digest proposal), all
 through :mod:`cvtfem.elements.contact.friction`.
 
-**Backends.** With ``use_numba`` the plate pass of :meth:`ChainA5.forces` runs in the compiled
-``plates_kernel`` (plate ends as virtual whole pins); the numpy pass here is its tested twin.  The
-Jacobian is coloured central differences of the forces on the 5-pin stencil.
+**Backends.** With ``use_numba`` :meth:`ChainA5.forces` runs the whole pass in the compiled
+:mod:`halves_kernel` (plate ends as virtual whole pins, the per-plate law of ``plates_kernel``); the numpy
+pass here is its tested twin.  The Jacobian is coloured central differences of the forces on the 5-pin stencil.
 
 **A2** (:class:`CoupledHalvesA2`): the whole pins of :class:`ChainA1` with two half-pin end points
 per pin end, ``U(xi_e) +- h_pin tau_p`` (1.210), and the exact virtual work of a force there.
@@ -47,6 +47,7 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.linalg import splu
 
+from cvtfem.elements.chain import halves_kernel as HK
 from cvtfem.elements.chain import plates as P
 from cvtfem.elements.chain import plates_kernel as PK
 from cvtfem.elements.chain.asymmetric import (_M_PAR, _M_PERP, ChainA1, _cross, _dot, _kx, shape_functions,
@@ -129,8 +130,8 @@ class ChainA5:
     closed : bool
         Closed loop or open segment (link ``n-1`` absent).
     use_numba : bool
-        :meth:`forces` runs the plate pass in the compiled ``plates_kernel`` (each plate end mapped to a
-        virtual whole pin at ``xi = 0``); the numpy pass is its tested reference twin.
+        :meth:`forces` runs in the compiled :mod:`halves_kernel` (each plate end mapped to a virtual whole
+        pin at ``xi = 0``); the numpy pass is its tested reference twin.
     """
 
     def __init__(self, *, pitch, plate_offset, n_plates, plate_stiffness, plate_bending_stiffness,
@@ -229,8 +230,9 @@ class ChainA5:
         self.mass_matrix = self._mass_matrix()
         self._lu = splu(self.mass_matrix.tocsc())
         self.jac_sparsity = self._jac_sparsity()
-        self.backend = "numba" if use_numba and PK.HAVE_NUMBA else "numpy"
+        self.backend = "numba" if use_numba and HK.HAVE_NUMBA else "numpy"
         self._kmodel = {"A4": PK.A4, "A3": PK.A3_DROP, "A3-keep": PK.A3_KEEP}[plate_model]
+        self._kernel_args = HK.pack(self, CONTACTS)
 
     # ------------------------------------------------------------------ layout
     def _dof_index(self) -> np.ndarray:
@@ -332,12 +334,8 @@ class ChainA5:
         return np.bincount(self.axis_link[0], gh[0], n) + np.bincount(self.axis_link[1], gh[1], n)
 
     # ------------------------------------------------------------------ evaluation
-    def _evaluate(self, q: np.ndarray, v: np.ndarray | None, terms=TERMS, fast: bool = False) -> dict:
-        """Energies ``Pi`` (J) and ``Phi`` (W) per term, ``dPi/dq``, ``dPhi/dv`` and the friction forces (vectors).
-
-        ``fast``: the plate pass in the compiled kernel, which returns elastic plus damping forces together
-        (both land in ``grad``) and no plate energies.
-        """
+    def _evaluate(self, q: np.ndarray, v: np.ndarray | None, terms=TERMS) -> dict:
+        """Energies ``Pi`` (J) and ``Phi`` (W) per term, ``dPi/dq``, ``dPhi/dv`` and the friction forces (vectors)."""
         n, l = self.n_pins, self.l
         u, w, qp = self.split(np.asarray(q, float))
         have_v = v is not None
@@ -361,7 +359,7 @@ class ChainA5:
             self._half_bending(u, vu, fr, thd_h, Pi, Phi, gu, gth_h, du, dth_h)
         T_link = np.zeros(n)
         if "plates" in terms or "twist" in terms:
-            gl, dl = self._links(u, w, qp, vu, vw, vq, terms, Pi, Phi, out, fast)
+            gl, dl = self._links(u, w, qp, vu, vw, vq, terms, Pi, Phi, out)
             T_link = out.get("chain.link_tension", T_link)
             self._scatter_links(gl, gu, gw, gq)
             self._scatter_links(dl, du, dw, dq)
@@ -421,7 +419,7 @@ class ChainA5:
             du[:, 2:] += self.beta_bend * mb.transpose(1, 0, 2, 3)
             dth_h -= self.beta_bend * np.sum(_dot(_kx(U), mb), 0)
 
-    def _links(self, u, w, qp, vu, vw, vq, terms, Pi, Phi, out, fast=False):
+    def _links(self, u, w, qp, vu, vw, vq, terms, Pi, Phi, out):
         """Per-plate strains at the variable stations (1.211)-(1.212), (1.219)-(1.220), the plate law, twist.
 
         Returns the link-local gradients ``dPi/dy``, ``dPhi/dy'`` ``(n, 22)`` over (half - of ``e``, half + of
@@ -435,9 +433,7 @@ class ChainA5:
                              vu[1][:, nx].transpose(1, 0, 2).reshape(-1, 8), vw[1][:, nx].T,
                              vq[:, None], vq[nx][:, None]], 1)
         g_loc, d_loc = np.zeros((self.n_pins, 22)), np.zeros((self.n_pins, 22))
-        if "plates" in terms and fast:
-            g_loc -= self._plate_kernel_forces(y, yd, out)
-        elif "plates" in terms:
+        if "plates" in terms:
             eps, J = self._plate_strains(um, up, wm, wp, qp, qp[nx])
             c, c1, c2, wgt = self.plate_c, self.plate_c1, self.plate_c2, self.plate_w
             if self.plate_model == "A4":
@@ -510,57 +506,6 @@ class ChainA5:
             J[..., 20 + b] += 2 / l * dx                                  # xi_b grows with q (1.212)
             J[..., o + 8] -= 2 / l * dx                                   # and falls with w_0 of the half
         return eps, J
-
-    def _plate_kernel_forces(self, y: np.ndarray, yd: np.ndarray, out: dict) -> np.ndarray:
-        """Plate forces on the link-local coordinates ``(n, 22)`` from ``plates_kernel``, elastic plus damping.
-
-        Each plate end ``a`` becomes a virtual whole pin at ``xi = 0``: ``u_0 = U_perp(xi_a)``, ``u_1 = dU_perp/dxi``,
-        ``u_2 = u_3 = 0``, ``w_0 = U_par(xi_a)``, ``w_1`` (the same strains); forces map back through this
-        linear map and its station derivatives (``xi_a`` moves with ``q`` and ``w_0``, (1.212)).
-        """
-        l, n, K = self.l, self.n_pins, self.kmax
-        qv, qvd = np.zeros((n, K, 20)), np.zeros((n, K, 20))
-        maps = []
-        for b in range(2):
-            o = 10 * b
-            u, ud = y[:, o:o + 8].reshape(n, 4, 2), yd[:, o:o + 8].reshape(n, 4, 2)
-            w, wd = y[:, o + 8:o + 10], yd[:, o + 8:o + 10]
-            xi = 2 / l * (y[:, 20 + b][:, None] - w[:, 0][:, None] + self.plate_d)
-            xid = 2 / l * (yd[:, 20 + b] - wd[:, 0])[:, None]
-            H, Hp, Hpp = shape_functions(xi, l), shape_slopes(xi, l), shape_curvatures(xi, l)
-            u1 = np.einsum("iek,eic->ekc", Hp, u)
-            du1 = np.einsum("iek,eic->ekc", Hpp, u)
-            qv[..., o:o + 2] = np.einsum("iek,eic->ekc", H, u)
-            qv[..., o + 2:o + 4] = u1
-            qv[..., o + 8] = w[:, 0][:, None] + w[:, 1][:, None] * xi
-            qv[..., o + 9] = w[:, 1][:, None]
-            qvd[..., o:o + 2] = np.einsum("iek,eic->ekc", H, ud) + u1 * xid[..., None]
-            qvd[..., o + 2:o + 4] = np.einsum("iek,eic->ekc", Hp, ud) + du1 * xid[..., None]
-            qvd[..., o + 8] = wd[:, 0][:, None] + wd[:, 1][:, None] * xi + w[:, 1][:, None] * xid
-            qvd[..., o + 9] = wd[:, 1][:, None]
-            maps.append((H, Hp, xi, u1, du1, w))
-        shp = (n * K,)
-        c, c1, c2 = self.plate_c.ravel(), self.plate_c1.ravel(), self.plate_c2.ravel()
-        T, M, st = np.zeros(shp), np.zeros(shp + (2,)), np.zeros(shp, np.int64)
-        Qf = np.zeros(shp + (20,))
-        PK.plate_forces_kernel(qv.reshape(-1, 20), qvd.reshape(-1, 20), np.zeros(shp), np.full(shp, l),
-                               np.repeat(self.L, K), c, c1, c2, np.full(shp, self.plate_h), self.beta_ext,
-                               self.beta_shear, self._kmodel, Qf, T, M, st)
-        Qv = Qf.reshape(n, K, 20) * self.plate_w[..., None]
-        Q = np.zeros((n, 22))
-        for b, (H, Hp, xi, u1, du1, w) in enumerate(maps):
-            o = 10 * b
-            Q0, Q1, Qw0, Qw1 = Qv[..., o:o + 2], Qv[..., o + 2:o + 4], Qv[..., o + 8], Qv[..., o + 9]
-            Q[:, o:o + 8] = (np.einsum("iek,ekc->eic", H, Q0) + np.einsum("iek,ekc->eic", Hp, Q1)).reshape(n, 8)
-            S = np.sum(Q0 * u1, -1) + np.sum(Q1 * du1, -1) + Qw0 * w[:, 1][:, None]       # force on xi
-            Q[:, o + 8] = Qw0.sum(1) - 2 / l * S.sum(1)
-            Q[:, o + 9] = (Qw0 * xi + Qw1).sum(1)
-            Q[:, 20 + b] = 2 / l * S.sum(1)
-        Tw = T.reshape(n, K) * self.plate_w
-        out["chain.plate_tension"] = Tw.ravel()
-        out["chain.plate_state"] = np.where(self.plate_w > 0, st.reshape(n, K), P.SLACK).ravel().astype(float)
-        out["chain.link_tension"] = Tw.sum(1)
-        return Q
 
     def _scatter_links(self, g: np.ndarray, gu: np.ndarray, gw: np.ndarray, gq: np.ndarray) -> None:
         """Add link-local ``(n, 22)`` gradients to the half and pack arrays."""
@@ -656,8 +601,10 @@ class ChainA5:
         return self._evaluate(q, v)["friction"]
 
     def forces(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
-        """``Q = -dPi/dq - dPhi/dv + Q_friction`` in one pass (plate pass compiled with ``use_numba``)."""
-        r = self._evaluate(q, v, fast=self.backend == "numba")
+        """``Q = -dPi/dq - dPhi/dv + Q_friction`` in one pass (compiled :func:`halves_kernel.forces` with ``use_numba``)."""
+        if self.backend == "numba":
+            return HK.forces(np.asarray(q, float), np.asarray(v, float), *self._kernel_args)
+        r = self._evaluate(q, v)
         return r["friction"] - r["grad"] - r["gradv"]
 
     def outputs(self, q: np.ndarray, v: np.ndarray | None = None) -> dict[str, np.ndarray]:
