@@ -34,7 +34,8 @@ through :mod:`cvtfem.elements.contact.friction`.
 
 **Backends.** With ``use_numba`` :meth:`ChainA5.forces` runs the whole pass in the compiled
 :mod:`halves_kernel` (plate ends as virtual whole pins, the per-plate law of ``plates_kernel``); the numpy
-pass here is its tested twin.  The Jacobian is coloured central differences of the forces on the 5-pin stencil.
+pass here is its tested twin.  The Jacobian is assembled element by element in the kernel (exact velocity blocks of the links, differences
+of single links and pins), or coloured central differences of the forces on the 5-pin stencil.
 
 **A2** (:class:`CoupledHalvesA2`): the whole pins of :class:`ChainA1` with two half-pin end points
 per pin end, ``U(xi_e) +- h_pin tau_p`` (1.210), and the exact virtual work of a force there.
@@ -233,6 +234,7 @@ class ChainA5:
         self.backend = "numba" if use_numba and HK.HAVE_NUMBA else "numpy"
         self._kmodel = {"A4": PK.A4, "A3": PK.A3_DROP, "A3-keep": PK.A3_KEEP}[plate_model]
         self._kernel_args = HK.pack(self, CONTACTS)
+        self._positions = None                  # CSR positions of the compiled Jacobian's blocks, at first use
 
     # ------------------------------------------------------------------ layout
     def _dof_index(self) -> np.ndarray:
@@ -660,8 +662,34 @@ class ChainA5:
         pat.sort_indices()
         return pat
 
-    def jacobian(self, q: np.ndarray, v: np.ndarray, step: float = 1e-7,
-                 damping: bool = True) -> tuple[sp.csr_matrix, sp.csr_matrix | None]:
+    def jacobian(self, q: np.ndarray, v: np.ndarray, damping: bool = True,
+                 scheme: str = "forward") -> tuple[sp.csr_matrix, sp.csr_matrix | None]:
+        """``(dQ/dq, dQ/dv)`` of :meth:`forces` on :attr:`jac_sparsity`; ``damping=False`` returns None for ``dQ/dv``.
+
+        Compiled backend: element by element (:func:`halves_kernel.jacobian`): each link's velocity block exact,
+        its coordinate block by ``scheme`` ("forward", step ``sqrt(eps)``, or "central", step ``1e-7``, relative to
+        ``max(|x|, l)``) differences of that link alone; each pin's blocks (bending, contacts, friction) central
+        differences of the pin alone (steps ``1e-7 max(|x|, l)``, ``1e-3 max(|v|, v_0)``);
+        the axial friction's tension dependence by the chain rule.  About 23 (forward) or 45 (central) link
+        passes and 116 pin passes per element, 25-45 force evaluations in time for 84 pins (docs/chain.md).
+        numpy backend: :meth:`coloured_jacobian`.
+        """
+        if scheme not in ("forward", "central"):
+            raise InputError("scheme", scheme, 'must be "forward" or "central"')
+        if self.backend != "numba":
+            return self.coloured_jacobian(q, v, damping=damping)
+        pat = self.jac_sparsity
+        if self._positions is None:
+            self._positions = HK.positions(self._kernel_args, self.dof_index, pat)
+        Jq, Jv = np.zeros(pat.nnz + 1), np.zeros(pat.nnz + 1)
+        steps = np.array([np.sqrt(np.finfo(float).eps) if scheme == "forward" else 1e-7, 1e-7, 1e-3])
+        HK.jacobian(np.asarray(q, float), np.asarray(v, float), *self._kernel_args, *self._positions, steps,
+                    scheme == "central", Jq, Jv)
+        out = [sp.csr_matrix((d[:-1], pat.indices, pat.indptr), shape=pat.shape) for d in (Jq, Jv)]
+        return out[0], out[1] if damping else None
+
+    def coloured_jacobian(self, q: np.ndarray, v: np.ndarray, step: float = 1e-7,
+                          damping: bool = True) -> tuple[sp.csr_matrix, sp.csr_matrix | None]:
         """``(dQ/dq, dQ/dv)`` of :meth:`forces` by central differences over pin colours, on :attr:`jac_sparsity`.
 
         Pins five or more apart share a colour (the stencil is ``p-2..p+2``), so ``2 x 21 x colours``

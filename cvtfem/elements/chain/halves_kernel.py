@@ -26,8 +26,14 @@ _G = 1.0 / np.sqrt(3.0)
 def pack(ch, contacts) -> tuple:
     """Kernel constants of a :class:`ChainA5` with its ``contacts`` table (built once per family).
 
-    Per contact one row ``arc = (offset of A's centre along tau, n; R_A; offset of B's; R_B; rho_0; k)``.
+    Index tables ``gl (n, 22)`` (each link's local coordinates in ``q``) and ``gp (n, 29)`` (each pin's, see
+    :func:`_pin`); per contact one row ``arc = (offset of A's centre along tau, n; R_A; offset of B's; R_B;
+    rho_0; k)``.
     """
+    n, di, al = ch.n_pins, ch.dof_index, ch.axis_link
+    nx = (np.arange(n) + 1) % n
+    gl = np.concatenate([di[:, :10], di[nx, 10:20], di[:, 20:], di[nx, 20:]], 1)
+    gp = np.concatenate([di, di[al[0], :2], di[nx[al[0]], 10:12], di[al[1], :2], di[nx[al[1]], 10:12]], 1)
     arcs = [ch._arcs[c[0]] for c in contacts]
     arc = np.array([[a[0][0], a[0][1], a[1], a[2][0], a[2][1], a[3], a[4], a[5]] for a in arcs])
     idx = np.array([[c[1], c[2]] for c in contacts], np.int64)
@@ -36,42 +42,31 @@ def pack(ch, contacts) -> tuple:
     par = np.array([ch.l, ch.c_half, ch.b_half, ch.A_tau, ch.A_n, ch.beta_bend, ch.beta_ext, ch.beta_shear,
                     ch.beta_twist, ch.b_roll, ch.k_tie, ch.k_stop, ch.d_stop, ch.f0, ch.v0, ch.plate_h])
     ints = np.array([LAW_CODES[ch.law], ch._kmodel], np.int64)
-    return (np.ascontiguousarray(ch.axis_link), np.ascontiguousarray(ch._cs), ch.L, ch.c_twist, ch.b_joint,
-            np.ascontiguousarray(ch.plate_w), np.ascontiguousarray(ch.plate_d), np.ascontiguousarray(ch.plate_c),
-            np.ascontiguousarray(ch.plate_c1), np.ascontiguousarray(ch.plate_c2), arc, idx, sig,
-            np.ascontiguousarray(cw), par, ints)
+    return tuple(np.ascontiguousarray(a) for a in (gl, gp, ch.L, ch.c_twist, ch.b_joint, ch._cs, ch.plate_w,
+                                                   ch.plate_d, ch.plate_c, ch.plate_c1, ch.plate_c2, arc, idx,
+                                                   sig, cw, par, ints))
 
 
-@njit(cache=True)
-def _unpack(x, n, u, w, qp):
-    """State vector -> ``u (2, 4, n, 2)``, ``w (2, 2, n)``, ``qp (n,)`` (layout of ``ChainA5.split``)."""
-    for h in range(2):
-        o = 10 * n * h
-        for i in range(4):
-            for p in range(n):
-                for c in range(2):
-                    u[h, i, p, c] = x[o + 2 * n * i + 2 * p + c]
-        for j in range(2):
-            for p in range(n):
-                w[h, j, p] = x[o + 8 * n + n * j + p]
-    for p in range(n):
-        qp[p] = x[20 * n + p]
+def positions(args: tuple, dof_index: np.ndarray, pattern) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Positions in the data of the sorted CSR ``pattern`` of the link blocks ``(n, 22, 22)``, the pin blocks
+    ``(n, 29, 29)`` and the axial-friction rows against the tensions' link coordinates ``(n, 2, 3, 22)``.
 
-
-@njit(cache=True)
-def _pack_out(n, Qu, Qw, Qq, Q):
-    """Inverse of :func:`_unpack`."""
-    for h in range(2):
-        o = 10 * n * h
-        for i in range(4):
-            for p in range(n):
-                for c in range(2):
-                    Q[o + 2 * n * i + 2 * p + c] = Qu[h, i, p, c]
-        for j in range(2):
-            for p in range(n):
-                Q[o + 8 * n + n * j + p] = Qw[h, j, p]
-    for p in range(n):
-        Q[20 * n + p] = Qq[p]
+    Entries outside the pattern (only the absent link of an open segment, whose terms are all zero) point to
+    the spare slot ``pattern.nnz``: the data arrays have ``nnz + 1`` entries.
+    """
+    gl, gp, link_w = args[0], args[1], args[6].any(1) | (args[3] != 0)
+    n = gl.shape[0]
+    lut = np.full(pattern.shape, pattern.nnz, np.int64)
+    rows = np.repeat(np.arange(pattern.shape[0]), np.diff(pattern.indptr))
+    lut[rows, pattern.indices] = np.arange(pattern.nnz)
+    pos_l = lut[gl[:, :, None], gl[:, None, :]]
+    pos_p = lut[gp[:, :, None], gp[:, None, :]]
+    links = np.stack([np.arange(n), (np.arange(n) - 1) % n], 1)               # tension of (p, p+1), (p-1, p)
+    fr = dof_index[:, [8, 18, 20]]                                            # w_0-, w_0+, q_p
+    pos_t = lut[fr[:, None, :, None], gl[links][:, :, None, :]]
+    if max(pos_l[link_w].max(), pos_p.max(), pos_t[link_w[links]].max()) == pattern.nnz:
+        raise AssertionError("halves_kernel.positions: an element block reaches outside the Jacobian pattern")
+    return pos_l, pos_p, pos_t
 
 
 @njit(cache=True)
@@ -83,306 +78,411 @@ def _shape(xi, l, H, Hp, Hpp):
     Hpp[0], Hpp[1], Hpp[2], Hpp[3] = 0.0, 0.0, l8 * (6 * xi - 2), l8 * (6 * xi + 2)
 
 
+# ---------------------------------------------------------------------------------------------- links
 @njit(cache=True)
-def _half_bending(u, vu, th, nh, thd_h, par, Qu, Qth):
-    """Half bending (1.216) on axes turning with the links and its co-rotational damping (section 5.4)."""
-    n = u.shape[2]
-    l, A_tau, A_n, beta = par[0], par[3], par[4], par[5]
-    m = np.zeros((2, 2))
-    nab = np.zeros((2, 2))
-    for h in range(2):
-        for p in range(n):
-            t0, t1, n0, n1 = th[h, p, 0], th[h, p, 1], nh[h, p, 0], nh[h, p, 1]
-            for c in range(2):
-                m[0, c] = (4 * u[h, 2, p, c] + 2 * u[h, 3, p, c]) / l
-                m[1, c] = (2 * u[h, 2, p, c] + 4 * u[h, 3, p, c]) / l
-            gth = 0.0
-            for k in range(2):
-                at = A_tau * (t0 * m[k, 0] + t1 * m[k, 1])
-                an = A_n * (n0 * m[k, 0] + n1 * m[k, 1])
-                Qu[h, 2 + k, p, 0] -= at * t0 + an * n0
-                Qu[h, 2 + k, p, 1] -= at * t1 + an * n1
-                gth += (n0 * u[h, 2 + k, p, 0] + n1 * u[h, 2 + k, p, 1]) * (t0 * m[k, 0] + t1 * m[k, 1])
-            Qth[h, p] -= (A_tau - A_n) * gth
-            if beta != 0.0:
-                for k in range(2):                               # nabla = U' - theta' k x U
-                    nab[k, 0] = vu[h, 2 + k, p, 0] + thd_h[h, p] * u[h, 2 + k, p, 1]
-                    nab[k, 1] = vu[h, 2 + k, p, 1] - thd_h[h, p] * u[h, 2 + k, p, 0]
-                dth = 0.0
-                for k in range(2):
-                    a0 = (4 * nab[k, 0] + 2 * nab[1 - k, 0]) / l
-                    a1 = (4 * nab[k, 1] + 2 * nab[1 - k, 1]) / l
-                    at, an = A_tau * (t0 * a0 + t1 * a1), A_n * (n0 * a0 + n1 * a1)
-                    mb0, mb1 = at * t0 + an * n0, at * t1 + an * n1
-                    Qu[h, 2 + k, p, 0] -= beta * mb0
-                    Qu[h, 2 + k, p, 1] -= beta * mb1
-                    dth += -u[h, 2 + k, p, 1] * mb0 + u[h, 2 + k, p, 0] * mb1
-                Qth[h, p] += beta * dth
+def _link_work():
+    """Scratch arrays of :func:`_link`."""
+    return (np.zeros(20), np.zeros(20), np.zeros(20), np.zeros((3, 4)), np.zeros((3, 4)), np.zeros((3, 20)),
+            np.zeros((3, 3)), np.zeros(4), np.zeros(4), np.zeros(3), np.zeros((2, 3)), np.zeros((2, 3)),
+            np.zeros(3), np.zeros(3), np.zeros(10), np.zeros(22), np.zeros(20), np.zeros((3, 22)))
 
 
 @njit(cache=True)
-def _virtual_pin(u, w, ud, wd, qa, qad, d, l, o, qv, qvd, mp):
-    """End ``o`` (0 or 10) of one plate as a virtual whole pin at ``xi = 0`` (docstring of
-    ``ChainA5``); ``mp`` (3, 4) keeps ``H, H', H''`` for the back map.  Returns ``xi``."""
-    xi = 2.0 / l * (qa - w[0] + d)
-    xid = 2.0 / l * (qad - wd[0])
-    _shape(xi, l, mp[0], mp[1], mp[2])
+def _virtual_pin(x, xd, b, d, l, qv, qvd, Hm):
+    """End ``b`` of a plate at offset ``d`` as a virtual whole pin at ``xi = 0`` (``qv``, ``qvd`` entries
+    ``10 b .. 10 b + 9``): ``u_0 = U_perp(xi_b)``, ``u_1 = dU_perp/dxi``, ``u_2 = u_3 = 0``, ``w_0 = U_par(xi_b)``,
+    ``w_1``, the same strains as the half's axis (1.211)-(1.212).  ``Hm`` (3, 4) gets ``h, h', h''``; returns ``xi_b``."""
+    o = 10 * b
+    xi = 2.0 / l * (x[20 + b] - x[o + 8] + d)
+    xid = 2.0 / l * (xd[20 + b] - xd[o + 8])
+    _shape(xi, l, Hm[0], Hm[1], Hm[2])
     for c in range(2):
         U, u1, du1, Ud, u1d = 0.0, 0.0, 0.0, 0.0, 0.0
         for i in range(4):
-            U += mp[0, i] * u[i, c]
-            u1 += mp[1, i] * u[i, c]
-            du1 += mp[2, i] * u[i, c]
-            Ud += mp[0, i] * ud[i, c]
-            u1d += mp[1, i] * ud[i, c]
+            U += Hm[0, i] * x[o + 2 * i + c]
+            u1 += Hm[1, i] * x[o + 2 * i + c]
+            du1 += Hm[2, i] * x[o + 2 * i + c]
+            Ud += Hm[0, i] * xd[o + 2 * i + c]
+            u1d += Hm[1, i] * xd[o + 2 * i + c]
         qv[o + c], qv[o + 2 + c], qv[o + 4 + c], qv[o + 6 + c] = U, u1, 0.0, 0.0
         qvd[o + c], qvd[o + 2 + c], qvd[o + 4 + c], qvd[o + 6 + c] = Ud + u1 * xid, u1d + du1 * xid, 0.0, 0.0
-    qv[o + 8], qv[o + 9] = w[0] + w[1] * xi, w[1]
-    qvd[o + 8], qvd[o + 9] = wd[0] + wd[1] * xi + w[1] * xid, wd[1]
+    qv[o + 8], qv[o + 9] = x[o + 8] + x[o + 9] * xi, x[o + 9]
+    qvd[o + 8], qvd[o + 9] = xd[o + 8] + xd[o + 9] * xi + x[o + 9] * xid, xd[o + 9]
     return xi
 
 
 @njit(cache=True)
-def _links(u, w, qp, vu, vw, vq, L, c_twist, plate_w, plate_d, plate_c, plate_c1, plate_c2, par, kmodel,
-           Qu, Qw, Qq, T_link):
-    """Plates (virtual-pin map and per-plate law, elastic plus damping) and twist of every link."""
-    n, K = u.shape[2], plate_w.shape[1]
-    l, beta_ext, beta_shear, beta_twist, h_pl = par[0], par[6], par[7], par[8], par[15]
-    ua, ub, uad, ubd = np.zeros((4, 2)), np.zeros((4, 2)), np.zeros((4, 2)), np.zeros((4, 2))
-    wa, wb, wad, wbd = np.zeros(2), np.zeros(2), np.zeros(2), np.zeros(2)
-    qv, qvd, Qf = np.zeros(20), np.zeros(20), np.zeros(20)
-    mpa, mpb = np.zeros((3, 4)), np.zeros((3, 4))
-    J, A = np.zeros((3, 20)), np.zeros((3, 3))
-    H, Hp, V, t, e = np.zeros(4), np.zeros(4), np.zeros(3), np.zeros((2, 3)), np.zeros((2, 3))
-    ed, r, m = np.zeros(3), np.zeros(3), np.zeros(10)
-    loc = np.zeros(22)
-    Jp = np.zeros(22)
-    for e_ in range(n):
-        nx = (e_ + 1) % n
+def _back(out, f, x, b, xi, Hm, l):
+    """Add ``G_b^T f`` to ``out`` (22,): a vector ``f`` (20,) on the virtual pin ``b`` mapped back to the link's
+    local coordinates (the transpose of :func:`_virtual_pin`'s linearisation, ``xi_b`` moving with ``q``, ``w_0``)."""
+    o = 10 * b
+    S = f[o + 8] * x[o + 9]
+    for c in range(2):
+        u1, du1 = 0.0, 0.0
         for i in range(4):
-            for c in range(2):
-                ua[i, c], ub[i, c] = u[0, i, e_, c], u[1, i, nx, c]
-                uad[i, c], ubd[i, c] = vu[0, i, e_, c], vu[1, i, nx, c]
-        for j in range(2):
-            wa[j], wb[j], wad[j], wbd[j] = w[0, j, e_], w[1, j, nx], vw[0, j, e_], vw[1, j, nx]
-        loc[:] = 0.0
-        Le = L[e_]
-        for k in range(K):
-            pw = plate_w[e_, k]
-            if pw == 0.0:
-                continue
-            xa = _virtual_pin(ua, wa, uad, wad, qp[e_], vq[e_], plate_d[e_, k], l, 0, qv, qvd, mpa)
-            xb = _virtual_pin(ub, wb, ubd, wbd, qp[nx], vq[nx], plate_d[e_, k], l, 10, qv, qvd, mpb)
-            c, c1, c2 = plate_c[e_, k], plate_c1[e_, k], plate_c2[e_, k]
-            psi1, psi2, Delta = _strains(qv, 0.0, l, Le, J, H, Hp, V, t, e)
-            st, d1, d2, tension = _plate_law(kmodel, psi1, psi2, Delta, c, c1, c2, h_pl, A, m)
-            z1, z2 = psi1 - d1, psi2 - d2
-            _strain_rates(J, qvd, A, ed, r)
-            s0 = c1 * z1 + c2 * z2 + beta_shear * (c1 * r[0] + c2 * r[1])
-            s1 = c2 * z1 + c1 * z2 + beta_shear * (c2 * r[0] + c1 * r[1])
-            s2 = tension + beta_ext * c * r[2]
-            g0 = -(A[0, 0] * s0 + A[1, 0] * s1 + A[2, 0] * s2)
-            g1 = -(A[0, 1] * s0 + A[1, 1] * s1 + A[2, 1] * s2)
-            g2 = -(A[0, 2] * s0 + A[1, 2] * s1 + A[2, 2] * s2)
-            for j in range(20):
-                Qf[j] = (J[0, j] * g0 + J[1, j] * g1 + J[2, j] * g2) * pw
-            T_link[e_] += tension * pw
-            for b in range(2):                                    # back through the virtual-pin map
-                o = 10 * b
-                mp = mpa if b == 0 else mpb
-                uu = ua if b == 0 else ub
-                ww = wa if b == 0 else wb
-                xi = xa if b == 0 else xb
-                S = Qf[o + 8] * ww[1]
-                for c_ in range(2):
-                    u1, du1 = 0.0, 0.0
-                    for i in range(4):
-                        loc[o + 2 * i + c_] += mp[0, i] * Qf[o + c_] + mp[1, i] * Qf[o + 2 + c_]
-                        u1 += mp[1, i] * uu[i, c_]
-                        du1 += mp[2, i] * uu[i, c_]
-                    S += Qf[o + c_] * u1 + Qf[o + 2 + c_] * du1
-                loc[o + 8] += Qf[o + 8] - 2.0 / l * S
-                loc[o + 9] += Qf[o + 8] * xi + Qf[o + 9]
-                loc[20 + b] += 2.0 / l * S
-        if c_twist[e_] != 0.0:                                    # (1.146) with (1.217)
-            kk = 2.0 / (l * Le)
-            d00, d01 = ub[0, 0] - ua[0, 0], ub[0, 1] - ua[0, 1]
-            d10, d11 = ub[1, 0] - ua[1, 0], ub[1, 1] - ua[1, 1]
-            phi = kk * (d10 * d01 - d11 * d00)
-            Jp[:] = 0.0
-            Jp[10], Jp[11] = -kk * d11, kk * d10
-            Jp[12], Jp[13] = kk * d01, -kk * d00
-            for j in range(4):
-                Jp[j] = -Jp[10 + j]
-            phid = 0.0
-            for j in range(4):
-                phid += Jp[j] * uad[j // 2, j % 2] + Jp[10 + j] * ubd[j // 2, j % 2]
-            f = c_twist[e_] * (phi + beta_twist * phid)
-            for j in range(22):
-                loc[j] -= f * Jp[j]
-        for i in range(4):
-            for c in range(2):
-                Qu[0, i, e_, c] += loc[2 * i + c]
-                Qu[1, i, nx, c] += loc[10 + 2 * i + c]
-        for j in range(2):
-            Qw[0, j, e_] += loc[8 + j]
-            Qw[1, j, nx] += loc[18 + j]
-        Qq[e_] += loc[20]
-        Qq[nx] += loc[21]
+            out[o + 2 * i + c] += Hm[0, i] * f[o + c] + Hm[1, i] * f[o + 2 + c]
+            u1 += Hm[1, i] * x[o + 2 * i + c]
+            du1 += Hm[2, i] * x[o + 2 * i + c]
+        S += f[o + c] * u1 + f[o + 2 + c] * du1
+    out[o + 8] += f[o + 8] - 2.0 / l * S
+    out[o + 9] += f[o + 8] * xi + f[o + 9]
+    out[20 + b] += 2.0 / l * S
 
 
 @njit(cache=True)
-def _pair(Qu, Qth, p, A, B, H, s, v0, v1, kA, kB):
-    """Add ``s v . (dU_B - dU_A + kB dth_B - kA dth_A)`` at one station (generalized-force sign applied by caller)."""
+def _link(x, xd, e, L, c_twist, plate_w, plate_d, plate_c, plate_c1, plate_c2, par, kmodel, loc, Dv, want_dv, wk):
+    """Plates (per-plate law, elastic plus damping) and twist (1.146), (1.217) of link ``e`` on its 22 local
+    coordinates ``x`` (half ``-`` of pin ``e``, half ``+`` of pin ``e+1``, ``q_e``, ``q_{e+1}``; layout of
+    ``ChainA5._links``) and velocities ``xd``.  Adds the forces to ``loc`` (22,) and, with ``want_dv``,
+    their exact velocity derivative (they are linear in ``xd``) to ``Dv`` (22, 22).  Returns the link tension (N).
+    """
+    qv, qvd, Qf, Ha, Hb, J, A, H, Hp, V, t, ev, ed, r, m, Jp, row, AJG = wk
+    l, beta_ext, beta_shear, beta_twist, h_pl = par[0], par[6], par[7], par[8], par[15]
+    Le = L[e]
+    T = 0.0
+    for k in range(plate_w.shape[1]):
+        pw = plate_w[e, k]
+        if pw == 0.0:
+            continue
+        xa = _virtual_pin(x, xd, 0, plate_d[e, k], l, qv, qvd, Ha)
+        xb = _virtual_pin(x, xd, 1, plate_d[e, k], l, qv, qvd, Hb)
+        c, c1, c2 = plate_c[e, k], plate_c1[e, k], plate_c2[e, k]
+        psi1, psi2, Delta = _strains(qv, 0.0, l, Le, J, H, Hp, V, t, ev)
+        st, d1, d2, tension = _plate_law(kmodel, psi1, psi2, Delta, c, c1, c2, h_pl, A, m)
+        z1, z2 = psi1 - d1, psi2 - d2
+        _strain_rates(J, qvd, A, ed, r)
+        s0 = c1 * z1 + c2 * z2 + beta_shear * (c1 * r[0] + c2 * r[1])
+        s1 = c2 * z1 + c1 * z2 + beta_shear * (c2 * r[0] + c1 * r[1])
+        s2 = tension + beta_ext * c * r[2]
+        g0 = -(A[0, 0] * s0 + A[1, 0] * s1 + A[2, 0] * s2)
+        g1 = -(A[0, 1] * s0 + A[1, 1] * s1 + A[2, 1] * s2)
+        g2 = -(A[0, 2] * s0 + A[1, 2] * s1 + A[2, 2] * s2)
+        for j in range(20):
+            Qf[j] = (J[0, j] * g0 + J[1, j] * g1 + J[2, j] * g2) * pw
+        T += tension * pw
+        _back(loc, Qf, x, 0, xa, Ha, l)
+        _back(loc, Qf, x, 1, xb, Hb, l)
+        if want_dv:                                               # -(A J G)^T D (A J G), D of (1.192)-(1.193)
+            for i in range(3):
+                for j in range(20):
+                    row[j] = A[i, 0] * J[0, j] + A[i, 1] * J[1, j] + A[i, 2] * J[2, j]
+                AJG[i, :] = 0.0
+                _back(AJG[i], row, x, 0, xa, Ha, l)
+                _back(AJG[i], row, x, 1, xb, Hb, l)
+            for a in range(22):
+                da0 = beta_shear * (c1 * AJG[0, a] + c2 * AJG[1, a])
+                da1 = beta_shear * (c2 * AJG[0, a] + c1 * AJG[1, a])
+                da2 = beta_ext * c * AJG[2, a]
+                for b in range(22):
+                    Dv[b, a] -= pw * (AJG[0, b] * da0 + AJG[1, b] * da1 + AJG[2, b] * da2)
+    if c_twist[e] != 0.0:
+        kk = 2.0 / (l * Le)
+        d00, d01, d10, d11 = x[10] - x[0], x[11] - x[1], x[12] - x[2], x[13] - x[3]
+        phi = kk * (d10 * d01 - d11 * d00)
+        Jp[:] = 0.0
+        Jp[10], Jp[11], Jp[12], Jp[13] = -kk * d11, kk * d10, kk * d01, -kk * d00
+        for j in range(4):
+            Jp[j] = -Jp[10 + j]
+        phid = 0.0
+        for j in range(22):
+            phid += Jp[j] * xd[j]
+        f = c_twist[e] * (phi + beta_twist * phid)
+        for j in range(22):
+            loc[j] -= f * Jp[j]
+        if want_dv:
+            for a in range(22):
+                for b in range(22):
+                    Dv[b, a] -= beta_twist * c_twist[e] * Jp[b] * Jp[a]
+    return T
+
+
+# ---------------------------------------------------------------------------------------------- pins
+@njit(cache=True)
+def _pin_work():
+    """Scratch arrays of :func:`_pin`."""
+    return (np.zeros((2, 2)), np.zeros(2), np.zeros(2), np.zeros((2, 2)), np.zeros((2, 2)), np.zeros(2),
+            np.zeros(4), np.zeros(4), np.zeros(4), np.zeros((2, 2)), np.zeros((2, 2)), np.zeros(2), np.zeros(2),
+            np.zeros((2, 2)))
+
+
+@njit(cache=True)
+def _pair(loc, Qth, A, B, H, s, v0, v1, kA, kB):
+    """Add ``s v . (dU_B - dU_A + kB dth_B - kA dth_A)`` of one station to the pin's local forces and half torques."""
     sv0, sv1 = s * v0, s * v1
     for i in range(4):
-        Qu[B, i, p, 0] += H[i] * sv0
-        Qu[B, i, p, 1] += H[i] * sv1
-        Qu[A, i, p, 0] -= H[i] * sv0
-        Qu[A, i, p, 1] -= H[i] * sv1
-    Qth[B, p] += sv0 * kB[0] + sv1 * kB[1]
-    Qth[A, p] -= sv0 * kA[0] + sv1 * kA[1]
+        loc[10 * B + 2 * i] += H[i] * sv0
+        loc[10 * B + 2 * i + 1] += H[i] * sv1
+        loc[10 * A + 2 * i] -= H[i] * sv0
+        loc[10 * A + 2 * i + 1] -= H[i] * sv1
+    Qth[B] += sv0 * kB[0] + sv1 * kB[1]
+    Qth[A] -= sv0 * kA[0] + sv1 * kA[1]
 
 
 @njit(cache=True)
-def _contacts(u, vu, tau, th, nh, thd_h, axis_link, arc, idx, sig_, cw, par, law, Qu, Qth):
-    """The three arc contacts of every pin at two Gauss stations: penalty, roll damping, tie, rolling friction."""
-    n = u.shape[2]
-    l, b_roll, k_tie, f0, v0 = par[0], par[9], par[10], par[13], par[14]
-    H, Hp, Hpp = np.zeros(4), np.zeros(4), np.zeros(4)
-    Ux, Vx = np.zeros((2, 2)), np.zeros((2, 2))
-    kA, kB = np.zeros(2), np.zeros(2)
+def _half_bending(x, xd, h, th, nh, thd, par, elastic, loc, Qth, nab):
+    """Half bending (1.216) of half ``h`` on axes turning with its link (with ``elastic``), and its co-rotational
+    damping (section 5.4)."""
+    l, A_tau, A_n, beta = par[0], par[3], par[4], par[5]
+    o = 10 * h + 4                                                # u_2 of the half
+    t0, t1, n0, n1 = th[h, 0], th[h, 1], nh[h, 0], nh[h, 1]
+    gth = 0.0
+    for k in range(2 if elastic else 0):
+        a0 = (4 * x[o + 2 * k] + 2 * x[o + 2 - 2 * k]) / l
+        a1 = (4 * x[o + 2 * k + 1] + 2 * x[o + 3 - 2 * k]) / l
+        at, an = A_tau * (t0 * a0 + t1 * a1), A_n * (n0 * a0 + n1 * a1)
+        loc[o + 2 * k] -= at * t0 + an * n0
+        loc[o + 2 * k + 1] -= at * t1 + an * n1
+        gth += (n0 * x[o + 2 * k] + n1 * x[o + 2 * k + 1]) * (t0 * a0 + t1 * a1)
+    Qth[h] -= (A_tau - A_n) * gth
+    if beta != 0.0:
+        for k in range(2):                                        # nabla = U' - theta' k x U
+            nab[k, 0] = xd[o + 2 * k] + thd[h] * x[o + 2 * k + 1]
+            nab[k, 1] = xd[o + 2 * k + 1] - thd[h] * x[o + 2 * k]
+        dth = 0.0
+        for k in range(2):
+            a0 = (4 * nab[k, 0] + 2 * nab[1 - k, 0]) / l
+            a1 = (4 * nab[k, 1] + 2 * nab[1 - k, 1]) / l
+            at, an = A_tau * (t0 * a0 + t1 * a1), A_n * (n0 * a0 + n1 * a1)
+            mb0, mb1 = at * t0 + an * n0, at * t1 + an * n1
+            loc[o + 2 * k] -= beta * mb0
+            loc[o + 2 * k + 1] -= beta * mb1
+            dth += -x[o + 2 * k + 1] * mb0 + x[o + 2 * k] * mb1
+        Qth[h] += beta * dth
+
+
+@njit(cache=True)
+def _pin(x, xd, p, T_next, T_prev, b_joint, cs, arc, idx, sig_, cw, par, law, elastic, loc, wk):
+    """Everything of pin ``p`` but its links, on 29 local coordinates ``x`` and velocities ``xd``: half ``-`` (0..9,
+    A1 order), half ``+`` (10..19), ``q_p`` (20) and the ends of the links giving the half axes (1.215): start and
+    end ``u_0`` of the ``-`` half's link (21..24), of the ``+`` half's link (25..28), copies allowed.  Half axial
+    (1.214), half bending (1.216), the three arc contacts at two Gauss stations (penalty, roll damping, tie,
+    rolling friction), stoppers, axial friction (1.221) with the link tensions ``T_next`` (link ``(p, p+1)``) and
+    ``T_prev`` (``(p-1, p)``) and joint damping (1.80); half torques go to the link ends.  Adds to ``loc`` (29,);
+    without ``elastic`` only the velocity-dependent forces (their differences then keep their own round-off).
+    """
+    tau, rho, thd, th, nh, Qth, H, Hp, Hpp, Ux, Vx, kA, kB, nab = wk
+    l, c_half, b_half, b_roll, k_tie = par[0], par[1], par[2], par[9], par[10]
+    k_stop, d_stop, f0, v0 = par[11], par[12], par[13], par[14]
+    for j in range(2):                                            # link frames, spin rates, half axes
+        o = 21 + 4 * j
+        x0, x1 = x[o + 2] - x[o], x[o + 3] - x[o + 1]
+        rho[j] = np.sqrt(x0 * x0 + x1 * x1)
+        tau[j, 0], tau[j, 1] = x0 / rho[j], x1 / rho[j]
+        thd[j] = (-tau[j, 1] * (xd[o + 2] - xd[o]) + tau[j, 0] * (xd[o + 3] - xd[o + 1])) / rho[j]
+        c, s = cs[j, 0], cs[j, 1]
+        th[j, 0] = c * tau[j, 0] - s * tau[j, 1]
+        th[j, 1] = c * tau[j, 1] + s * tau[j, 0]
+        nh[j, 0], nh[j, 1] = -th[j, 1], th[j, 0]
+        Qth[j] = 0.0
+    for h in range(2):
+        o = 10 * h
+        loc[o + 9] -= (2 * c_half * (2 * x[o + 9] - l) if elastic else 0.0) + 4 * b_half * xd[o + 9]
+        _half_bending(x, xd, h, th, nh, thd, par, elastic, loc, Qth, nab)
     for s in range(2):
         _shape((2 * s - 1) * _G, l, H, Hp, Hpp)
-        for p in range(n):
-            for h in range(2):
-                for c in range(2):
-                    a, b = 0.0, 0.0
-                    for i in range(4):
-                        a += H[i] * u[h, i, p, c]
-                        b += H[i] * vu[h, i, p, c]
-                    Ux[h, c], Vx[h, c] = a, b
-            for ic in range(3):
-                A, B, sig = idx[ic, 0], idx[ic, 1], sig_[ic]
-                RA, RB, rho0, k = arc[ic, 2], arc[ic, 5], arc[ic, 6], arc[ic, 7]
-                wgt = l / 2 * cw[ic, p]
-                rA0 = arc[ic, 0] * th[A, p, 0] + arc[ic, 1] * nh[A, p, 0]
-                rA1 = arc[ic, 0] * th[A, p, 1] + arc[ic, 1] * nh[A, p, 1]
-                rB0 = arc[ic, 3] * th[B, p, 0] + arc[ic, 4] * nh[B, p, 0]
-                rB1 = arc[ic, 3] * th[B, p, 1] + arc[ic, 4] * nh[B, p, 1]
-                d0 = Ux[B, 0] + rB0 - Ux[A, 0] - rA0
-                d1 = Ux[B, 1] + rB1 - Ux[A, 1] - rA1
-                rho = np.sqrt(d0 * d0 + d1 * d1)
-                n0, n1 = d0 / rho, d1 / rho
-                t0, t1 = -n1, n0
-                g = sig * (rho - rho0)
-                pen = max(-g, 0.0)
-                N = wgt * k * pen
-                kA[0], kA[1], kB[0], kB[1] = -rA1, rA0, -rB1, rB0
-                if N != 0.0:
-                    _pair(Qu, Qth, p, A, B, H, N * sig, n0, n1, kA, kB)
-                vr0, vr1 = Vx[B, 0] - Vx[A, 0], Vx[B, 1] - Vx[A, 1]
-                if b_roll != 0.0 and ic == 0 and g < 0:
-                    gdot = sig * (n0 * vr0 + n1 * vr1 + (n0 * kB[0] + n1 * kB[1]) * thd_h[B, p]
-                                  - (n0 * kA[0] + n1 * kA[1]) * thd_h[A, p])
-                    _pair(Qu, Qth, p, A, B, H, -wgt * b_roll * gdot * sig, n0, n1, kA, kB)
-                if k_tie != 0.0 and ic == 0:
-                    ta, tb = axis_link[A, p], axis_link[B, p]
-                    gt = (RA * np.arctan2(n0 * tau[ta, 1] - n1 * tau[ta, 0], n0 * tau[ta, 0] + n1 * tau[ta, 1])
-                          + RB * np.arctan2(n0 * tau[tb, 1] - n1 * tau[tb, 0], n0 * tau[tb, 0] + n1 * tau[tb, 1]))
-                    st = wgt * k_tie * gt
-                    _pair(Qu, Qth, p, A, B, H, (RA + RB) / rho * st, t0, t1, kA, kB)
-                    Qth[A, p] -= st * RA
-                    Qth[B, p] -= st * RB
-                if f0 != 0.0 and N != 0.0:
-                    vs = (t0 * vr0 + t1 * vr1 + (t0 * kB[0] + t1 * kB[1] - sig * RB) * thd_h[B, p]
-                          - (t0 * kA[0] + t1 * kA[1] + RA) * thd_h[A, p])
-                    Ft = -N * _gain(abs(vs), f0, v0, law, SMOOTH_EPS) * vs
-                    _pair(Qu, Qth, p, A, B, H, Ft, t0, t1, kA, kB)
-                    Qth[B, p] -= Ft * sig * RB
-                    Qth[A, p] -= Ft * RA
+        for h in range(2):
+            for c in range(2):
+                a, b = 0.0, 0.0
+                for i in range(4):
+                    a += H[i] * x[10 * h + 2 * i + c]
+                    b += H[i] * xd[10 * h + 2 * i + c]
+                Ux[h, c], Vx[h, c] = a, b
+        for ic in range(3):
+            A, B, sig = idx[ic, 0], idx[ic, 1], sig_[ic]
+            RA, RB, rho0, k = arc[ic, 2], arc[ic, 5], arc[ic, 6], arc[ic, 7]
+            wgt = l / 2 * cw[ic, p]
+            rA0 = arc[ic, 0] * th[A, 0] + arc[ic, 1] * nh[A, 0]
+            rA1 = arc[ic, 0] * th[A, 1] + arc[ic, 1] * nh[A, 1]
+            rB0 = arc[ic, 3] * th[B, 0] + arc[ic, 4] * nh[B, 0]
+            rB1 = arc[ic, 3] * th[B, 1] + arc[ic, 4] * nh[B, 1]
+            d0 = Ux[B, 0] + rB0 - Ux[A, 0] - rA0
+            d1 = Ux[B, 1] + rB1 - Ux[A, 1] - rA1
+            dist = np.sqrt(d0 * d0 + d1 * d1)
+            n0, n1 = d0 / dist, d1 / dist
+            t0, t1 = -n1, n0
+            g = sig * (dist - rho0)
+            N = wgt * k * max(-g, 0.0)
+            kA[0], kA[1], kB[0], kB[1] = -rA1, rA0, -rB1, rB0
+            if N != 0.0 and elastic:
+                _pair(loc, Qth, A, B, H, N * sig, n0, n1, kA, kB)
+            vr0, vr1 = Vx[B, 0] - Vx[A, 0], Vx[B, 1] - Vx[A, 1]
+            if b_roll != 0.0 and ic == 0 and g < 0:
+                gdot = sig * (n0 * vr0 + n1 * vr1 + (n0 * kB[0] + n1 * kB[1]) * thd[B]
+                              - (n0 * kA[0] + n1 * kA[1]) * thd[A])
+                _pair(loc, Qth, A, B, H, -wgt * b_roll * gdot * sig, n0, n1, kA, kB)
+            if k_tie != 0.0 and ic == 0 and elastic:                          # g_t = R_A ang(n, tau_A) + R_B ang(n, tau_B)
+                gt = (RA * np.arctan2(n0 * tau[A, 1] - n1 * tau[A, 0], n0 * tau[A, 0] + n1 * tau[A, 1])
+                      + RB * np.arctan2(n0 * tau[B, 1] - n1 * tau[B, 0], n0 * tau[B, 0] + n1 * tau[B, 1]))
+                st = wgt * k_tie * gt
+                _pair(loc, Qth, A, B, H, (RA + RB) / dist * st, t0, t1, kA, kB)
+                Qth[A] -= st * RA
+                Qth[B] -= st * RB
+            if f0 != 0.0 and N != 0.0:
+                vs = (t0 * vr0 + t1 * vr1 + (t0 * kB[0] + t1 * kB[1] - sig * RB) * thd[B]
+                      - (t0 * kA[0] + t1 * kA[1] + RA) * thd[A])
+                Ft = -N * _gain(abs(vs), f0, v0, law, SMOOTH_EPS) * vs
+                _pair(loc, Qth, A, B, H, Ft, t0, t1, kA, kB)
+                Qth[B] -= Ft * sig * RB
+                Qth[A] -= Ft * RA
+    for h in range(2 if elastic else 0):                          # stoppers (erratum 13)
+        s = x[10 * h + 8] - x[20]
+        f = k_stop * max(abs(s) - d_stop, 0.0) * np.sign(s)
+        loc[10 * h + 8] -= f
+        loc[20] += f
+    if f0 != 0.0:                                                 # axial friction (1.221)
+        Tn, Tp = max(T_next, 0.0), max(T_prev, 0.0)
+        v_hh = xd[18] - xd[8]
+        R = -0.5 * (Tn + Tp) * _gain(abs(v_hh), f0, v0, law, SMOOTH_EPS) * v_hh
+        loc[18] += R
+        loc[8] -= R
+        for h in range(2):
+            v_hp = xd[10 * h + 8] - xd[20]
+            R = -(Tn if h == 0 else Tp) * _gain(abs(v_hp), f0, v0, law, SMOOTH_EPS) * v_hp
+            loc[10 * h + 8] += R
+            loc[20] -= R
+    if b_joint[p] != 0.0:                                         # joint damping (1.80)
+        tq = b_joint[p] * (thd[0] - thd[1])
+        Qth[0] -= tq
+        Qth[1] += tq
+    for j in range(2):                                            # half torques to the link ends
+        o = 21 + 4 * j
+        a = Qth[j] / rho[j]
+        g0, g1 = -a * tau[j, 1], a * tau[j, 0]
+        loc[o + 2] += g0
+        loc[o + 3] += g1
+        loc[o] -= g0
+        loc[o + 1] -= g1
 
 
 @njit(cache=True)
-def forces(q, v, axis_link, cs, L, c_twist, b_joint, plate_w, plate_d, plate_c, plate_c1, plate_c2, arc, idx, sig,
+def _axial_friction_slopes(xd, p, T_next, T_prev, f0, v0, law, out):
+    """``d Q / d T`` of pin ``p``'s axial friction (rows ``w_0-``, ``w_0+``, ``q_p``) for ``T_next`` (``out[0]``)
+    and ``T_prev`` (``out[1]``); zero where a tension is not positive."""
+    v_hh = xd[18] - xd[8]
+    r_hh = -0.5 * _gain(abs(v_hh), f0, v0, law, SMOOTH_EPS) * v_hh
+    for j in range(2):
+        Tj = T_next if j == 0 else T_prev
+        v_hp = xd[10 * j + 8] - xd[20]
+        r_hp = -_gain(abs(v_hp), f0, v0, law, SMOOTH_EPS) * v_hp if Tj > 0 else 0.0
+        rh = r_hh if Tj > 0 else 0.0
+        out[j, 0] = -rh + (r_hp if j == 0 else 0.0)
+        out[j, 1] = rh + (r_hp if j == 1 else 0.0)
+        out[j, 2] = -r_hp
+
+
+# ---------------------------------------------------------------------------------------------- passes
+@njit(cache=True)
+def forces(q, v, gl, gp, L, c_twist, b_joint, cs, plate_w, plate_d, plate_c, plate_c1, plate_c2, arc, idx, sig,
            cw, par, ints):
     """Generalized forces ``Q (21 n,)`` of the A5 chain: elastic, dissipative and friction (``ChainA5.forces``)."""
     n = L.shape[0]
-    l, c_half, b_half, k_stop, d_stop, f0, v0 = par[0], par[1], par[2], par[11], par[12], par[13], par[14]
     law, kmodel = ints[0], ints[1]
-    u, w, qp = np.zeros((2, 4, n, 2)), np.zeros((2, 2, n)), np.zeros(n)
-    vu, vw, vq = np.zeros((2, 4, n, 2)), np.zeros((2, 2, n)), np.zeros(n)
-    _unpack(q, n, u, w, qp)
-    _unpack(v, n, vu, vw, vq)
-    Qu, Qw, Qq = np.zeros((2, 4, n, 2)), np.zeros((2, 2, n)), np.zeros(n)
-    Qth = np.zeros((2, n))                                        # generalized forces on the half angles
-    # ---- link frames and spin rates, half axes (1.215)
-    rho, tau, thd = np.zeros(n), np.zeros((n, 2)), np.zeros(n)
+    Q = np.zeros(q.shape[0])
+    T = np.zeros(n)
+    x, xd, loc, Dv = np.zeros(22), np.zeros(22), np.zeros(22), np.zeros((1, 1))
+    wk = _link_work()
     for e in range(n):
-        nx = (e + 1) % n
-        x0, x1 = u[1, 0, nx, 0] - u[0, 0, e, 0], u[1, 0, nx, 1] - u[0, 0, e, 1]
-        rho[e] = np.sqrt(x0 * x0 + x1 * x1)
-        tau[e, 0], tau[e, 1] = x0 / rho[e], x1 / rho[e]
-        thd[e] = (-tau[e, 1] * (vu[1, 0, nx, 0] - vu[0, 0, e, 0])
-                  + tau[e, 0] * (vu[1, 0, nx, 1] - vu[0, 0, e, 1])) / rho[e]
-    th, nh, thd_h = np.zeros((2, n, 2)), np.zeros((2, n, 2)), np.zeros((2, n))
-    for h in range(2):
-        c, s = cs[h, 0], cs[h, 1]
-        for p in range(n):
-            e = axis_link[h, p]
-            th[h, p, 0] = c * tau[e, 0] - s * tau[e, 1]
-            th[h, p, 1] = c * tau[e, 1] + s * tau[e, 0]
-            nh[h, p, 0], nh[h, p, 1] = -th[h, p, 1], th[h, p, 0]
-            thd_h[h, p] = thd[e]
-    # ---- half axial (1.214)
-    for h in range(2):
-        for p in range(n):
-            Qw[h, 1, p] -= 2 * c_half * (2 * w[h, 1, p] - l) + 4 * b_half * vw[h, 1, p]
-    _half_bending(u, vu, th, nh, thd_h, par, Qu, Qth)
-    T_link = np.zeros(n)
-    _links(u, w, qp, vu, vw, vq, L, c_twist, plate_w, plate_d, plate_c, plate_c1, plate_c2, par, kmodel,
-           Qu, Qw, Qq, T_link)
-    _contacts(u, vu, tau, th, nh, thd_h, axis_link, arc, idx, sig, cw, par, law, Qu, Qth)
-    # ---- stoppers (erratum 13), axial friction (1.221), joint damping (1.80)
+        for j in range(22):
+            x[j], xd[j], loc[j] = q[gl[e, j]], v[gl[e, j]], 0.0
+        T[e] = _link(x, xd, e, L, c_twist, plate_w, plate_d, plate_c, plate_c1, plate_c2, par, kmodel, loc, Dv,
+                     False, wk)
+        for j in range(22):
+            Q[gl[e, j]] += loc[j]
+    y, yd, lp = np.zeros(29), np.zeros(29), np.zeros(29)
+    pk = _pin_work()
     for p in range(n):
-        pv = (p - 1) % n
-        for h in range(2):
-            s = w[h, 0, p] - qp[p]
-            g = max(abs(s) - d_stop, 0.0)
-            f = k_stop * g * np.sign(s)
-            Qw[h, 0, p] -= f
-            Qq[p] += f
-        if f0 != 0.0:
-            Tm, Tp = max(T_link[p], 0.0), max(T_link[pv], 0.0)
-            v_hh = vw[1, 0, p] - vw[0, 0, p]
-            R = -0.5 * (Tm + Tp) * _gain(abs(v_hh), f0, v0, law, SMOOTH_EPS) * v_hh
-            Qw[1, 0, p] += R
-            Qw[0, 0, p] -= R
-            for h in range(2):
-                v_hp = vw[h, 0, p] - vq[p]
-                R = -(Tm if h == 0 else Tp) * _gain(abs(v_hp), f0, v0, law, SMOOTH_EPS) * v_hp
-                Qw[h, 0, p] += R
-                Qq[p] -= R
-        if b_joint[p] != 0.0:
-            tq = b_joint[p] * (thd[axis_link[0, p]] - thd[axis_link[1, p]])
-            Qth[0, p] -= tq
-            Qth[1, p] += tq
-    # ---- half angles -> link angles -> u_0 (d theta_e = n_e . dx_e / rho_e)
-    Qang = np.zeros(n)
-    for h in range(2):
-        for p in range(n):
-            Qang[axis_link[h, p]] += Qth[h, p]
-    for e in range(n):
-        nx = (e + 1) % n
-        a = Qang[e] / rho[e]
-        g0, g1 = -a * tau[e, 1], a * tau[e, 0]
-        Qu[1, 0, nx, 0] += g0
-        Qu[1, 0, nx, 1] += g1
-        Qu[0, 0, e, 0] -= g0
-        Qu[0, 0, e, 1] -= g1
-    Q = np.zeros(21 * n)
-    _pack_out(n, Qu, Qw, Qq, Q)
+        for j in range(29):
+            y[j], yd[j], lp[j] = q[gp[p, j]], v[gp[p, j]], 0.0
+        _pin(y, yd, p, T[p], T[(p - 1) % n], b_joint, cs, arc, idx, sig, cw, par, law, True, lp, pk)
+        for j in range(29):
+            Q[gp[p, j]] += lp[j]
     return Q
 
 
-__all__ = ["HAVE_NUMBA", "SMOOTH_EPS", "forces", "pack"]
+@njit(cache=True)
+def _step(x, rel, floor):
+    """A difference step ``rel max(|x|, floor)`` rounded so that ``x + h`` is exact."""
+    h = rel * max(abs(x), floor)
+    return (x + h) - x
+
+
+@njit(cache=True)
+def jacobian(q, v, gl, gp, L, c_twist, b_joint, cs, plate_w, plate_d, plate_c, plate_c1, plate_c2, arc, idx, sig,
+             cw, par, ints, pos_l, pos_p, pos_t, steps, central_link, Jq, Jv):
+    """``dQ/dq``, ``dQ/dv`` of :func:`forces` added into the CSR data ``Jq``, ``Jv`` (positions ``pos_l (n, 22, 22)``
+    of the link blocks, ``pos_p (n, 29, 29)`` of the pin blocks, ``pos_t (n, 2, 3, 22)`` of the axial friction
+    rows against the tensions' link coordinates).
+
+    Element by element: a link's velocity block is exact (its forces are linear in the velocities), its
+    coordinate block forward (``central_link`` false) or central differences of the link alone; a pin's blocks
+    central differences of the pin alone; the axial friction's dependence on the link tensions by the chain
+    rule with the tensions' differences.  ``steps = (link, pin coordinate, pin velocity)`` relative steps,
+    applied to ``max(|x|, l)`` and ``max(|v|, v_0)`` (smaller steps drown in the round-off of the contact forces).
+    """
+    n = L.shape[0]
+    l, f0, v0 = par[0], par[13], par[14]
+    law, kmodel = ints[0], ints[1]
+    floor = l
+    rel_link = steps[0]
+    T, dT = np.zeros(n), np.zeros((n, 22))
+    x, xd, f_0, f_p, f_m = np.zeros(22), np.zeros(22), np.zeros(22), np.zeros(22), np.zeros(22)
+    Dv, Dx = np.zeros((22, 22)), np.zeros((1, 1))
+    wk = _link_work()
+    for e in range(n):
+        for j in range(22):
+            x[j], xd[j], f_0[j] = q[gl[e, j]], v[gl[e, j]], 0.0
+        Dv[:, :] = 0.0
+        T[e] = _link(x, xd, e, L, c_twist, plate_w, plate_d, plate_c, plate_c1, plate_c2, par, kmodel, f_0, Dv,
+                     True, wk)
+        for j in range(22):
+            x0 = x[j]
+            h = _step(x0, rel_link, floor)
+            x[j] = x0 + h
+            f_p[:] = 0.0
+            Tp = _link(x, xd, e, L, c_twist, plate_w, plate_d, plate_c, plate_c1, plate_c2, par, kmodel, f_p, Dx,
+                       False, wk)
+            if central_link:
+                x[j] = x0 - h
+                f_m[:] = 0.0
+                Tm = _link(x, xd, e, L, c_twist, plate_w, plate_d, plate_c, plate_c1, plate_c2, par, kmodel, f_m,
+                           Dx, False, wk)
+                h2 = 2 * h
+            else:
+                f_m[:] = f_0
+                Tm, h2 = T[e], h
+            x[j] = x0
+            dT[e, j] = (Tp - Tm) / h2
+            for r in range(22):
+                Jq[pos_l[e, r, j]] += (f_p[r] - f_m[r]) / h2
+                Jv[pos_l[e, r, j]] += Dv[r, j]
+    y, yd, g_p, g_m = np.zeros(29), np.zeros(29), np.zeros(29), np.zeros(29)
+    pk = _pin_work()
+    slopes = np.zeros((2, 3))
+    for p in range(n):
+        pv = (p - 1) % n
+        for j in range(29):
+            y[j], yd[j] = q[gp[p, j]], v[gp[p, j]]
+        for j in range(58):                                       # 29 coordinates, then 29 velocities
+            z = y if j < 29 else yd
+            jj = j % 29
+            z0 = z[jj]
+            h = _step(z0, steps[1], floor) if j < 29 else _step(z0, steps[2], v0)
+            for sgn in range(2):
+                z[jj] = z0 + h if sgn == 0 else z0 - h
+                g = g_p if sgn == 0 else g_m
+                g[:] = 0.0
+                _pin(y, yd, p, T[p], T[pv], b_joint, cs, arc, idx, sig, cw, par, law, j < 29, g, pk)
+            z[jj] = z0
+            Jx = Jq if j < 29 else Jv
+            for r in range(29):
+                Jx[pos_p[p, r, jj]] += (g_p[r] - g_m[r]) / (2 * h)
+        if f0 != 0.0:
+            _axial_friction_slopes(yd, p, T[p], T[pv], f0, v0, law, slopes)
+            for j in range(2):
+                e = p if j == 0 else pv
+                for r in range(3):
+                    for c in range(22):
+                        Jq[pos_t[p, j, r, c]] += slopes[j, r] * dT[e, c]
+
+
+__all__ = ["HAVE_NUMBA", "SMOOTH_EPS", "forces", "jacobian", "pack", "positions"]
