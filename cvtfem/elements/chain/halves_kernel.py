@@ -134,7 +134,8 @@ def _link(x, xd, e, L, c_twist, plate_w, plate_d, plate_c, plate_c1, plate_c2, p
     """Plates (per-plate law, elastic plus damping) and twist (1.146), (1.217) of link ``e`` on its 22 local
     coordinates ``x`` (half ``-`` of pin ``e``, half ``+`` of pin ``e+1``, ``q_e``, ``q_{e+1}``; layout of
     ``ChainA5._links``) and velocities ``xd``.  Adds the forces to ``loc`` (22,) and, with ``want_dv``,
-    their exact velocity derivative (they are linear in ``xd``) to ``Dv`` (22, 22).  Returns the link tension (N).
+    their exact velocity derivative (they are linear in ``xd``) to ``Dv`` (22, 22; symmetric, the upper triangle
+    overwritten).  Returns the link tension (N).
     """
     qv, qvd, Qf, Ha, Hb, J, A, H, Hp, V, t, ev, ed, r, m, Jp, row, AJG = wk
     l, beta_ext, beta_shear, beta_twist, h_pl = par[0], par[6], par[7], par[8], par[15]
@@ -169,12 +170,12 @@ def _link(x, xd, e, L, c_twist, plate_w, plate_d, plate_c, plate_c1, plate_c2, p
                 AJG[i, :] = 0.0
                 _back(AJG[i], row, x, 0, xa, Ha, l)
                 _back(AJG[i], row, x, 1, xb, Hb, l)
-            for a in range(22):
-                da0 = beta_shear * (c1 * AJG[0, a] + c2 * AJG[1, a])
-                da1 = beta_shear * (c2 * AJG[0, a] + c1 * AJG[1, a])
-                da2 = beta_ext * c * AJG[2, a]
-                for b in range(22):
-                    Dv[b, a] -= pw * (AJG[0, b] * da0 + AJG[1, b] * da1 + AJG[2, b] * da2)
+            for a in range(22):                                   # lower triangle; symmetric
+                da0 = pw * beta_shear * (c1 * AJG[0, a] + c2 * AJG[1, a])
+                da1 = pw * beta_shear * (c2 * AJG[0, a] + c1 * AJG[1, a])
+                da2 = pw * beta_ext * c * AJG[2, a]
+                for b in range(a, 22):
+                    Dv[b, a] -= AJG[0, b] * da0 + AJG[1, b] * da1 + AJG[2, b] * da2
     if c_twist[e] != 0.0:
         kk = 2.0 / (l * Le)
         d00, d01, d10, d11 = x[10] - x[0], x[11] - x[1], x[12] - x[2], x[13] - x[3]
@@ -191,8 +192,12 @@ def _link(x, xd, e, L, c_twist, plate_w, plate_d, plate_c, plate_c1, plate_c2, p
             loc[j] -= f * Jp[j]
         if want_dv:
             for a in range(22):
-                for b in range(22):
+                for b in range(a, 22):
                     Dv[b, a] -= beta_twist * c_twist[e] * Jp[b] * Jp[a]
+    if want_dv:
+        for a in range(22):
+            for b in range(a + 1, 22):
+                Dv[a, b] = Dv[b, a]
     return T
 
 
@@ -251,18 +256,40 @@ def _half_bending(x, xd, h, th, nh, thd, par, elastic, loc, Qth, nab):
 
 
 @njit(cache=True)
-def _pin(x, xd, p, T_next, T_prev, b_joint, cs, arc, idx, sig_, cw, par, law, elastic, loc, wk):
+def _pin(x, xd, p, T_next, T_prev, b_joint, cs, arc, idx, sig_, cw, par, law, elastic, lateral, loc, wk):
     """Everything of pin ``p`` but its links, on 29 local coordinates ``x`` and velocities ``xd``: half ``-`` (0..9,
     A1 order), half ``+`` (10..19), ``q_p`` (20) and the ends of the links giving the half axes (1.215): start and
     end ``u_0`` of the ``-`` half's link (21..24), of the ``+`` half's link (25..28), copies allowed.  Half axial
     (1.214), half bending (1.216), the three arc contacts at two Gauss stations (penalty, roll damping, tie,
     rolling friction), stoppers, axial friction (1.221) with the link tensions ``T_next`` (link ``(p, p+1)``) and
     ``T_prev`` (``(p-1, p)``) and joint damping (1.80); half torques go to the link ends.  Adds to ``loc`` (29,);
-    without ``elastic`` only the velocity-dependent forces (their differences then keep their own round-off).
+    without ``elastic`` only the velocity-dependent forces (their differences then keep their own round-off),
+    without ``lateral`` only the axial terms (half axial, stoppers, axial friction: all that ``w``, ``q_p`` reach).
     """
     tau, rho, thd, th, nh, Qth, H, Hp, Hpp, Ux, Vx, kA, kB, nab = wk
     l, c_half, b_half, b_roll, k_tie = par[0], par[1], par[2], par[9], par[10]
     k_stop, d_stop, f0, v0 = par[11], par[12], par[13], par[14]
+    for h in range(2):
+        o = 10 * h
+        loc[o + 9] -= (2 * c_half * (2 * x[o + 9] - l) if elastic else 0.0) + 4 * b_half * xd[o + 9]
+    for h in range(2 if elastic else 0):                          # stoppers (erratum 13)
+        s = x[10 * h + 8] - x[20]
+        f = k_stop * max(abs(s) - d_stop, 0.0) * np.sign(s)
+        loc[10 * h + 8] -= f
+        loc[20] += f
+    if f0 != 0.0:                                                 # axial friction (1.221)
+        Tn, Tp = max(T_next, 0.0), max(T_prev, 0.0)
+        v_hh = xd[18] - xd[8]
+        R = -0.5 * (Tn + Tp) * _gain(abs(v_hh), f0, v0, law, SMOOTH_EPS) * v_hh
+        loc[18] += R
+        loc[8] -= R
+        for h in range(2):
+            v_hp = xd[10 * h + 8] - xd[20]
+            R = -(Tn if h == 0 else Tp) * _gain(abs(v_hp), f0, v0, law, SMOOTH_EPS) * v_hp
+            loc[10 * h + 8] += R
+            loc[20] -= R
+    if not lateral:
+        return
     for j in range(2):                                            # link frames, spin rates, half axes
         o = 21 + 4 * j
         x0, x1 = x[o + 2] - x[o], x[o + 3] - x[o + 1]
@@ -275,8 +302,6 @@ def _pin(x, xd, p, T_next, T_prev, b_joint, cs, arc, idx, sig_, cw, par, law, el
         nh[j, 0], nh[j, 1] = -th[j, 1], th[j, 0]
         Qth[j] = 0.0
     for h in range(2):
-        o = 10 * h
-        loc[o + 9] -= (2 * c_half * (2 * x[o + 9] - l) if elastic else 0.0) + 4 * b_half * xd[o + 9]
         _half_bending(x, xd, h, th, nh, thd, par, elastic, loc, Qth, nab)
     for s in range(2):
         _shape((2 * s - 1) * _G, l, H, Hp, Hpp)
@@ -324,22 +349,6 @@ def _pin(x, xd, p, T_next, T_prev, b_joint, cs, arc, idx, sig_, cw, par, law, el
                 _pair(loc, Qth, A, B, H, Ft, t0, t1, kA, kB)
                 Qth[B] -= Ft * sig * RB
                 Qth[A] -= Ft * RA
-    for h in range(2 if elastic else 0):                          # stoppers (erratum 13)
-        s = x[10 * h + 8] - x[20]
-        f = k_stop * max(abs(s) - d_stop, 0.0) * np.sign(s)
-        loc[10 * h + 8] -= f
-        loc[20] += f
-    if f0 != 0.0:                                                 # axial friction (1.221)
-        Tn, Tp = max(T_next, 0.0), max(T_prev, 0.0)
-        v_hh = xd[18] - xd[8]
-        R = -0.5 * (Tn + Tp) * _gain(abs(v_hh), f0, v0, law, SMOOTH_EPS) * v_hh
-        loc[18] += R
-        loc[8] -= R
-        for h in range(2):
-            v_hp = xd[10 * h + 8] - xd[20]
-            R = -(Tn if h == 0 else Tp) * _gain(abs(v_hp), f0, v0, law, SMOOTH_EPS) * v_hp
-            loc[10 * h + 8] += R
-            loc[20] -= R
     if b_joint[p] != 0.0:                                         # joint damping (1.80)
         tq = b_joint[p] * (thd[0] - thd[1])
         Qth[0] -= tq
@@ -393,7 +402,7 @@ def forces(q, v, gl, gp, L, c_twist, b_joint, cs, plate_w, plate_d, plate_c, pla
     for p in range(n):
         for j in range(29):
             y[j], yd[j], lp[j] = q[gp[p, j]], v[gp[p, j]], 0.0
-        _pin(y, yd, p, T[p], T[(p - 1) % n], b_joint, cs, arc, idx, sig, cw, par, law, True, lp, pk)
+        _pin(y, yd, p, T[p], T[(p - 1) % n], b_joint, cs, arc, idx, sig, cw, par, law, True, True, lp, pk)
         for j in range(29):
             Q[gp[p, j]] += lp[j]
     return Q
@@ -465,13 +474,14 @@ def jacobian(q, v, gl, gp, L, c_twist, b_joint, cs, plate_w, plate_d, plate_c, p
         for j in range(58):                                       # 29 coordinates, then 29 velocities
             z = y if j < 29 else yd
             jj = j % 29
+            lateral = jj < 8 or 9 < jj < 18 or jj > 20                # w, q_p reach the axial terms only
             z0 = z[jj]
             h = _step(z0, steps[1], floor) if j < 29 else _step(z0, steps[2], v0)
             for sgn in range(2):
                 z[jj] = z0 + h if sgn == 0 else z0 - h
                 g = g_p if sgn == 0 else g_m
                 g[:] = 0.0
-                _pin(y, yd, p, T[p], T[pv], b_joint, cs, arc, idx, sig, cw, par, law, j < 29, g, pk)
+                _pin(y, yd, p, T[p], T[pv], b_joint, cs, arc, idx, sig, cw, par, law, j < 29, lateral, g, pk)
             z[jj] = z0
             Jx = Jq if j < 29 else Jv
             for r in range(29):
