@@ -77,7 +77,7 @@ def main() -> None:
     for name, fun, calls in (("numba  forces", lambda: ch.forces(q, v), CALLS),
                              ("numba  accel (forces + mass solve)", lambda: ch.accel(q, v), CALLS),
                              ("numpy  forces (reference twin)", lambda: ref.forces(q, v), 200),
-                             ("numba  jacobian, forward link differences", lambda: ch.jacobian(q, v), 200),
+                             ("numba  jacobian, forward link differences", lambda: ch.jacobian(q, v, scheme="forward"), 200),
                              ("numba  jacobian, central link differences",
                               lambda: ch.jacobian(q, v, scheme="central"), 200),
                              ("numba  coloured_jacobian (504 force calls)", lambda: ch.coloured_jacobian(q, v), 5)):

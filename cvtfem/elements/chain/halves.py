@@ -663,15 +663,17 @@ class ChainA5:
         return pat
 
     def jacobian(self, q: np.ndarray, v: np.ndarray, damping: bool = True,
-                 scheme: str = "forward") -> tuple[sp.csr_matrix, sp.csr_matrix | None]:
+                 scheme: str = "central") -> tuple[sp.csr_matrix, sp.csr_matrix | None]:
         """``(dQ/dq, dQ/dv)`` of :meth:`forces` on :attr:`jac_sparsity`; ``damping=False`` returns None for ``dQ/dv``.
 
         Compiled backend: element by element (:func:`halves_kernel.jacobian`): each link's velocity block exact,
-        its coordinate block by ``scheme`` ("forward", step ``sqrt(eps)``, or "central", step ``1e-7``, relative to
+        its coordinate block by ``scheme`` ("central", step ``1e-7``, or "forward", step ``sqrt(eps)``, relative to
         ``max(|x|, l)``) differences of that link alone; each pin's blocks (bending, contacts, friction) central
         differences of the pin alone (steps ``1e-7 max(|x|, l)``, ``1e-3 max(|v|, v_0)``);
-        the axial friction's tension dependence by the chain rule.  About 23 (forward) or 45 (central) link
-        passes and 116 pin passes per element, 25-45 force evaluations in time for 84 pins (docs/chain.md).
+        the axial friction's tension dependence by the chain rule.  Per element 45 (central) or 23 (forward) link
+        passes and 116 pin passes: about 56 or 38 force evaluations in time for 84 pins (docs/chain.md).  Forward
+        differences are one-sided at the kinks of the plate law and the contacts: Newton from the exact straight
+        chain diverged with them, hence central by default.
         numpy backend: :meth:`coloured_jacobian`.
         """
         if scheme not in ("forward", "central"):

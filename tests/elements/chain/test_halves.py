@@ -191,7 +191,7 @@ def test_open_segment_under_end_tension_carries_it_in_every_link():
         R = ch.forces(q, v) + Qext
         if np.abs(R).max() < 1e-9 * T:
             break
-        K, _ = ch.jacobian(q, v, damping=False)
+        K, _ = ch.jacobian(q, v, damping=False)        # central: forward differences diverge from the kinks here
         q = q + np.linalg.lstsq(-K.toarray(), R, rcond=1e-12)[0]
     assert np.abs(ch.forces(q, v) + Qext).max() < 1e-9 * T
     out = ch.outputs(q)
@@ -207,7 +207,8 @@ def _ring_run(periods, rtol, n=6, lossy=False):
     """A free 6-pin ring (soft parameters: highest frequency ~7x the lowest link mode), DOP853.
 
     ``lossy``: damping and friction on, and the state carries the dissipated energy ``D' = 2 Phi - P_friction``;
-    returns ``E + D`` then."""
+    returns ``E + D`` then.  Also returns the round-off scale of the momentum, ``eps sqrt(m) max|Q(0)| t_end``
+    (the internal forces sum to zero only up to the rounding of their element contributions)."""
     soft = dict(plate_stiffness=1e8, plate_bending_stiffness=0.03, plate_torsion_stiffness=5.0,
                 pin_axial_stiffness=2e6, half_bending_tau=0.05, half_bending_n=0.1, roll_stiffness=1e9,
                 hole_stiffness=1e9, hole_clearance=1.2e-3, hole_radius=0.0038, stopper_play=0.0, plate_model="A3-keep")
@@ -233,18 +234,19 @@ def _ring_run(periods, rtol, n=6, lossy=False):
     ys = sol.y.T[:: max(1, sol.y.shape[1] // 50)]
     E = np.array([ch.kinetic_energy(y[m:2 * m]) + ch.potential_energy(y[:m]) + (y[-1] if lossy else 0.0) for y in ys])
     P = np.array([ch.momentum(y[m:2 * m]) for y in ys])
-    return E, P, ch.momentum(v0), sol.y[-1, -1] if lossy else 0.0
+    roundoff = np.finfo(float).eps * np.sqrt(m) * np.abs(ch.forces(q0, v0)).max() * sol.t[-1]
+    return E, P, ch.momentum(v0), sol.y[-1, -1] if lossy else 0.0, roundoff
 
 
 def test_free_ring_conserves_momentum_and_energy():
-    E, P, P0, _ = _ring_run(periods=0.5, rtol=1e-8)
+    E, P, P0, _, _ = _ring_run(periods=0.5, rtol=1e-8)
     assert np.abs(E - E[0]).max() < 1e-6 * E[0]
     assert np.abs(P - P0).max() < 1e-12 * max(np.abs(P0).max(), 1e-3)
 
 
 def test_damped_ring_with_friction_loses_exactly_its_dissipated_energy():
     """E + int (2 Phi - Q_friction . v) dt stays constant while a good part of E is dissipated."""
-    E, P, P0, lost = _ring_run(periods=0.2, rtol=1e-8, lossy=True)
+    E, P, P0, lost, _ = _ring_run(periods=0.2, rtol=1e-8, lossy=True)
     assert lost > 0.05 * E[0]
     assert np.abs(E - E[0]).max() < 1e-6 * lost
     assert np.abs(P - P0).max() < 1e-12 * np.abs(P0).max()               # internal forces, friction included
@@ -252,9 +254,10 @@ def test_damped_ring_with_friction_loses_exactly_its_dissipated_energy():
 
 @pytest.mark.slow
 def test_free_ring_conserves_energy_over_many_periods():
-    E, P, P0, _ = _ring_run(periods=20, rtol=1e-9)
+    E, P, P0, _, roundoff = _ring_run(periods=20, rtol=1e-9)
     assert np.abs(E - E[0]).max() < 1e-6 * E[0]
-    assert np.abs(P - P0).max() < 1e-12 * max(np.abs(P0).max(), 1e-3)
+    assert np.abs(P - P0).max() < roundoff            # 1.1e-15 kg m/s found (compiled pass), 5e-16 (numpy); 1.5e-14
+
 
 
 def test_point_loads_are_the_virtual_work_at_half_axis_points():

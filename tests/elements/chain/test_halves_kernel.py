@@ -78,7 +78,8 @@ JAC_CASES = ["A4 closed, linear-saturated", "A4 open, smooth", "holes closed, st
 @pytest.mark.parametrize("case", JAC_CASES)
 def test_element_jacobian_equals_central_differences(case):
     """All columns of both matrices, relative to each column's largest entry, everywhere (so also zero outside
-    ``jac_sparsity``); central link differences to 1e-5, forward to 1e-3."""
+    ``jac_sparsity``): dQ/dq with central link differences to 1e-5, forward to 1e-3 (found 2e-6, 3e-4), dQ/dv to
+    1e-4 (found 2e-5)."""
     kw, v_scale = CASES[case]
     ch, ref = chain(**kw), chain(use_numba=False, **kw)
     rng = np.random.default_rng(3)
@@ -88,7 +89,7 @@ def test_element_jacobian_equals_central_differences(case):
     for scheme, tol_q in (("central", 1e-5), ("forward", 1e-3)):
         K, C = ch.jacobian(q, v, scheme=scheme)
         assert np.all(np.abs(K.toarray() - ref_q).max(0) <= tol_q * scale_q)
-        assert np.all(np.abs(C.toarray() - ref_v).max(0) <= 2e-3 * scale_v)
+        assert np.all(np.abs(C.toarray() - ref_v).max(0) <= 1e-4 * scale_v)
     assert ch.jacobian(q, v, damping=False)[1] is None
 
 
