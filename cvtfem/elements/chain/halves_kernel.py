@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from cvtfem.elements.chain.plates_kernel import _plate_law, _strain_rates, _strains
+from cvtfem.elements.chain.plates_kernel import _plate_law, _strain_rates
 from cvtfem.elements.contact.kernels import LAW_CODES, _gain
 from cvtfem.elements.jit import HAVE_NUMBA, njit
 
@@ -81,10 +81,10 @@ def _shape(xi, l, H, Hp, Hpp):
 # ---------------------------------------------------------------------------------------------- links
 @njit(cache=True)
 def _link_work():
-    """Scratch arrays of :func:`_link`."""
+    """Scratch arrays of :func:`_link` (``J`` zero: :func:`_virtual_strains` writes only its nonzero columns)."""
     return (np.zeros(20), np.zeros(20), np.zeros(20), np.zeros((3, 4)), np.zeros((3, 4)), np.zeros((3, 20)),
-            np.zeros((3, 3)), np.zeros(4), np.zeros(4), np.zeros(3), np.zeros((2, 3)), np.zeros((2, 3)),
-            np.zeros(3), np.zeros(3), np.zeros(10), np.zeros(22), np.zeros(20), np.zeros((3, 22)))
+            np.zeros((3, 3)), np.zeros(3), np.zeros((2, 3)), np.zeros(3), np.zeros(3), np.zeros(10), np.zeros(22),
+            np.zeros(20), np.zeros((3, 22)))
 
 
 @njit(cache=True)
@@ -109,6 +109,31 @@ def _virtual_pin(x, xd, b, d, l, qv, qvd, Hm):
     qv[o + 8], qv[o + 9] = x[o + 8] + x[o + 9] * xi, x[o + 9]
     qvd[o + 8], qvd[o + 9] = xd[o + 8] + xd[o + 9] * xi + x[o + 9] * xid, xd[o + 9]
     return xi
+
+
+@njit(cache=True)
+def _virtual_strains(qv, l, L, J, tau, e):
+    """``(psi_1, psi_2, Delta)`` of a plate between two virtual pins (``xi = 0``, ``u_2 = u_3 = 0``): the strains
+    (1.186)-(1.189) of ``plates_kernel._strains`` there, ``V = u_0+ - u_0-``, ``t_a = (2/l u_1, 1)``.  Fills the
+    columns ``u_0``, ``u_1``, ``w_0`` of ``J`` (3, 20); the others (``u_2``, ``u_3``, ``w_1``) stay zero."""
+    V0, V1, V2 = qv[10] - qv[0], qv[11] - qv[1], qv[18] - qv[8]
+    Lt = np.sqrt(V0 * V0 + V1 * V1 + V2 * V2)
+    tau[0], tau[1], tau[2] = V0 / Lt, V1 / Lt, V2 / Lt
+    psi = (tau[0] * 2.0 / l * qv[2] + tau[1] * 2.0 / l * qv[3] + tau[2],
+           tau[0] * 2.0 / l * qv[12] + tau[1] * 2.0 / l * qv[13] + tau[2])
+    for a in range(2):
+        o = 10 * a
+        e[a, 0] = (2.0 / l * qv[o + 2] - tau[0] * psi[a]) / Lt
+        e[a, 1] = (2.0 / l * qv[o + 3] - tau[1] * psi[a]) / Lt
+        e[a, 2] = (1.0 - tau[2] * psi[a]) / Lt
+    for b in range(2):
+        o = 10 * b
+        sg = 2.0 * b - 1.0
+        for x in range(2):
+            J[0, o + x], J[1, o + x], J[2, o + x] = sg * e[0, x], sg * e[1, x], sg * tau[x]
+            J[b, o + 2 + x] = 2.0 / l * tau[x]
+        J[0, o + 8], J[1, o + 8], J[2, o + 8] = sg * e[0, 2], sg * e[1, 2], sg * tau[2]
+    return psi[0], psi[1], Lt - L
 
 
 @njit(cache=True)
@@ -137,7 +162,7 @@ def _link(x, xd, e, L, c_twist, plate_w, plate_d, plate_c, plate_c1, plate_c2, p
     their exact velocity derivative (they are linear in ``xd``) to ``Dv`` (22, 22; symmetric, the upper triangle
     overwritten).  Returns the link tension (N).
     """
-    qv, qvd, Qf, Ha, Hb, J, A, H, Hp, V, t, ev, ed, r, m, Jp, row, AJG = wk
+    qv, qvd, Qf, Ha, Hb, J, A, V, ev, ed, r, m, Jp, row, AJG = wk
     l, beta_ext, beta_shear, beta_twist, h_pl = par[0], par[6], par[7], par[8], par[15]
     Le = L[e]
     T = 0.0
@@ -148,7 +173,7 @@ def _link(x, xd, e, L, c_twist, plate_w, plate_d, plate_c, plate_c1, plate_c2, p
         xa = _virtual_pin(x, xd, 0, plate_d[e, k], l, qv, qvd, Ha)
         xb = _virtual_pin(x, xd, 1, plate_d[e, k], l, qv, qvd, Hb)
         c, c1, c2 = plate_c[e, k], plate_c1[e, k], plate_c2[e, k]
-        psi1, psi2, Delta = _strains(qv, 0.0, l, Le, J, H, Hp, V, t, ev)
+        psi1, psi2, Delta = _virtual_strains(qv, l, Le, J, V, ev)
         st, d1, d2, tension = _plate_law(kmodel, psi1, psi2, Delta, c, c1, c2, h_pl, A, m)
         z1, z2 = psi1 - d1, psi2 - d2
         _strain_rates(J, qvd, A, ed, r)
