@@ -34,8 +34,9 @@ through :mod:`cvtfem.elements.contact.friction`.
 
 **Backends.** With ``use_numba`` :meth:`ChainA5.forces` runs the whole pass in the compiled
 :mod:`halves_kernel` (plate ends as virtual whole pins, the per-plate law of ``plates_kernel``); the numpy
-pass here is its tested twin.  The Jacobian is assembled element by element in the kernel (exact velocity blocks of the links, differences
-of single links and pins), or coloured central differences of the forces on the 5-pin stencil.
+pass here is its tested twin.  The Jacobian is assembled element by element in the kernel (exact velocity
+blocks of the links, differences of single links and pins), or coloured central differences of the forces on
+the 5-pin stencil.
 
 **A2** (:class:`CoupledHalvesA2`): the whole pins of :class:`ChainA1` with two half-pin end points
 per pin end, ``U(xi_e) +- h_pin tau_p`` (1.210), and the exact virtual work of a force there.
@@ -603,7 +604,7 @@ class ChainA5:
         return self._evaluate(q, v)["friction"]
 
     def forces(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
-        """``Q = -dPi/dq - dPhi/dv + Q_friction`` in one pass (compiled :func:`halves_kernel.forces` with ``use_numba``)."""
+        """``Q = -dPi/dq - dPhi/dv + Q_friction`` in one pass (:func:`halves_kernel.forces` with ``use_numba``)."""
         if self.backend == "numba":
             return HK.forces(np.asarray(q, float), np.asarray(v, float), *self._kernel_args)
         r = self._evaluate(q, v)

@@ -47,9 +47,10 @@ def pack(ch, contacts) -> tuple:
                                                    sig, cw, par, ints))
 
 
-def positions(args: tuple, dof_index: np.ndarray, pattern) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def positions(args: tuple, dof_index: np.ndarray, pattern) -> tuple[np.ndarray, ...]:
     """Positions in the data of the sorted CSR ``pattern`` of the link blocks ``(n, 22, 22)``, the pin blocks
-    ``(n, 29, 29)`` and the axial-friction rows against the tensions' link coordinates ``(n, 2, 3, 22)``.
+    ``(n, 29, 29)`` and the axial-friction rows against the tensions' link coordinates ``(n, 2, 3, 22)``, and
+    ``first (n, 29)``: the first local copy of each pin coordinate (the link ends repeat pin coordinates).
 
     Entries outside the pattern (only the absent link of an open segment, whose terms are all zero) point to
     the spare slot ``pattern.nnz``: the data arrays have ``nnz + 1`` entries.
@@ -66,7 +67,8 @@ def positions(args: tuple, dof_index: np.ndarray, pattern) -> tuple[np.ndarray, 
     pos_t = lut[fr[:, None, :, None], gl[links][:, :, None, :]]
     if max(pos_l[link_w].max(), pos_p.max(), pos_t[link_w[links]].max()) == pattern.nnz:
         raise AssertionError("halves_kernel.positions: an element block reaches outside the Jacobian pattern")
-    return pos_l, pos_p, pos_t
+    first = np.argmax(gp[:, :, None] == gp[:, None, :], axis=2)
+    return pos_l, pos_p, pos_t, first
 
 
 @njit(cache=True)
@@ -91,7 +93,8 @@ def _link_work():
 def _virtual_pin(x, xd, b, d, l, qv, qvd, Hm):
     """End ``b`` of a plate at offset ``d`` as a virtual whole pin at ``xi = 0`` (``qv``, ``qvd`` entries
     ``10 b .. 10 b + 9``): ``u_0 = U_perp(xi_b)``, ``u_1 = dU_perp/dxi``, ``u_2 = u_3 = 0``, ``w_0 = U_par(xi_b)``,
-    ``w_1``, the same strains as the half's axis (1.211)-(1.212).  ``Hm`` (3, 4) gets ``h, h', h''``; returns ``xi_b``."""
+    ``w_1``, the same strains as the half's axis (1.211)-(1.212).  ``Hm`` (3, 4) gets ``h, h', h''``; returns
+    ``xi_b``."""
     o = 10 * b
     xi = 2.0 / l * (x[20 + b] - x[o + 8] + d)
     xid = 2.0 / l * (xd[20 + b] - xd[o + 8])
@@ -360,7 +363,7 @@ def _pin(x, xd, p, T_next, T_prev, b_joint, cs, arc, idx, sig_, cw, par, law, el
                 gdot = sig * (n0 * vr0 + n1 * vr1 + (n0 * kB[0] + n1 * kB[1]) * thd[B]
                               - (n0 * kA[0] + n1 * kA[1]) * thd[A])
                 _pair(loc, Qth, A, B, H, -wgt * b_roll * gdot * sig, n0, n1, kA, kB)
-            if k_tie != 0.0 and ic == 0 and elastic:                          # g_t = R_A ang(n, tau_A) + R_B ang(n, tau_B)
+            if k_tie != 0.0 and ic == 0 and elastic:              # g_t = R_A ang(n, tau_A) + R_B ang(n, tau_B)
                 gt = (RA * np.arctan2(n0 * tau[A, 1] - n1 * tau[A, 0], n0 * tau[A, 0] + n1 * tau[A, 1])
                       + RB * np.arctan2(n0 * tau[B, 1] - n1 * tau[B, 0], n0 * tau[B, 0] + n1 * tau[B, 1]))
                 st = wgt * k_tie * gt
@@ -442,16 +445,17 @@ def _step(x, rel, floor):
 
 @njit(cache=True)
 def jacobian(q, v, gl, gp, L, c_twist, b_joint, cs, plate_w, plate_d, plate_c, plate_c1, plate_c2, arc, idx, sig,
-             cw, par, ints, pos_l, pos_p, pos_t, steps, central_link, Jq, Jv):
+             cw, par, ints, pos_l, pos_p, pos_t, first, steps, central_link, Jq, Jv):
     """``dQ/dq``, ``dQ/dv`` of :func:`forces` added into the CSR data ``Jq``, ``Jv`` (positions ``pos_l (n, 22, 22)``
     of the link blocks, ``pos_p (n, 29, 29)`` of the pin blocks, ``pos_t (n, 2, 3, 22)`` of the axial friction
-    rows against the tensions' link coordinates).
+    rows against the tensions' link coordinates; ``first`` of :func:`positions`).
 
     Element by element: a link's velocity block is exact (its forces are linear in the velocities), its
     coordinate block forward (``central_link`` false) or central differences of the link alone; a pin's blocks
-    central differences of the pin alone; the axial friction's dependence on the link tensions by the chain
-    rule with the tensions' differences.  ``steps = (link, pin coordinate, pin velocity)`` relative steps,
-    applied to ``max(|x|, l)`` and ``max(|v|, v_0)`` (smaller steps drown in the round-off of the contact forces).
+    central differences of the pin alone (a coordinate and its copies at once); the axial friction's
+    dependence on the link tensions by the chain rule with the tensions' differences.  ``steps = (link, pin
+    coordinate, pin velocity)`` relative steps, applied to ``max(|x|, l)`` and ``max(|v|, v_0)`` (smaller steps
+    drown in the round-off of the contact forces).
     """
     n = L.shape[0]
     l, f0, v0 = par[0], par[13], par[14]
@@ -499,15 +503,21 @@ def jacobian(q, v, gl, gp, L, c_twist, b_joint, cs, plate_w, plate_d, plate_c, p
         for j in range(58):                                       # 29 coordinates, then 29 velocities
             z = y if j < 29 else yd
             jj = j % 29
+            if first[p, jj] != jj:                                # a copy: moved with its first
+                continue
             lateral = jj < 8 or 9 < jj < 18 or jj > 20                # w, q_p reach the axial terms only
             z0 = z[jj]
             h = _step(z0, steps[1], floor) if j < 29 else _step(z0, steps[2], v0)
             for sgn in range(2):
-                z[jj] = z0 + h if sgn == 0 else z0 - h
+                for k in range(jj, 29):
+                    if first[p, k] == jj:
+                        z[k] = z0 + h if sgn == 0 else z0 - h
                 g = g_p if sgn == 0 else g_m
                 g[:] = 0.0
                 _pin(y, yd, p, T[p], T[pv], b_joint, cs, arc, idx, sig, cw, par, law, j < 29, lateral, g, pk)
-            z[jj] = z0
+            for k in range(jj, 29):
+                if first[p, k] == jj:
+                    z[k] = z0
             Jx = Jq if j < 29 else Jv
             for r in range(29):
                 Jx[pos_p[p, r, jj]] += (g_p[r] - g_m[r]) / (2 * h)
