@@ -235,7 +235,7 @@ def _pin_work():
     """Scratch arrays of :func:`_pin`."""
     return (np.zeros((2, 2)), np.zeros(2), np.zeros(2), np.zeros((2, 2)), np.zeros((2, 2)), np.zeros(2),
             np.zeros(4), np.zeros(4), np.zeros(4), np.zeros((2, 2)), np.zeros((2, 2)), np.zeros(2), np.zeros(2),
-            np.zeros((2, 2)))
+            np.zeros((2, 2)), np.zeros((2, 4)), np.zeros((2, 3, 9)))
 
 
 @njit(cache=True)
@@ -284,7 +284,46 @@ def _half_bending(x, xd, h, th, nh, thd, par, elastic, loc, Qth, nab):
 
 
 @njit(cache=True)
-def _pin(x, xd, p, T_next, T_prev, b_joint, cs, arc, idx, sig_, cw, par, law, elastic, lateral, loc, wk):
+def _pin_geometry(x, p, cs, arc, idx, sig_, cw, par, tau, rho, th, nh, H, Hp, Hpp, Ux, Hs, CG):
+    """Link frames ``tau``, ``rho`` and half axes ``th``, ``nh`` (1.215) of pin ``p``, the station shape values
+    ``Hs`` (2, 4) and per station and contact ``CG (2, 3, 9) = (distance, normal (2), gap, normal force, k x r_A,
+    k x r_B)`` (arcs at the half axes, penalty ``(l/2) w k [-g]_+``)."""
+    l = par[0]
+    for j in range(2):
+        o = 21 + 4 * j
+        x0, x1 = x[o + 2] - x[o], x[o + 3] - x[o + 1]
+        rho[j] = np.sqrt(x0 * x0 + x1 * x1)
+        tau[j, 0], tau[j, 1] = x0 / rho[j], x1 / rho[j]
+        c, s = cs[j, 0], cs[j, 1]
+        th[j, 0] = c * tau[j, 0] - s * tau[j, 1]
+        th[j, 1] = c * tau[j, 1] + s * tau[j, 0]
+        nh[j, 0], nh[j, 1] = -th[j, 1], th[j, 0]
+    for s in range(2):
+        _shape((2 * s - 1) * _G, l, H, Hp, Hpp)
+        Hs[s, :] = H
+        for h in range(2):
+            for c in range(2):
+                a = 0.0
+                for i in range(4):
+                    a += H[i] * x[10 * h + 2 * i + c]
+                Ux[h, c] = a
+        for ic in range(3):
+            A, B = idx[ic, 0], idx[ic, 1]
+            rA0 = arc[ic, 0] * th[A, 0] + arc[ic, 1] * nh[A, 0]
+            rA1 = arc[ic, 0] * th[A, 1] + arc[ic, 1] * nh[A, 1]
+            rB0 = arc[ic, 3] * th[B, 0] + arc[ic, 4] * nh[B, 0]
+            rB1 = arc[ic, 3] * th[B, 1] + arc[ic, 4] * nh[B, 1]
+            d0 = Ux[B, 0] + rB0 - Ux[A, 0] - rA0
+            d1 = Ux[B, 1] + rB1 - Ux[A, 1] - rA1
+            dist = np.sqrt(d0 * d0 + d1 * d1)
+            g = sig_[ic] * (dist - arc[ic, 6])
+            CG[s, ic, 0], CG[s, ic, 1], CG[s, ic, 2], CG[s, ic, 3] = dist, d0 / dist, d1 / dist, g
+            CG[s, ic, 4] = l / 2 * cw[ic, p] * arc[ic, 7] * max(-g, 0.0)
+            CG[s, ic, 5], CG[s, ic, 6], CG[s, ic, 7], CG[s, ic, 8] = -rA1, rA0, -rB1, rB0
+
+
+@njit(cache=True)
+def _pin(x, xd, p, T_next, T_prev, b_joint, cs, arc, idx, sig_, cw, par, law, elastic, lateral, cached, loc, wk):
     """Everything of pin ``p`` but its links, on 29 local coordinates ``x`` and velocities ``xd``: half ``-`` (0..9,
     A1 order), half ``+`` (10..19), ``q_p`` (20) and the ends of the links giving the half axes (1.215): start and
     end ``u_0`` of the ``-`` half's link (21..24), of the ``+`` half's link (25..28), copies allowed.  Half axial
@@ -292,9 +331,11 @@ def _pin(x, xd, p, T_next, T_prev, b_joint, cs, arc, idx, sig_, cw, par, law, el
     rolling friction), stoppers, axial friction (1.221) with the link tensions ``T_next`` (link ``(p, p+1)``) and
     ``T_prev`` (``(p-1, p)``) and joint damping (1.80); half torques go to the link ends.  Adds to ``loc`` (29,);
     without ``elastic`` only the velocity-dependent forces (their differences then keep their own round-off),
-    without ``lateral`` only the axial terms (half axial, stoppers, axial friction: all that ``w``, ``q_p`` reach).
+    without ``lateral`` only the axial terms (half axial, stoppers, axial friction: all that ``w``, ``q_p`` reach);
+    with ``cached`` the geometry (frames, stations, contact normals and forces) of the previous call is reused
+    (only ``xd`` changed since).
     """
-    tau, rho, thd, th, nh, Qth, H, Hp, Hpp, Ux, Vx, kA, kB, nab = wk
+    tau, rho, thd, th, nh, Qth, H, Hp, Hpp, Ux, Vx, kA, kB, nab, Hs, CG = wk
     l, c_half, b_half, b_roll, k_tie = par[0], par[1], par[2], par[9], par[10]
     k_stop, d_stop, f0, v0 = par[11], par[12], par[13], par[14]
     for h in range(2):
@@ -318,63 +359,48 @@ def _pin(x, xd, p, T_next, T_prev, b_joint, cs, arc, idx, sig_, cw, par, law, el
             loc[20] -= R
     if not lateral:
         return
-    for j in range(2):                                            # link frames, spin rates, half axes
+    if not cached:
+        _pin_geometry(x, p, cs, arc, idx, sig_, cw, par, tau, rho, th, nh, H, Hp, Hpp, Ux, Hs, CG)
+    for j in range(2):                                            # spin rates of the links
         o = 21 + 4 * j
-        x0, x1 = x[o + 2] - x[o], x[o + 3] - x[o + 1]
-        rho[j] = np.sqrt(x0 * x0 + x1 * x1)
-        tau[j, 0], tau[j, 1] = x0 / rho[j], x1 / rho[j]
         thd[j] = (-tau[j, 1] * (xd[o + 2] - xd[o]) + tau[j, 0] * (xd[o + 3] - xd[o + 1])) / rho[j]
-        c, s = cs[j, 0], cs[j, 1]
-        th[j, 0] = c * tau[j, 0] - s * tau[j, 1]
-        th[j, 1] = c * tau[j, 1] + s * tau[j, 0]
-        nh[j, 0], nh[j, 1] = -th[j, 1], th[j, 0]
         Qth[j] = 0.0
     for h in range(2):
         _half_bending(x, xd, h, th, nh, thd, par, elastic, loc, Qth, nab)
     for s in range(2):
-        _shape((2 * s - 1) * _G, l, H, Hp, Hpp)
+        Hst = Hs[s]
         for h in range(2):
             for c in range(2):
-                a, b = 0.0, 0.0
+                b = 0.0
                 for i in range(4):
-                    a += H[i] * x[10 * h + 2 * i + c]
-                    b += H[i] * xd[10 * h + 2 * i + c]
-                Ux[h, c], Vx[h, c] = a, b
+                    b += Hst[i] * xd[10 * h + 2 * i + c]
+                Vx[h, c] = b
         for ic in range(3):
             A, B, sig = idx[ic, 0], idx[ic, 1], sig_[ic]
-            RA, RB, rho0, k = arc[ic, 2], arc[ic, 5], arc[ic, 6], arc[ic, 7]
+            RA, RB = arc[ic, 2], arc[ic, 5]
             wgt = l / 2 * cw[ic, p]
-            rA0 = arc[ic, 0] * th[A, 0] + arc[ic, 1] * nh[A, 0]
-            rA1 = arc[ic, 0] * th[A, 1] + arc[ic, 1] * nh[A, 1]
-            rB0 = arc[ic, 3] * th[B, 0] + arc[ic, 4] * nh[B, 0]
-            rB1 = arc[ic, 3] * th[B, 1] + arc[ic, 4] * nh[B, 1]
-            d0 = Ux[B, 0] + rB0 - Ux[A, 0] - rA0
-            d1 = Ux[B, 1] + rB1 - Ux[A, 1] - rA1
-            dist = np.sqrt(d0 * d0 + d1 * d1)
-            n0, n1 = d0 / dist, d1 / dist
+            dist, n0, n1, g, N = CG[s, ic, 0], CG[s, ic, 1], CG[s, ic, 2], CG[s, ic, 3], CG[s, ic, 4]
+            kA[0], kA[1], kB[0], kB[1] = CG[s, ic, 5], CG[s, ic, 6], CG[s, ic, 7], CG[s, ic, 8]
             t0, t1 = -n1, n0
-            g = sig * (dist - rho0)
-            N = wgt * k * max(-g, 0.0)
-            kA[0], kA[1], kB[0], kB[1] = -rA1, rA0, -rB1, rB0
             if N != 0.0 and elastic:
-                _pair(loc, Qth, A, B, H, N * sig, n0, n1, kA, kB)
+                _pair(loc, Qth, A, B, Hst, N * sig, n0, n1, kA, kB)
             vr0, vr1 = Vx[B, 0] - Vx[A, 0], Vx[B, 1] - Vx[A, 1]
             if b_roll != 0.0 and ic == 0 and g < 0:
                 gdot = sig * (n0 * vr0 + n1 * vr1 + (n0 * kB[0] + n1 * kB[1]) * thd[B]
                               - (n0 * kA[0] + n1 * kA[1]) * thd[A])
-                _pair(loc, Qth, A, B, H, -wgt * b_roll * gdot * sig, n0, n1, kA, kB)
+                _pair(loc, Qth, A, B, Hst, -wgt * b_roll * gdot * sig, n0, n1, kA, kB)
             if k_tie != 0.0 and ic == 0 and elastic:              # g_t = R_A ang(n, tau_A) + R_B ang(n, tau_B)
                 gt = (RA * np.arctan2(n0 * tau[A, 1] - n1 * tau[A, 0], n0 * tau[A, 0] + n1 * tau[A, 1])
                       + RB * np.arctan2(n0 * tau[B, 1] - n1 * tau[B, 0], n0 * tau[B, 0] + n1 * tau[B, 1]))
                 st = wgt * k_tie * gt
-                _pair(loc, Qth, A, B, H, (RA + RB) / dist * st, t0, t1, kA, kB)
+                _pair(loc, Qth, A, B, Hst, (RA + RB) / dist * st, t0, t1, kA, kB)
                 Qth[A] -= st * RA
                 Qth[B] -= st * RB
             if f0 != 0.0 and N != 0.0:
                 vs = (t0 * vr0 + t1 * vr1 + (t0 * kB[0] + t1 * kB[1] - sig * RB) * thd[B]
                       - (t0 * kA[0] + t1 * kA[1] + RA) * thd[A])
                 Ft = -N * _gain(abs(vs), f0, v0, law, SMOOTH_EPS) * vs
-                _pair(loc, Qth, A, B, H, Ft, t0, t1, kA, kB)
+                _pair(loc, Qth, A, B, Hst, Ft, t0, t1, kA, kB)
                 Qth[B] -= Ft * sig * RB
                 Qth[A] -= Ft * RA
     if b_joint[p] != 0.0:                                         # joint damping (1.80)
@@ -430,7 +456,7 @@ def forces(q, v, gl, gp, L, c_twist, b_joint, cs, plate_w, plate_d, plate_c, pla
     for p in range(n):
         for j in range(29):
             y[j], yd[j], lp[j] = q[gp[p, j]], v[gp[p, j]], 0.0
-        _pin(y, yd, p, T[p], T[(p - 1) % n], b_joint, cs, arc, idx, sig, cw, par, law, True, True, lp, pk)
+        _pin(y, yd, p, T[p], T[(p - 1) % n], b_joint, cs, arc, idx, sig, cw, par, law, True, True, False, lp, pk)
         for j in range(29):
             Q[gp[p, j]] += lp[j]
     return Q
@@ -505,6 +531,8 @@ def jacobian(q, v, gl, gp, L, c_twist, b_joint, cs, plate_w, plate_d, plate_c, p
             jj = j % 29
             if first[p, jj] != jj:                                # a copy: moved with its first
                 continue
+            if j == 29:                                           # geometry at the unperturbed coordinates
+                _pin(y, yd, p, T[p], T[pv], b_joint, cs, arc, idx, sig, cw, par, law, False, True, False, g_p, pk)
             lateral = jj < 8 or 9 < jj < 18 or jj > 20                # w, q_p reach the axial terms only
             z0 = z[jj]
             h = _step(z0, steps[1], floor) if j < 29 else _step(z0, steps[2], v0)
@@ -514,7 +542,8 @@ def jacobian(q, v, gl, gp, L, c_twist, b_joint, cs, plate_w, plate_d, plate_c, p
                         z[k] = z0 + h if sgn == 0 else z0 - h
                 g = g_p if sgn == 0 else g_m
                 g[:] = 0.0
-                _pin(y, yd, p, T[p], T[pv], b_joint, cs, arc, idx, sig, cw, par, law, j < 29, lateral, g, pk)
+                _pin(y, yd, p, T[p], T[pv], b_joint, cs, arc, idx, sig, cw, par, law, j < 29, lateral, j >= 29, g,
+                     pk)
             for k in range(jj, 29):
                 if first[p, k] == jj:
                     z[k] = z0
