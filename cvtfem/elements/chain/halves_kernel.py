@@ -1,14 +1,13 @@
-"""Compiled force pass (numba) of the A5 chain with independent pin halves: one loop over links, one over pins.
+"""Compiled force pass and Jacobian (numba) of the A5 chain with independent pin halves, element by element.
 
-The numpy methods of :class:`~cvtfem.elements.chain.halves.ChainA5` are the reference twin:
-:func:`forces` computes ``Q = -dPi/dq - dPhi/dv + Q_friction`` with the same formulas (half axial and
-bending (1.214), (1.216); plates at the variable stations (1.211)-(1.212) through the virtual-pin map and
-the per-plate law of :mod:`plates_kernel`; twist (1.146), (1.217); the three arc contacts with damping, tie
-and rolling friction; stoppers; axial friction (1.221); joint damping (1.80)), without numpy's per-call
-overhead on 84-pin arrays (``tests/elements/chain/test_halves_kernel.py`` checks the two against each other).
-
-Arguments: state ``q`` and velocity ``v`` (21 n, layout of ``ChainA5``) and the constant tuple of
-:func:`pack`.  Without numba (``HAVE_NUMBA`` false) the family uses its numpy twin.
+The pass is a sum of link elements (:func:`_link`: plates at the variable stations (1.211)-(1.212) through the
+virtual-pin map and the per-plate law of :mod:`plates_kernel`, twist (1.146), (1.217)) and pin elements
+(:func:`_pin`: half axial and bending (1.214), (1.216), the three arc contacts with damping, tie and rolling
+friction, stoppers, axial friction (1.221), joint damping (1.80)), gathered and scattered through index tables.
+:func:`forces` sums them; :func:`jacobian` differentiates each element alone (exact link velocity blocks,
+differences of one link or one pin) into the CSR data of the Jacobian pattern.  The numpy methods of
+:class:`~cvtfem.elements.chain.halves.ChainA5` are the reference twin (``tests/elements/chain/test_halves_kernel.py``).
+Arguments: state ``q`` and velocity ``v`` (21 n, layout of ``ChainA5``) and the constant tuple of :func:`pack`.
 """
 from __future__ import annotations
 
