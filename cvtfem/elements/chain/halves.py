@@ -47,7 +47,6 @@ from types import SimpleNamespace
 
 import numpy as np
 import scipy.sparse as sp
-from scipy.sparse.linalg import splu
 
 from cvtfem.elements.chain import halves_kernel as HK
 from cvtfem.elements.chain import plates as P
@@ -230,7 +229,7 @@ class ChainA5:
         self.n2 = 21 * n
         self.dof_index = self._dof_index()
         self.mass_matrix = self._mass_matrix()
-        self._lu = splu(self.mass_matrix.tocsc())
+        self.inverse_mass = self._mass_matrix(inverse=True)
         self.jac_sparsity = self._jac_sparsity()
         self.backend = "numba" if use_numba and HK.HAVE_NUMBA else "numpy"
         self._kmodel = {"A4": PK.A4, "A3": PK.A3_DROP, "A3-keep": PK.A3_KEEP}[plate_model]
@@ -278,22 +277,26 @@ class ChainA5:
                 OutputSpec("chain.twist", "rad", "Link twist angle phi (1.146).", n))
 
     # ------------------------------------------------------------------ inertia
-    def _mass_matrix(self) -> sp.csr_matrix:
-        """Constant block-diagonal mass (1.213): per half ``m_perp (x) I_2`` and ``m^pin/2 diag(1, 1/3)``, pack ``m^q``."""
+    def _mass_matrix(self, inverse: bool = False) -> sp.csr_matrix:
+        """Constant block-diagonal mass (1.213): per half ``m_perp (x) I_2`` and ``m^pin/2 diag(1, 1/3)``, pack ``m^q``;
+        with ``inverse`` its inverse (block by block, the same pattern)."""
         l, n = self.l, self.n_pins
         mp = np.kron(_M_PERP * np.outer([1, 1, l, l], [1, 1, l, l]), np.eye(2))
+        mpar, p = _M_PAR, 1.0
+        if inverse:
+            mp, mpar, p = np.linalg.inv(mp), np.linalg.inv(_M_PAR), -1.0
         rows, cols, vals = [], [], []
         for hf in range(2):
             idx = self.dof_index[:, 10 * hf:10 * hf + 10]
             blk = np.zeros((n, 10, 10))
-            blk[:, :8, :8] = self.m_half[hf][:, None, None] * mp
-            blk[:, 8:, 8:] = self.m_axial[:, None, None] * _M_PAR
+            blk[:, :8, :8] = self.m_half[hf][:, None, None] ** p * mp
+            blk[:, 8:, 8:] = self.m_axial[:, None, None] ** p * mpar
             rows.append(np.repeat(idx[:, :, None], 10, 2).ravel())
             cols.append(np.repeat(idx[:, None, :], 10, 1).ravel())
             vals.append(blk.ravel())
         rows.append(self.dof_index[:, 20])
         cols.append(self.dof_index[:, 20])
-        vals.append(self.m_pack)
+        vals.append(self.m_pack ** p)
         M = sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))), shape=(self.n2,) * 2)
         M.eliminate_zeros()
         return M
@@ -308,9 +311,9 @@ class ChainA5:
         return np.r_[pu[:, 0].sum((0, 1)), pw[:, 0].sum() + pq.sum()]
 
     def accel(self, q: np.ndarray, v: np.ndarray, q_ext: np.ndarray | None = None) -> np.ndarray:
-        """``M^{-1} (Q + Q_ext)`` with the factorised constant mass matrix."""
+        """``M^{-1} (Q + Q_ext)`` with the block-diagonal inverse :attr:`inverse_mass`."""
         Q = self.forces(q, v)
-        return self._lu.solve(Q if q_ext is None else Q + q_ext)
+        return self.inverse_mass @ (Q if q_ext is None else Q + q_ext)
 
     # ------------------------------------------------------------------ geometry
     def _frames(self, u: np.ndarray) -> dict:

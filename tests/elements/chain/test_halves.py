@@ -225,7 +225,7 @@ def _ring_run(periods, rtol, n=6, lossy=False):
             return np.r_[v, ch.accel(q, v)]
         r = ch._evaluate(q, v)                                   # one pass: forces, Phi and friction together
         Q = r["friction"] - r["grad"] - r["gradv"]
-        return np.r_[v, ch._lu.solve(Q), 2 * sum(r["Phi"].values()) - v @ r["friction"]]
+        return np.r_[v, ch.inverse_mass @ Q, 2 * sum(r["Phi"].values()) - v @ r["friction"]]
 
     omega = 2 * np.sqrt(2 * soft["plate_stiffness"] / (0.012 + 0.01)) * np.sin(np.pi / n)   # lowest link mode
     y0 = np.r_[q0, v0, [0.0] if lossy else []]
