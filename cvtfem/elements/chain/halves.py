@@ -32,9 +32,11 @@ twist, joint damping (1.80) with the exact gradient, contact normal damping whil
 tension proxies, and regularised Coulomb on the rolling slip of every contact (digest proposal), all
 through :mod:`cvtfem.elements.contact.friction`.
 
-**Backends.** With ``use_numba`` the plate pass of :meth:`ChainA5.forces` runs in the compiled
-``plates_kernel`` (plate ends as virtual whole pins); the numpy pass here is its tested twin.  The
-Jacobian is coloured central differences of the forces on the 5-pin stencil.
+**Backends.** With ``use_numba`` :meth:`ChainA5.forces` runs the whole pass in the compiled
+:mod:`halves_kernel` (plate ends as virtual whole pins, the per-plate law of ``plates_kernel``); the numpy
+pass here is its tested twin.  The Jacobian is assembled element by element in the kernel (exact velocity
+blocks of the links, differences of single links and pins), or coloured central differences of the forces on
+the 5-pin stencil.
 
 **A2** (:class:`CoupledHalvesA2`): the whole pins of :class:`ChainA1` with two half-pin end points
 per pin end, ``U(xi_e) +- h_pin tau_p`` (1.210), and the exact virtual work of a force there.
@@ -45,8 +47,8 @@ from types import SimpleNamespace
 
 import numpy as np
 import scipy.sparse as sp
-from scipy.sparse.linalg import splu
 
+from cvtfem.elements.chain import halves_kernel as HK
 from cvtfem.elements.chain import plates as P
 from cvtfem.elements.chain import plates_kernel as PK
 from cvtfem.elements.chain.asymmetric import (_M_PAR, _M_PERP, ChainA1, _cross, _dot, _kx, shape_functions,
@@ -129,8 +131,8 @@ class ChainA5:
     closed : bool
         Closed loop or open segment (link ``n-1`` absent).
     use_numba : bool
-        :meth:`forces` runs the plate pass in the compiled ``plates_kernel`` (each plate end mapped to a
-        virtual whole pin at ``xi = 0``); the numpy pass is its tested reference twin.
+        :meth:`forces` runs in the compiled :mod:`halves_kernel` (each plate end mapped to a virtual whole
+        pin at ``xi = 0``); the numpy pass is its tested reference twin.
     """
 
     def __init__(self, *, pitch, plate_offset, n_plates, plate_stiffness, plate_bending_stiffness,
@@ -227,10 +229,12 @@ class ChainA5:
         self.n2 = 21 * n
         self.dof_index = self._dof_index()
         self.mass_matrix = self._mass_matrix()
-        self._lu = splu(self.mass_matrix.tocsc())
+        self.inverse_mass = self._mass_matrix(inverse=True)
         self.jac_sparsity = self._jac_sparsity()
-        self.backend = "numba" if use_numba and PK.HAVE_NUMBA else "numpy"
+        self.backend = "numba" if use_numba and HK.HAVE_NUMBA else "numpy"
         self._kmodel = {"A4": PK.A4, "A3": PK.A3_DROP, "A3-keep": PK.A3_KEEP}[plate_model]
+        self._kernel_args = HK.pack(self, CONTACTS)
+        self._positions = None                  # CSR positions of the compiled Jacobian's blocks, at first use
 
     # ------------------------------------------------------------------ layout
     def _dof_index(self) -> np.ndarray:
@@ -273,22 +277,26 @@ class ChainA5:
                 OutputSpec("chain.twist", "rad", "Link twist angle phi (1.146).", n))
 
     # ------------------------------------------------------------------ inertia
-    def _mass_matrix(self) -> sp.csr_matrix:
-        """Constant block-diagonal mass (1.213): per half ``m_perp (x) I_2`` and ``m^pin/2 diag(1, 1/3)``, pack ``m^q``."""
+    def _mass_matrix(self, inverse: bool = False) -> sp.csr_matrix:
+        """Constant block-diagonal mass (1.213): per half ``m_perp (x) I_2`` and ``m^pin/2 diag(1, 1/3)``, pack ``m^q``;
+        with ``inverse`` its inverse (block by block, the same pattern)."""
         l, n = self.l, self.n_pins
         mp = np.kron(_M_PERP * np.outer([1, 1, l, l], [1, 1, l, l]), np.eye(2))
+        mpar, p = _M_PAR, 1.0
+        if inverse:
+            mp, mpar, p = np.linalg.inv(mp), np.linalg.inv(_M_PAR), -1.0
         rows, cols, vals = [], [], []
         for hf in range(2):
             idx = self.dof_index[:, 10 * hf:10 * hf + 10]
             blk = np.zeros((n, 10, 10))
-            blk[:, :8, :8] = self.m_half[hf][:, None, None] * mp
-            blk[:, 8:, 8:] = self.m_axial[:, None, None] * _M_PAR
+            blk[:, :8, :8] = self.m_half[hf][:, None, None] ** p * mp
+            blk[:, 8:, 8:] = self.m_axial[:, None, None] ** p * mpar
             rows.append(np.repeat(idx[:, :, None], 10, 2).ravel())
             cols.append(np.repeat(idx[:, None, :], 10, 1).ravel())
             vals.append(blk.ravel())
         rows.append(self.dof_index[:, 20])
         cols.append(self.dof_index[:, 20])
-        vals.append(self.m_pack)
+        vals.append(self.m_pack ** p)
         M = sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))), shape=(self.n2,) * 2)
         M.eliminate_zeros()
         return M
@@ -303,9 +311,9 @@ class ChainA5:
         return np.r_[pu[:, 0].sum((0, 1)), pw[:, 0].sum() + pq.sum()]
 
     def accel(self, q: np.ndarray, v: np.ndarray, q_ext: np.ndarray | None = None) -> np.ndarray:
-        """``M^{-1} (Q + Q_ext)`` with the factorised constant mass matrix."""
+        """``M^{-1} (Q + Q_ext)`` with the block-diagonal inverse :attr:`inverse_mass`."""
         Q = self.forces(q, v)
-        return self._lu.solve(Q if q_ext is None else Q + q_ext)
+        return self.inverse_mass @ (Q if q_ext is None else Q + q_ext)
 
     # ------------------------------------------------------------------ geometry
     def _frames(self, u: np.ndarray) -> dict:
@@ -332,12 +340,8 @@ class ChainA5:
         return np.bincount(self.axis_link[0], gh[0], n) + np.bincount(self.axis_link[1], gh[1], n)
 
     # ------------------------------------------------------------------ evaluation
-    def _evaluate(self, q: np.ndarray, v: np.ndarray | None, terms=TERMS, fast: bool = False) -> dict:
-        """Energies ``Pi`` (J) and ``Phi`` (W) per term, ``dPi/dq``, ``dPhi/dv`` and the friction forces (vectors).
-
-        ``fast``: the plate pass in the compiled kernel, which returns elastic plus damping forces together
-        (both land in ``grad``) and no plate energies.
-        """
+    def _evaluate(self, q: np.ndarray, v: np.ndarray | None, terms=TERMS) -> dict:
+        """Energies ``Pi`` (J) and ``Phi`` (W) per term, ``dPi/dq``, ``dPhi/dv`` and the friction forces (vectors)."""
         n, l = self.n_pins, self.l
         u, w, qp = self.split(np.asarray(q, float))
         have_v = v is not None
@@ -361,7 +365,7 @@ class ChainA5:
             self._half_bending(u, vu, fr, thd_h, Pi, Phi, gu, gth_h, du, dth_h)
         T_link = np.zeros(n)
         if "plates" in terms or "twist" in terms:
-            gl, dl = self._links(u, w, qp, vu, vw, vq, terms, Pi, Phi, out, fast)
+            gl, dl = self._links(u, w, qp, vu, vw, vq, terms, Pi, Phi, out)
             T_link = out.get("chain.link_tension", T_link)
             self._scatter_links(gl, gu, gw, gq)
             self._scatter_links(dl, du, dw, dq)
@@ -421,7 +425,7 @@ class ChainA5:
             du[:, 2:] += self.beta_bend * mb.transpose(1, 0, 2, 3)
             dth_h -= self.beta_bend * np.sum(_dot(_kx(U), mb), 0)
 
-    def _links(self, u, w, qp, vu, vw, vq, terms, Pi, Phi, out, fast=False):
+    def _links(self, u, w, qp, vu, vw, vq, terms, Pi, Phi, out):
         """Per-plate strains at the variable stations (1.211)-(1.212), (1.219)-(1.220), the plate law, twist.
 
         Returns the link-local gradients ``dPi/dy``, ``dPhi/dy'`` ``(n, 22)`` over (half - of ``e``, half + of
@@ -435,9 +439,7 @@ class ChainA5:
                              vu[1][:, nx].transpose(1, 0, 2).reshape(-1, 8), vw[1][:, nx].T,
                              vq[:, None], vq[nx][:, None]], 1)
         g_loc, d_loc = np.zeros((self.n_pins, 22)), np.zeros((self.n_pins, 22))
-        if "plates" in terms and fast:
-            g_loc -= self._plate_kernel_forces(y, yd, out)
-        elif "plates" in terms:
+        if "plates" in terms:
             eps, J = self._plate_strains(um, up, wm, wp, qp, qp[nx])
             c, c1, c2, wgt = self.plate_c, self.plate_c1, self.plate_c2, self.plate_w
             if self.plate_model == "A4":
@@ -510,57 +512,6 @@ class ChainA5:
             J[..., 20 + b] += 2 / l * dx                                  # xi_b grows with q (1.212)
             J[..., o + 8] -= 2 / l * dx                                   # and falls with w_0 of the half
         return eps, J
-
-    def _plate_kernel_forces(self, y: np.ndarray, yd: np.ndarray, out: dict) -> np.ndarray:
-        """Plate forces on the link-local coordinates ``(n, 22)`` from ``plates_kernel``, elastic plus damping.
-
-        Each plate end ``a`` becomes a virtual whole pin at ``xi = 0``: ``u_0 = U_perp(xi_a)``, ``u_1 = dU_perp/dxi``,
-        ``u_2 = u_3 = 0``, ``w_0 = U_par(xi_a)``, ``w_1`` (the same strains); forces map back through this
-        linear map and its station derivatives (``xi_a`` moves with ``q`` and ``w_0``, (1.212)).
-        """
-        l, n, K = self.l, self.n_pins, self.kmax
-        qv, qvd = np.zeros((n, K, 20)), np.zeros((n, K, 20))
-        maps = []
-        for b in range(2):
-            o = 10 * b
-            u, ud = y[:, o:o + 8].reshape(n, 4, 2), yd[:, o:o + 8].reshape(n, 4, 2)
-            w, wd = y[:, o + 8:o + 10], yd[:, o + 8:o + 10]
-            xi = 2 / l * (y[:, 20 + b][:, None] - w[:, 0][:, None] + self.plate_d)
-            xid = 2 / l * (yd[:, 20 + b] - wd[:, 0])[:, None]
-            H, Hp, Hpp = shape_functions(xi, l), shape_slopes(xi, l), shape_curvatures(xi, l)
-            u1 = np.einsum("iek,eic->ekc", Hp, u)
-            du1 = np.einsum("iek,eic->ekc", Hpp, u)
-            qv[..., o:o + 2] = np.einsum("iek,eic->ekc", H, u)
-            qv[..., o + 2:o + 4] = u1
-            qv[..., o + 8] = w[:, 0][:, None] + w[:, 1][:, None] * xi
-            qv[..., o + 9] = w[:, 1][:, None]
-            qvd[..., o:o + 2] = np.einsum("iek,eic->ekc", H, ud) + u1 * xid[..., None]
-            qvd[..., o + 2:o + 4] = np.einsum("iek,eic->ekc", Hp, ud) + du1 * xid[..., None]
-            qvd[..., o + 8] = wd[:, 0][:, None] + wd[:, 1][:, None] * xi + w[:, 1][:, None] * xid
-            qvd[..., o + 9] = wd[:, 1][:, None]
-            maps.append((H, Hp, xi, u1, du1, w))
-        shp = (n * K,)
-        c, c1, c2 = self.plate_c.ravel(), self.plate_c1.ravel(), self.plate_c2.ravel()
-        T, M, st = np.zeros(shp), np.zeros(shp + (2,)), np.zeros(shp, np.int64)
-        Qf = np.zeros(shp + (20,))
-        PK.plate_forces_kernel(qv.reshape(-1, 20), qvd.reshape(-1, 20), np.zeros(shp), np.full(shp, l),
-                               np.repeat(self.L, K), c, c1, c2, np.full(shp, self.plate_h), self.beta_ext,
-                               self.beta_shear, self._kmodel, Qf, T, M, st)
-        Qv = Qf.reshape(n, K, 20) * self.plate_w[..., None]
-        Q = np.zeros((n, 22))
-        for b, (H, Hp, xi, u1, du1, w) in enumerate(maps):
-            o = 10 * b
-            Q0, Q1, Qw0, Qw1 = Qv[..., o:o + 2], Qv[..., o + 2:o + 4], Qv[..., o + 8], Qv[..., o + 9]
-            Q[:, o:o + 8] = (np.einsum("iek,ekc->eic", H, Q0) + np.einsum("iek,ekc->eic", Hp, Q1)).reshape(n, 8)
-            S = np.sum(Q0 * u1, -1) + np.sum(Q1 * du1, -1) + Qw0 * w[:, 1][:, None]       # force on xi
-            Q[:, o + 8] = Qw0.sum(1) - 2 / l * S.sum(1)
-            Q[:, o + 9] = (Qw0 * xi + Qw1).sum(1)
-            Q[:, 20 + b] = 2 / l * S.sum(1)
-        Tw = T.reshape(n, K) * self.plate_w
-        out["chain.plate_tension"] = Tw.ravel()
-        out["chain.plate_state"] = np.where(self.plate_w > 0, st.reshape(n, K), P.SLACK).ravel().astype(float)
-        out["chain.link_tension"] = Tw.sum(1)
-        return Q
 
     def _scatter_links(self, g: np.ndarray, gu: np.ndarray, gw: np.ndarray, gq: np.ndarray) -> None:
         """Add link-local ``(n, 22)`` gradients to the half and pack arrays."""
@@ -656,8 +607,10 @@ class ChainA5:
         return self._evaluate(q, v)["friction"]
 
     def forces(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
-        """``Q = -dPi/dq - dPhi/dv + Q_friction`` in one pass (plate pass compiled with ``use_numba``)."""
-        r = self._evaluate(q, v, fast=self.backend == "numba")
+        """``Q = -dPi/dq - dPhi/dv + Q_friction`` in one pass (:func:`halves_kernel.forces` with ``use_numba``)."""
+        if self.backend == "numba":
+            return HK.forces(np.asarray(q, float), np.asarray(v, float), *self._kernel_args)
+        r = self._evaluate(q, v)
         return r["friction"] - r["grad"] - r["gradv"]
 
     def outputs(self, q: np.ndarray, v: np.ndarray | None = None) -> dict[str, np.ndarray]:
@@ -713,8 +666,36 @@ class ChainA5:
         pat.sort_indices()
         return pat
 
-    def jacobian(self, q: np.ndarray, v: np.ndarray, step: float = 1e-7,
-                 damping: bool = True) -> tuple[sp.csr_matrix, sp.csr_matrix | None]:
+    def jacobian(self, q: np.ndarray, v: np.ndarray, damping: bool = True,
+                 scheme: str = "central") -> tuple[sp.csr_matrix, sp.csr_matrix | None]:
+        """``(dQ/dq, dQ/dv)`` of :meth:`forces` on :attr:`jac_sparsity`; ``damping=False`` returns None for ``dQ/dv``.
+
+        Compiled backend: element by element (:func:`halves_kernel.jacobian`): each link's velocity block exact,
+        its coordinate block by ``scheme`` ("central", step ``1e-7``, or "forward", step ``sqrt(eps)``, relative to
+        ``max(|x|, l)``) differences of that link alone; each pin's blocks (bending, contacts, friction) central
+        differences of the pin alone (steps ``1e-7 max(|x|, l)``, ``1e-3 max(|v|, v_0)``);
+        the axial friction's tension dependence by the chain rule.  Per element 45 (central) or 23 (forward) link
+        passes and 116 pin passes: about 56 or 38 force evaluations in time for 84 pins (docs/chain.md).  Forward
+        differences are one-sided at the kinks of the plate law and the contacts: Newton from the exact straight
+        chain diverged with them, hence central by default.
+        numpy backend: :meth:`coloured_jacobian`.
+        """
+        if scheme not in ("forward", "central"):
+            raise InputError("scheme", scheme, 'must be "forward" or "central"')
+        if self.backend != "numba":
+            return self.coloured_jacobian(q, v, damping=damping)
+        pat = self.jac_sparsity
+        if self._positions is None:
+            self._positions = HK.positions(self._kernel_args, self.dof_index, pat)
+        Jq, Jv = np.zeros(pat.nnz + 1), np.zeros(pat.nnz + 1)
+        steps = np.array([np.sqrt(np.finfo(float).eps) if scheme == "forward" else 1e-7, 1e-7, 1e-3])
+        HK.jacobian(np.asarray(q, float), np.asarray(v, float), *self._kernel_args, *self._positions, steps,
+                    scheme == "central", Jq, Jv)
+        out = [sp.csr_matrix((d[:-1], pat.indices, pat.indptr), shape=pat.shape) for d in (Jq, Jv)]
+        return out[0], out[1] if damping else None
+
+    def coloured_jacobian(self, q: np.ndarray, v: np.ndarray, step: float = 1e-7,
+                          damping: bool = True) -> tuple[sp.csr_matrix, sp.csr_matrix | None]:
         """``(dQ/dq, dQ/dv)`` of :meth:`forces` by central differences over pin colours, on :attr:`jac_sparsity`.
 
         Pins five or more apart share a colour (the stencil is ``p-2..p+2``), so ``2 x 21 x colours``

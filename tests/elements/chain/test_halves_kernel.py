@@ -1,0 +1,99 @@
+"""Compiled A5 force pass (halves_kernel) against its numpy twin, and the element-by-element Jacobian against
+central differences of the numpy forces, column by column."""
+import numpy as np
+import pytest
+
+from cvtfem.errors import InputError
+from tests.elements.chain.test_halves import DAMP, chain, random_state
+
+pytest.importorskip("numba")
+
+CLOSED_HOLES = dict(hole_clearance=0.0, stopper_play=0.0, roll_tie=1e9)     # 8 pins at 45 degrees: holes closed
+CASES = {
+    "A4 closed, linear-saturated": (dict(plate_model="A4", friction_coefficient=0.1, **DAMP), 0.05),
+    "A4 open, smooth": (dict(plate_model="A4", closed=False, friction_coefficient=0.1, friction_law="smooth",
+                             **DAMP), 0.05),
+    "A3 closed": (dict(plate_model="A3", friction_coefficient=0.1, **DAMP), 0.05),
+    "A3-keep open, arctan near zero slip": (dict(plate_model="A3-keep", closed=False, friction_coefficient=0.1,
+                                                 friction_law="arctan", **DAMP), 1e-9),
+    "holes closed, stoppers, tie, tanh near zero slip": (dict(friction_coefficient=0.1, friction_law="tanh",
+                                                              **CLOSED_HOLES, **DAMP), 1e-9),
+}
+
+
+def state(ch, v_scale, seed=12):
+    rng = np.random.default_rng(seed)
+    return random_state(ch, rng, amp=2e-5), v_scale * rng.standard_normal(ch.n2)
+
+
+def slot_error(ch, ref, test):
+    """Largest error of each of the 21 coordinate slots relative to that slot's largest reference force."""
+    errs = [np.abs(ref[i] - test[i]).max() / np.abs(ref[i]).max() for i in ch.dof_index.T if np.abs(ref[i]).max() > 0]
+    return max(errs)
+
+
+@pytest.mark.parametrize("case", CASES)
+def test_compiled_forces_equal_numpy_twin(case):
+    kw, v_scale = CASES[case]
+    fast, ref = chain(**kw), chain(use_numba=False, **kw)
+    assert fast.backend == "numba" and ref.backend == "numpy"
+    q, v = state(ref, v_scale)
+    Qf, Qr = fast.forces(q, v), ref.forces(q, v)
+    assert slot_error(ref, Qr, Qf) < 1e-12
+    out = ref.outputs(q, v)
+    roll = out["chain.roll_force"]
+    assert roll.max() > 0 and roll.min() == 0                                 # contacts on and off
+    if kw.get("plate_model", "A4") == "A4":
+        assert len(set(out["chain.plate_state"])) > 2                         # several plate states
+    if v_scale < 1e-6:                                                        # friction below its series threshold
+        assert np.abs(out["chain.half_slip"]).max() < 1e-4 * fast.v0
+    if "hole_clearance" in kw:
+        contacts = ref.potential_parts(q, ("contacts",))["contacts"]
+        no_holes = chain(use_numba=False, **{**kw, "hole_stiffness": 0.0}).potential_parts(q, ("contacts",))["contacts"]
+        assert contacts > no_holes > 0 and ref.potential_parts(q)["stoppers"] > 0
+
+
+def column_differences(ref, f, x0, steps):
+    """Central differences of ``f(x)`` over every coordinate of ``x0`` with the steps ``steps`` (n,)."""
+    out = np.empty((ref.n2, ref.n2))
+    for j in range(ref.n2):
+        e = np.zeros(ref.n2)
+        e[j] = steps[j]
+        out[:, j] = (f(x0 + e) - f(x0 - e)) / (2 * steps[j])
+    return out
+
+
+def reference_jacobian(ref, q, v):
+    """``dQ/dq``: differences of ``forces`` (step ``1e-7 max(|q|, l)``); ``dQ/dv``: of the dissipative forces
+    (linear in ``v``: unit steps, exact but for round-off) plus of the friction forces (step ``1e-3 max(|v|, v_0)``)."""
+    K = column_differences(ref, lambda x: ref.forces(x, v), q, 1e-7 * np.maximum(np.abs(q), ref.l))
+    C = column_differences(ref, lambda y: ref.dissipative_forces(q, y), v, np.ones(ref.n2))
+    C += column_differences(ref, lambda y: ref.friction_forces(q, y), v, 1e-3 * np.maximum(np.abs(v), ref.v0))
+    return K, C
+
+
+JAC_CASES = ["A4 closed, linear-saturated", "A4 open, smooth", "holes closed, stoppers, tie, tanh near zero slip"]
+
+
+@pytest.mark.parametrize("case", JAC_CASES)
+def test_element_jacobian_equals_central_differences(case):
+    """All columns of both matrices, relative to each column's largest entry, everywhere (so also zero outside
+    ``jac_sparsity``): dQ/dq with central link differences to 1e-5, forward to 1e-3 (found 2e-6, 3e-4), dQ/dv to
+    1e-4 (found 2e-5)."""
+    kw, v_scale = CASES[case]
+    ch, ref = chain(**kw), chain(use_numba=False, **kw)
+    rng = np.random.default_rng(3)
+    q, v = random_state(ref, rng, amp=2e-6), v_scale * rng.standard_normal(ref.n2)
+    ref_q, ref_v = reference_jacobian(ref, q, v)
+    scale_q, scale_v = np.abs(ref_q).max(0), np.abs(ref_v).max(0)
+    for scheme, tol_q in (("central", 1e-5), ("forward", 1e-3)):
+        K, C = ch.jacobian(q, v, scheme=scheme)
+        assert np.all(np.abs(K.toarray() - ref_q).max(0) <= tol_q * scale_q)
+        assert np.all(np.abs(C.toarray() - ref_v).max(0) <= 1e-4 * scale_v)
+    assert ch.jacobian(q, v, damping=False)[1] is None
+
+
+def test_bad_scheme_is_reported():
+    ch = chain()
+    with pytest.raises(InputError, match="scheme"):
+        ch.jacobian(np.zeros(ch.n2), np.zeros(ch.n2), scheme="complex")
