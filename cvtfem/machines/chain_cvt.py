@@ -200,6 +200,10 @@ class ChainCVT(ModelBase):
         ud, u3d, _ = self.family.split(v[:nc])
         return self.contact.gather(pins, shafts, u, u3, ud, u3d, q[iz], v[iz], v[iphi])
 
+    def _extra_approach(self, k: int, r: float) -> float:
+        """Penetration of the contact beyond H1's for a pin end at radius ``r`` (m) on shaft ``k`` (0 for H1)."""
+        return 0.0
+
     def _contact_rows(self, pins, shafts):
         """State rows of the local contact force outputs (all but the last, the friction power), (m, 5)."""
         _, iphi, iz, dof3 = self._idx
@@ -419,7 +423,7 @@ class ChainCVT(ModelBase):
         parts = [pl.u, u3] + ([np.zeros((fam.n, 2))] if fam.ndof == 5 else [])
         q[:nc] = fam.join(*parts)
         u3k = l / 2 - Nk / (2 * fam.geom.c_pin.mean())
-        q[iz] = [u3k[k] - faces[k].lever(pl.r[k]) - dk[k] for k in range(2)]
+        q[iz] = [u3k[k] - faces[k].lever(pl.r[k]) - dk[k] + self._extra_approach(k, pl.r[k]) for k in range(2)]
         vel = np.zeros(n2)
         a = np.zeros(nc)
         au = fam.split(a)[0]

@@ -29,6 +29,9 @@ class RefinedChainCVT(ChainCVT):
         return self.contact.gather(pins, shafts, self.family.split(q[:nc]), self.family.split(v[:nc]),
                                    q[iz], v[iz], v[iphi])
 
+    def _extra_approach(self, k, r):
+        return float(self.contact.extra_approach(k, r))
+
     def _contact_rows(self, pins, shafts):
         _, iphi, iz, _ = self._idx
         return self.contact.coordinates(pins, shafts, self.family.dof_index, iz, iphi)
