@@ -14,6 +14,7 @@ from cvtfem.elements.contact.hertz import hertz_force, hertz_potential
 from cvtfem.elements.contact.refined import (pin_coefficients, pin_loads, refined_contact, refined_slip,
                                              sheave_coefficients)
 from cvtfem.errors import InputError, NumericalError
+from cvtfem.integrate import solve
 from cvtfem.machines.chain_cvt import from_scene
 from cvtfem.machines.chain_cvt_refined import RefinedChainCVT
 from cvtfem.scene.loader import load_scene
@@ -241,3 +242,101 @@ def test_scene_builds_the_refined_chain(scene):
     m2 = chain_loop(load_scene("chain-S3-refined").replace({"cvt": {"model": "chain-S2",
                                                                        "effects": {"pin_bending": False}}}))
     assert isinstance(m2, RefinedChainCVT) and not m2.contact.slopes
+
+
+@pytest.fixture(scope="module")
+def static_s3(models, scene):
+    return models["chain-S3"].static_state(RATIO, scene.cvt.regime.input_speed)
+
+
+def test_static_state_with_refined_contact(models, static_s3):
+    """The quasi-static start with H2: balanced, pins on the planned radii (the driving sheave shifted by the
+    H2 approach), axial forces = clamping forces, contact points x_* inside the pin end face."""
+    m = models["chain-S3"]
+    x0, rep = static_s3
+    assert rep["residual"] < 1e-8 and rep["max_penetration"] < 5e-5
+    o = m.outputs(0.0, x0)
+    np.testing.assert_allclose(o["contact.sheave_axial_force"], [rep["F1"], F_APPL[1]], rtol=1e-8)
+    q = x0[:m.n2]
+    pins, shafts, X, (Y, d) = m._contacts(q, np.zeros(m.n2), details=True)
+    on = d["delta"] > 0
+    u = m.family.split(q[:m.family.size])[0]
+    pl = rep["placement"]
+    for k in (0, 1):
+        r = np.linalg.norm(u[pins[on & (shafts == k)]] - m.contact.centres[k], axis=1)
+        assert np.abs(r - pl.r[k]).max() < 2e-4          # within 0.2 mm of the planned arc
+    assert np.abs(d["offset"][on]).max() < 4e-3               # |x_*| = R_f tan(gamma) / (1 - R_f f'') ~ 3.4 mm
+    # the start turns the pins with their sheave but leaves the slope rates u'' at zero: slip (k x gamma') x rho
+    # of ~1 mm/s at the offset contact points, well inside the viscous range of the law (v0 = 20 mm/s).  The
+    # first and last pin of an arc turn at about half the sheave's rate (one link on the span), so their
+    # contact point, x_* off the axis, slips by about w |x_*| / 2 (0.2 m/s driven, 0.45 m/s driving)
+    n = m.family.n
+    slip = o["contact.slip_speed"].reshape(n, 2)
+    N = o["contact.normal_force"].reshape(n, 2)
+    for k in (0, 1):
+        on = N[:, k] > 0
+        inner = on & on[m.family.im1] & on[m.family.ip1]
+        assert np.all(slip[inner, k] < 2e-3) and (on & ~inner).sum() == 2
+        w_k = x0[m.n2 + m._idx[1][k]]
+        assert np.all(np.abs(slip[on & ~inner, k] / (w_k * 3.4e-3 / 2) - 1) < 0.25)
+
+
+def test_jacobian_of_the_refined_chain_against_differences(models, static_s3):
+    m = models["chain-S3"]
+    rng = np.random.default_rng(7)
+    x = static_s3[0].copy()
+    nc, n2 = m.family.size, m.n2
+    x[:nc] += rng.normal(0.0, 2e-6, nc)
+    x[n2:n2 + nc] += rng.normal(0.0, 0.05, nc)
+    J = m.jac(0.0, x).toarray()
+    assert not np.any(J[~m.jac_sparsity.toarray()])
+    n = m.family.n
+    slopes = 3 * n + rng.choice(2 * n, 12, replace=False)      # u' columns
+    cols = np.concatenate([rng.choice(3 * n, 12, replace=False), slopes, n2 + rng.choice(nc, 12, replace=False),
+                           n2 + slopes[:6], np.arange(nc, n2), n2 + np.arange(nc, n2)])
+    rows = slice(n2, None)
+    scale = np.abs(J[rows]).max(axis=1)
+    for c in cols:
+        h = 1e-9 if c < n2 else 1e-6 * max(1.0, abs(x[c]))
+        xp, xm = x.copy(), x.copy()
+        xp[c] += h
+        xm[c] -= h
+        fd = (m.rhs(0.0, xp) - m.rhs(0.0, xm))[rows] / (2 * h)
+        err = np.abs(J[rows, c] - fd)
+        assert np.all(err <= 1e-5 * scale + 1e-6), (c, err.max())
+
+
+def test_energy_balance_over_a_short_run(models, static_s3):
+    """20 us of running from the quasi-static start (Radau, rtol 1e-6): E(t) - E(0) = input - output +
+    clamping - dissipated work to 1e-6 of the input work."""
+    x0, rep = static_s3
+    m = models["chain-S3"].with_clamping([rep["F1"], F_APPL[1]])
+    res = solve(m, (0.0, 2e-5), x0, method="Radau", rtol=1e-6, atol=1e-9, n2=m.n2, jac=m.jac,
+                jac_sparsity=m.jac_sparsity)
+    assert res.status == 0
+    x1 = res.y[:, -1]
+    W = m.split(x1)[3]
+    assert W[0] > 1.0 and W[2] > 0.0
+    assert m.energy(x1) - m.energy(x0) == pytest.approx(W[0] - W[1] + W[3] - W[2], abs=1e-6 * W[0])
+
+
+@pytest.mark.slow
+def test_run_chain_s3_refined_balances_energy_and_axial_forces(cli, tmp_path):
+    """2 ms of the chain-S3-refined preset through the CLI: the work integrals close the energy balance to 1e-5
+    of the input work, every output is finite, and over the second millisecond the pins' axial forces on each
+    sheave balance its clamping force on average to 1 %."""
+    import h5py
+    h5 = tmp_path / "r.h5"
+    r = cli("run", "chain-S3-refined", "--until", "2e-3", "--results", str(h5), timeout=900)
+    assert r.returncode == 0, r.stderr
+    with h5py.File(h5) as f:
+        s = f["series"]
+        for name in s:
+            assert np.isfinite(s[name][:]).all(), name
+        W, E = s["work"][-1], s["energy"][:]
+        late = s["time"][:] >= 1e-3 - 1e-12
+        axial = s["contact.sheave_axial_force"][late]
+        clamping = np.column_stack([s["driving.clamping_force"][late], s["driven.clamping_force"][late]])
+    assert W[0] > 100.0
+    assert abs(W[0] - W[1] - W[2] + W[3] - (E[-1] - E[0])) < 1e-5 * W[0]
+    np.testing.assert_allclose(axial.mean(axis=0), clamping.mean(axis=0), rtol=0.01)
