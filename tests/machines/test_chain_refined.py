@@ -340,3 +340,14 @@ def test_run_chain_s3_refined_balances_energy_and_axial_forces(cli, tmp_path):
     assert W[0] > 100.0
     assert abs(W[0] - W[1] - W[2] + W[3] - (E[-1] - E[0])) < 1e-5 * W[0]
     np.testing.assert_allclose(axial.mean(axis=0), clamping.mean(axis=0), rtol=0.01)
+
+
+@pytest.mark.parametrize("law", ["tanh", "smooth", "arctan", "linear-saturated", "smoothed"])
+@pytest.mark.parametrize("model, face", [("chain-S3", "torus"), ("chain-S3", "cone"), ("chain-S2", "torus")])
+def test_kernel_equals_the_numpy_twin(models, model, face, law):
+    con = replace(_contact(models, model, face), law=law)
+    X, shafts = _random_inputs(con, seed=8)
+    X[:3, con.n_pos:] = 0.0                                      # three contacts without any motion: zero slip
+    Yk, Yr = con.local(X, shafts), con.local(X, shafts, reference=True)
+    assert np.all(np.abs(Yk - Yr) <= 1e-12 * np.abs(Yr).max(axis=0))
+    assert np.all(Yr[:3, -1] == 0) and np.abs(Yr[3:, -1]).max() > 1.0

@@ -39,9 +39,12 @@ import numpy as np
 
 from cvtfem.elements.band.geometry import Sheave
 from cvtfem.elements.chain.sheave_contact import face_profile
+from cvtfem.elements.chain.sheave_contact_refined_kernel import refined_local_kernel
 from cvtfem.elements.chain.symmetric import END_SLOPE_FACTOR
-from cvtfem.elements.contact.friction import friction_force
+from cvtfem.elements.contact.friction import _check, friction_force
 from cvtfem.elements.contact.hertz import hertz_force, hertz_potential
+from cvtfem.elements.contact.kernels import LAW_CODES
+from cvtfem.elements.contact.meridian import Meridian
 from cvtfem.errors import InputError, NumericalError
 
 _SIDE = -1.0   # sheave material on the +k side of the x3 > 0 pin end (as SheaveContact)
@@ -55,6 +58,13 @@ def face_derivatives(face: Sheave, r):
     u = r + face.y
     w = np.sqrt(face.R ** 2 - u * u)
     return f, fp, fpp, -3.0 * face.R ** 2 * u / w ** 5
+
+
+def face_meridian(face: Sheave) -> Meridian:
+    """The profile ``f = -s(r)`` of the face as a :class:`~cvtfem.elements.contact.meridian.Meridian` (kernels)."""
+    if face.profile == "conical":
+        return Meridian("cone", tan_gamma=float(np.tan(face.gamma)))
+    return Meridian("torus", R=face.R, y=face.y)
 
 
 def _kx(v):
@@ -105,6 +115,8 @@ class RefinedSheaveContact:
             raise InputError("face_radius", self.face_radius, "must be > 0 (crown radius of the pin end face, m)")
         object.__setattr__(self, "centres", np.asarray(self.centres, float).reshape(2, 2))
         object.__setattr__(self, "c", np.broadcast_to(np.asarray(self.c, float), (2,)).copy())
+        _check(self.law, self.eps)
+        object.__setattr__(self, "_meridians", np.stack([face_meridian(f).params for f in self.faces]))
 
     # ----- layout --------------------------------------------------------------------------------
     @property
@@ -171,13 +183,16 @@ class RefinedSheaveContact:
                 o[sel] = val
         return out
 
-    def local(self, X, shafts, details: bool = False):
+    def local(self, X, shafts, details: bool = False, reference: bool = False):
         """Local outputs ``Y`` (m, n_out) of contacts with inputs ``X`` (m, n_in) on shafts ``shafts``:
         generalized forces (both pin ends, ``2x``) on the position coordinates of :meth:`coordinates` and
         on ``phi_k``, and the friction power ``2 F_fr . v_r`` (W, <= 0); with ``details`` also a dict of
         per-contact quantities (``delta``, ``N``, ``radius``, ``slip``, ``F_fr``, ``F`` the force on one pin
         end's translation, ``potential``, ``offset`` ``x_*``, ``point`` ``R_*``, ``moment`` the end moment
-        on the slope ``gamma``)."""
+        on the slope ``gamma``).  Without ``details`` the compiled kernel runs; ``reference=True`` (or
+        ``details``) the numpy formulas, its tested twin."""
+        if not (details or reference):
+            return self._compiled(X, shafts)
         s = _SIDE
         um, up_, un, u3, g, z, vm, vp, vn, u3d, gd, zd, w = self._unpack(X)
         m = len(X)
@@ -249,6 +264,18 @@ class RefinedSheaveContact:
                    "potential": 2 * hertz_potential(delta, self.c[shafts]), "offset": x,
                    "point": np.column_stack([up_ + x, point3]), "moment": Q_slope, "normal": normal,
                    "spin_rate": om_p}
+
+    def _compiled(self, X, shafts):
+        """:meth:`local` by :func:`refined_local_kernel`."""
+        m = len(X)
+        Y, slip, fr = np.empty((m, self.n_out)), np.empty((m, 3)), np.empty((m, 3))
+        bad = refined_local_kernel(np.ascontiguousarray(X, float), np.ascontiguousarray(shafts, np.int64),
+                                   self.centres, self._meridians, float(self.face_radius), bool(self.slopes),
+                                   END_SLOPE_FACTOR, self.c, float(self.f0), float(self.v0), LAW_CODES[self.law],
+                                   float(self.eps), Y, slip, fr)
+        if bad >= 0:
+            raise NumericalError(f"H2 contact: a pin end on the shaft axis (contact {bad})", component="contact.refined")
+        return Y
 
     def local_jacobian(self, X, shafts):
         """``dY/dX`` (m, n_out, n_in) by central differences, all contacts at once (each contact depends only
