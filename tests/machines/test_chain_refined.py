@@ -351,3 +351,14 @@ def test_kernel_equals_the_numpy_twin(models, model, face, law):
     Yk, Yr = con.local(X, shafts), con.local(X, shafts, reference=True)
     assert np.all(np.abs(Yk - Yr) <= 1e-12 * np.abs(Yr).max(axis=0))
     assert np.all(Yr[:3, -1] == 0) and np.abs(Yr[3:, -1]).max() > 1.0
+
+
+@pytest.mark.parametrize("face", [Sheave("toroidal", 0.0, R=1.5, y=0.2), CONE])
+def test_face_derivatives_are_derivatives_of_the_sheave_face(face):
+    """``f = -s(r)`` of the band's Sheave (z0 with w = 0) and its first three derivatives, by differences."""
+    r, h = np.linspace(0.03, 0.09, 13), 1e-6
+    f, fp, fpp, f3 = face_derivatives(face, r)
+    np.testing.assert_allclose(f, replace(face, w=0.0).z0(r), rtol=0, atol=1e-15)
+    up, dn = face_derivatives(face, r + h), face_derivatives(face, r - h)
+    for i, deriv in enumerate((fp, fpp, f3)):
+        np.testing.assert_allclose((up[i] - dn[i]) / (2 * h), deriv, rtol=1e-7, atol=1e-7 * np.abs(deriv).max() + 1e-12)

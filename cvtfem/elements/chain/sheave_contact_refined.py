@@ -38,7 +38,6 @@ from dataclasses import dataclass
 import numpy as np
 
 from cvtfem.elements.band.geometry import Sheave
-from cvtfem.elements.chain.sheave_contact import face_profile
 from cvtfem.elements.chain.sheave_contact_refined_kernel import refined_local_kernel
 from cvtfem.elements.chain.symmetric import END_SLOPE_FACTOR
 from cvtfem.elements.contact.friction import _check, friction_force
@@ -50,21 +49,21 @@ from cvtfem.errors import InputError, NumericalError
 _SIDE = -1.0   # sheave material on the +k side of the x3 > 0 pin end (as SheaveContact)
 
 
-def face_derivatives(face: Sheave, r):
-    """``(f, f', f'', f''')`` (m, -, 1/m, 1/m^2) of the profile ``f = -s(r)`` of the face at radii ``r`` (m)."""
-    f, fp, fpp = face_profile(face)(r)
-    if face.profile == "conical":
-        return f, fp, fpp, np.zeros_like(r)
-    u = r + face.y
-    w = np.sqrt(face.R ** 2 - u * u)
-    return f, fp, fpp, -3.0 * face.R ** 2 * u / w ** 5
-
-
 def face_meridian(face: Sheave) -> Meridian:
     """The profile ``f = -s(r)`` of the face as a :class:`~cvtfem.elements.contact.meridian.Meridian` (kernels)."""
     if face.profile == "conical":
         return Meridian("cone", tan_gamma=float(np.tan(face.gamma)))
     return Meridian("torus", R=face.R, y=face.y)
+
+
+def face_derivatives(face: Sheave, r):
+    """``(f, f', f'', f''')`` (m, -, 1/m, 1/m^2) of the profile ``f = -s(r)`` of the face at radii ``r`` (m)."""
+    r = np.asarray(r, float)
+    f, fp, fpp = face_meridian(face)(r)
+    if face.profile == "conical":
+        return f, fp, fpp, np.zeros_like(r)
+    u = r + face.y
+    return f, fp, fpp, -3.0 * face.R ** 2 * u / (face.R ** 2 - u * u) ** 2.5
 
 
 def _kx(v):
@@ -74,10 +73,6 @@ def _kx(v):
 
 def _dot(a, b):
     return np.sum(a * b, axis=-1)
-
-
-def _cross(a, b):
-    return np.cross(a, b)
 
 
 @dataclass(frozen=True)
@@ -239,15 +234,15 @@ class RefinedSheaveContact:
         k = np.array([0.0, 0.0, 1.0])
         g3 = np.column_stack([g, np.zeros(m)])
         gd3 = np.column_stack([gd, np.zeros(m)])
-        lever = _cross(k + g3, rho)                                     # (k + gamma) x rho
-        v_pin = np.column_stack([vp, u3d]) + _cross(_cross(k, gd3), rho) + om_p[:, None] * lever
+        lever = np.cross(k + g3, rho)                                     # (k + gamma) x rho
+        v_pin = np.column_stack([vp, u3d]) + np.cross(np.cross(k, gd3), rho) + om_p[:, None] * lever
         v_sh = np.column_stack([-w * arm[:, 1], w * arm[:, 0], zd])
         v_rel = v_pin - v_sh
         slip = v_rel - _dot(normal, v_rel)[:, None] * normal
         F_fr, _ = friction_force(slip, N, self.f0, self.v0, self.law, self.eps)
         # generalized forces of one end, then x2
         Q_phi = _dot(F_fr, lever)                                      # on the pin spin
-        Q_slope = -N[:, None] * dg + np.cross(_cross(rho, F_fr), k)[:, :2]
+        Q_slope = -N[:, None] * dg + np.cross(np.cross(rho, F_fr), k)[:, :2]
         F_pin = np.column_stack([-N[:, None] * dd + F_fr[:, :2], s * N + F_fr[:, 2]])
         Q_rear = -Q_phi[:, None] * tp
         Q_front = Q_phi[:, None] * tn
