@@ -119,17 +119,15 @@ class ChainCVT(ModelBase):
 
     def _contacts(self, q, v, details=False):
         """Broad phase, local inputs and outputs of the contacts."""
-        nc, iphi, iz, _ = self._idx
-        u, u3, _ = self.family.split(q[:nc])
-        ud, u3d, _ = self.family.split(v[:nc])
-        pins, shafts = self.contact.candidates(u)
+        nc = self._idx[0]
+        pins, shafts = self.contact.candidates(self.family.split(q[:nc])[0])
         X = self._gather(pins, shafts, q, v)
         return pins, shafts, X, self.contact.local(X, shafts, details)
 
     def _forces(self, q, v, F, M, slip: bool = False):
         """Generalized forces on all coordinates (N, N m) and the friction power (W); with ``slip`` also the
         contact-force-weighted mean slip speed on each shaft (m/s, 0 without contact)."""
-        nc, iphi, iz, dof3 = self._idx
+        nc, iphi, iz, _ = self._idx
         Q = np.zeros(self.n2)
         Q[:nc] = self.family.forces(q[:nc], v[:nc])
         pins, shafts, _, Y = self._contacts(q, v, details=slip)
@@ -218,7 +216,7 @@ class ChainCVT(ModelBase):
     def jac(self, t: float, x) -> sp.csr_matrix:
         """Sparse ``d rhs / dx``."""
         q, v, zc, _ = self.split(x)
-        nc, iphi, iz, dof3 = self._idx
+        nc, iphi, iz, _ = self._idx
         n2, nz, N = self.n2, self.control.size, self.size
         ctrl = 2 * n2 + np.arange(nz)
         w = v[iphi]
@@ -234,7 +232,7 @@ class ChainCVT(ModelBase):
         for Mx, off in ((Kc.tocoo(), 0), (Cc.tocoo(), n2)):
             add(Mx.row, Mx.col + off, Mx.data)
         pins, shafts, X, _ = self._contacts(q, v)
-        Jl = self.contact.local_jacobian(X, shafts)            # (m, 6, 9)
+        Jl = self.contact.local_jacobian(X, shafts)            # (m, outputs, inputs)
         cin = self._contact_columns(pins, shafts)
         out_rows = self._contact_rows(pins, shafts)
         add(np.repeat(out_rows[:, :, None], cin.shape[1], 2), np.repeat(cin[:, None, :], out_rows.shape[1], 1),
@@ -268,7 +266,7 @@ class ChainCVT(ModelBase):
     def jac_sparsity(self) -> sp.csr_matrix:
         """Structural pattern: chain stencil (pins ``p +- 2``), every pin with every shaft (broad phase
         may take any pin), the loops, and dense work-rate rows (all but the angles)."""
-        nc, iphi, iz, dof3 = self._idx
+        nc, iphi, iz, _ = self._idx
         n2, nz, N, n = self.n2, self.control.size, self.size, self.family.n
         ctrl = 2 * n2 + np.arange(nz)
         P = sp.csr_matrix(self.family.jac_sparsity, dtype=float).tocoo()
