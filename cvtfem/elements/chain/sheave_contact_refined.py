@@ -29,6 +29,7 @@ its generalized forces.  Mirror symmetry doubles everything (chain-models-1 §2.
 Per contact the local inputs are the positions of pins ``p-1, p, p+1`` (2 each), ``u3_p``, the slope
 coordinates ``u'_p`` (S3), ``z_k``, the same velocities and the spin rate of the shaft; the outputs the
 generalized forces on the same position coordinates and ``phi_k``, and the friction power (last column).
+The pass runs compiled (:mod:`.sheave_contact_refined_kernel`); the numpy formulas here are its tested twin.
 Units SI.
 """
 from __future__ import annotations
