@@ -29,6 +29,21 @@ class RefinedChainCVT(ChainCVT):
         return self.contact.gather(pins, shafts, self.family.split(q[:nc]), self.family.split(v[:nc]),
                                    q[iz], v[iz], v[iphi])
 
+    def _static(self, ratio, w1, F2, tol):
+        """ChainCVT's quasi-static start, with the slopes of the S3 pins in contact turning with their sheave
+        (``u'' = phi_k' k x u'``): the material at the offset contact point then does not slip."""
+        x0, rep = super()._static(ratio, w1, F2, tol)
+        if self.contact.slopes:
+            nc, iphi, _, _ = self._idx
+            q = x0[:self.n2]
+            pins, shafts, _, (_, d) = self._contacts(q, np.zeros(self.n2), details=True)
+            up = self.family.split(q[:nc])[2]
+            upd = self.family.split(x0[self.n2:self.n2 + nc])[2]
+            for k in (0, 1):
+                on = pins[(shafts == k) & (d["delta"] > 0)]
+                upd[on] = x0[self.n2 + iphi[k]] * np.column_stack([-up[on, 1], up[on, 0]])
+        return x0, rep
+
     def _extra_approach(self, k, r):
         return float(self.contact.extra_approach(k, r))
 
