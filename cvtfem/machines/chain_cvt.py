@@ -32,7 +32,7 @@ from cvtfem.control.stabilisation import OpenLoop, Stabilisation, StabilisationP
 from cvtfem.elements.band.geometry import Sheave
 from cvtfem.elements.base import Block
 from cvtfem.elements.chain.placement import place_on_path
-from cvtfem.elements.chain.sheave_contact import N_IN, SheaveContact, hertz_constant
+from cvtfem.elements.chain.sheave_contact import SheaveContact, hertz_constant
 from cvtfem.elements.chain.symmetric import ChainS2, ChainS3, damping_from_ratio
 from cvtfem.errors import InputError, NumericalError
 from cvtfem.machines.chain import pin_coordinate_label
@@ -138,17 +138,15 @@ class ChainCVT(ModelBase):
 
     def _contacts(self, q, v, details=False):
         """Broad phase, local inputs and outputs of the contacts."""
-        nc, iphi, iz, _ = self._idx
-        u, u3, _ = self.family.split(q[:nc])
-        ud, u3d, _ = self.family.split(v[:nc])
-        pins, shafts = self.contact.candidates(u)
-        X = self.contact.gather(pins, shafts, u, u3, ud, u3d, q[iz], v[iz], v[iphi])
+        nc = self._idx[0]
+        pins, shafts = self.contact.candidates(self.family.split(q[:nc])[0])
+        X = self._gather(pins, shafts, q, v)
         return pins, shafts, X, self.contact.local(X, shafts, details)
 
     def _forces(self, q, v, F, M, slip: bool = False):
         """Generalized forces on all coordinates (N, N m) and the friction power (W); with ``slip`` also the
         contact-force-weighted mean slip speed on each shaft (m/s, 0 without contact)."""
-        nc, iphi, iz, dof3 = self._idx
+        nc, iphi, iz, _ = self._idx
         Q = np.zeros(self.n2)
         Q[:nc] = self.family.forces(q[:nc], v[:nc])
         pins, shafts, _, Y = self._contacts(q, v, details=slip)
@@ -157,7 +155,7 @@ class ChainCVT(ModelBase):
             N = np.bincount(shafts, det["N"], 2)
             mean_slip = np.bincount(shafts, det["N"] * np.linalg.norm(det["slip"], axis=1), 2) / np.maximum(N, 1e-300)
         Qp, Qz, Qphi, Pf = self.contact.scatter(Y, pins, shafts, self.family.n)
-        Q[dof3] += Qp
+        Q[self.family.dof_index[:, :Qp.shape[1]]] += Qp
         Q[iphi] += Qphi + M
         Q[iz] += Qz - 2 * F
         return (Q, Pf, mean_slip) if slip else (Q, Pf)
@@ -212,6 +210,22 @@ class ChainCVT(ModelBase):
             G[:, j] = (np.concatenate([Fp, Mp[1:], dzp]) - u0) / h
         return F, M, G
 
+    def _gather(self, pins, shafts, q, v):
+        """Local inputs of the contacts (``SheaveContact.gather``)."""
+        nc, iphi, iz, _ = self._idx
+        u, u3, _ = self.family.split(q[:nc])
+        ud, u3d, _ = self.family.split(v[:nc])
+        return self.contact.gather(pins, shafts, u, u3, ud, u3d, q[iz], v[iz], v[iphi])
+
+    def _extra_approach(self, k: int, r: float) -> float:
+        """Penetration of the contact beyond H1's for a pin end at radius ``r`` (m) on shaft ``k`` (0 for H1)."""
+        return 0.0
+
+    def _contact_rows(self, pins, shafts):
+        """State rows of the local contact force outputs (all but the last, the friction power), (m, 5)."""
+        _, iphi, iz, dof3 = self._idx
+        return np.column_stack([dof3[pins], iz[shafts], iphi[shafts]])
+
     def _contact_columns(self, pins, shafts):
         """State columns of the 9 local contact inputs, (m, 9)."""
         nc, iphi, iz, dof3 = self._idx
@@ -221,7 +235,7 @@ class ChainCVT(ModelBase):
     def jac(self, t: float, x) -> sp.csr_matrix:
         """Sparse ``d rhs / dx``."""
         q, v, zc, _ = self.split(x)
-        nc, iphi, iz, dof3 = self._idx
+        nc, iphi, iz, _ = self._idx
         n2, nz, N = self.n2, self.control.size, self.size
         ctrl = 2 * n2 + np.arange(nz)
         w = v[iphi]
@@ -237,10 +251,11 @@ class ChainCVT(ModelBase):
         for Mx, off in ((Kc.tocoo(), 0), (Cc.tocoo(), n2)):
             add(Mx.row, Mx.col + off, Mx.data)
         pins, shafts, X, _ = self._contacts(q, v)
-        Jl = self.contact.local_jacobian(X, shafts)            # (m, 6, 9)
+        Jl = self.contact.local_jacobian(X, shafts)            # (m, outputs, inputs)
         cin = self._contact_columns(pins, shafts)
-        out_rows = np.column_stack([dof3[pins], iz[shafts], iphi[shafts]])   # rows of outputs 0..4
-        add(np.repeat(out_rows[:, :, None], N_IN, 2), np.repeat(cin[:, None, :], 5, 1), Jl[:, :5, :])
+        out_rows = self._contact_rows(pins, shafts)
+        add(np.repeat(out_rows[:, :, None], cin.shape[1], 2), np.repeat(cin[:, None, :], out_rows.shape[1], 1),
+            Jl[:, :-1, :])
         add(np.repeat(iz, len(in_cols)), np.tile(in_cols, 2), -2 * G[:2].ravel())    # -2 F on z
         add(np.full(len(in_cols), iphi[1]), in_cols, G[2])                              # M2 on phi2
         dQ = sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))), shape=(n2, N))
@@ -255,7 +270,7 @@ class ChainCVT(ModelBase):
         d2phi = np.concatenate([-(Kd.T @ v[:nc]), -2 * Qd])
         chain_cols = np.concatenate([np.arange(nc), n2 + np.arange(nc)])
         dPf = np.zeros(N)
-        np.add.at(dPf, cin.ravel(), Jl[:, 5, :].ravel())
+        np.add.at(dPf, cin.ravel(), Jl[:, -1, :].ravel())
         dD = -dPf
         dD[chain_cols] += d2phi
         Wr[2, :] = dD
@@ -270,7 +285,7 @@ class ChainCVT(ModelBase):
     def jac_sparsity(self) -> sp.csr_matrix:
         """Structural pattern: chain stencil (pins ``p +- 2``), every pin with every shaft (broad phase
         may take any pin), the loops, and dense work-rate rows (all but the angles)."""
-        nc, iphi, iz, dof3 = self._idx
+        nc, iphi, iz, _ = self._idx
         n2, nz, N, n = self.n2, self.control.size, self.size, self.family.n
         ctrl = 2 * n2 + np.arange(nz)
         P = sp.csr_matrix(self.family.jac_sparsity, dtype=float).tocoo()
@@ -279,9 +294,9 @@ class ChainCVT(ModelBase):
         pins = np.repeat(np.arange(n), 2)
         shafts = np.tile(np.arange(2), n)
         cin = self._contact_columns(pins, shafts)
-        out_rows = np.column_stack([dof3[pins], iz[shafts], iphi[shafts]])
-        rows.append(np.repeat(out_rows[:, :, None], N_IN, 2).ravel())
-        cols.append(np.repeat(cin[:, None, :], 5, 1).ravel())
+        out_rows = self._contact_rows(pins, shafts)
+        rows.append(np.repeat(out_rows[:, :, None], cin.shape[1], 2).ravel())
+        cols.append(np.repeat(cin[:, None, :], out_rows.shape[1], 1).ravel())
         in_cols = np.concatenate([n2 + iphi, ctrl])
         rows.append(np.repeat(np.concatenate([iz, iphi]), len(in_cols)))
         cols.append(np.tile(in_cols, 4))
@@ -335,7 +350,7 @@ class ChainCVT(ModelBase):
                     "contact.radius": per(np.where(on, c["radius"], 0.0)),
                     "contact.slip_speed": per(np.where(on, np.linalg.norm(c["slip"], axis=1), 0.0)),
                     "contact.friction_force": per(c["F_fr"], 3),
-                    "contact.friction_power": np.bincount(shafts, Y[:, 5], 2),
+                    "contact.friction_power": np.bincount(shafts, Y[:, -1], 2),
                     "contact.sheave_axial_force": -np.bincount(shafts, c["F"][:, 2], 2),
                     "driving.speed": w[0], "driven.speed": w[1], "driving.torque": M[0], "driven.torque": M[1],
                     "driving.clamping_force": F[0], "driven.clamping_force": F[1],
@@ -425,7 +440,7 @@ class ChainCVT(ModelBase):
         parts = [pl.u, u3] + ([np.zeros((fam.n, 2))] if fam.ndof == 5 else [])
         q[:nc] = fam.join(*parts)
         u3k = l / 2 - Nk / (2 * fam.geom.c_pin.mean())
-        q[iz] = [u3k[k] - faces[k].lever(pl.r[k]) - dk[k] for k in range(2)]
+        q[iz] = [u3k[k] - faces[k].lever(pl.r[k]) - dk[k] + self._extra_approach(k, pl.r[k]) for k in range(2)]
         vel = np.zeros(n2)
         a = np.zeros(nc)
         au = fam.split(a)[0]
@@ -452,13 +467,13 @@ class ChainCVT(ModelBase):
             Kc = fam.jacobian(qq[:nc], vel[:nc], wrt=(0,))[0]
             pins, shafts, X, _ = self._contacts(qq, vel)
             Jl = self.contact.local_jacobian(X, shafts)
-            _, _, _, dof3 = self._idx
-            cin = np.column_stack([dof3[pins], iz[shafts]])
-            rws = np.column_stack([dof3[pins], iz[shafts], iphi[shafts]])
+            cin = self._contact_columns(pins, shafts)
+            rws = self._contact_rows(pins, shafts)
+            r, c = np.repeat(rws[:, :, None], cin.shape[1], 2), np.repeat(cin[:, None, :], rws.shape[1], 1)
+            pos = c < n2                                       # the position inputs
             Kc = Kc.tocoo()
             K = sp.csr_matrix((Kc.data, (Kc.row, Kc.col)), shape=(n2, n2)) + sp.csr_matrix(
-                (Jl[:, :5, :4].ravel(), (np.repeat(rws[:, :, None], 4, 2).ravel(),
-                                         np.repeat(cin[:, None, :], 5, 1).ravel())), shape=(n2, n2))
+                (Jl[:, :-1, :][pos], (r[pos], c[pos])), shape=(n2, n2))
             return (K[free][:, free] / F2).toarray()
         sol = least_squares(residual, q[free], jac=jacobian, method="lm", xtol=tol, ftol=tol, gtol=tol,
                             x_scale=1e-5, max_nfev=200)
@@ -508,13 +523,15 @@ class ChainCVT(ModelBase):
                         r_outer: float, J, m_sheave, f0: float, v0: float, law: str = "linear-saturated",
                         regime: Regime, F_appl, control: StabilisationParams | None = None,
                         damping_ratio: float = 0.05, b_joint: float = 0.0, face_radius: float = 0.02,
-                        E: float = 2.1e11, poisson: float = 0.3, r_hertz: float | None = None) -> "ChainCVT":
+                        E: float = 2.1e11, poisson: float = 0.3, r_hertz: float | None = None,
+                        contact: str = "hertz") -> "ChainCVT":
         """Build the model from plain parameters (SI units).
 
         ``geom`` a :class:`~cvtfem.elements.chain.geometry.ChainGeometry`; ``model`` ``chain-S2`` or
         ``chain-S3``; ``face`` the sheave face (its ``w`` is replaced by half the pin length); ``J``,
         ``m_sheave`` per shaft (driving, driven); ``F_appl`` clamping forces per sheave; ``control``
-        the loop parameters (None: open loop, ``M2 = -b20 w2``).  The Hertz stiffness is held
+        the loop parameters (None: open loop, ``M2 = -b20 w2``); ``contact`` ``"hertz"`` (H1) or ``"hertz-refined"``
+        (H2, :class:`~cvtfem.machines.chain_cvt_refined.RefinedChainCVT`).  The Hertz stiffness is held
         constant (digest §4.3) for a pin end crowned with ``face_radius`` at the contact radius
         ``r_hertz`` (default: the mean radius of ratio 1, ``(l - 2 L) / (2 pi)``).
         """
@@ -524,10 +541,16 @@ class ChainCVT(ModelBase):
         face = Sheave(face.profile, face.gamma, face.R, face.y, geom.l / 2)
         r_h = (geom.length - 2 * centre_distance) / (2 * np.pi) if r_hertz is None else r_hertz
         c = hertz_constant(face, r_h, face_radius, E, poisson)
-        contact = SheaveContact(np.array([[centre_distance, 0.0], [0.0, 0.0]]), (face, face), np.array([c, c]),
-                                r_outer, f0, v0, law)
+        centres = np.array([[centre_distance, 0.0], [0.0, 0.0]])
+        if contact == "hertz-refined":
+            from cvtfem.machines.chain_cvt_refined import RefinedChainCVT, refined_contact
+            cls, pair = RefinedChainCVT, refined_contact(family, centres, face, c, r_outer, f0, v0, law, face_radius)
+        elif contact == "hertz":
+            pair = SheaveContact(centres, (face, face), np.array([c, c]), r_outer, f0, v0, law)
+        else:
+            raise InputError("cvt.effects.contact", contact, "must be 'hertz' or 'hertz-refined' for a running chain")
         loop = OpenLoop() if control is None else Stabilisation(control)
-        return cls(family, contact, np.asarray(J, float), np.asarray(m_sheave, float), regime,
+        return cls(family, pair, np.asarray(J, float), np.asarray(m_sheave, float), regime,
                    np.asarray(F_appl, float), loop)
 
 

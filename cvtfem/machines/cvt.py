@@ -229,12 +229,13 @@ def closed_loop(scene: Scene, **overrides: Any):
 
 def chain_loop(scene: Scene):
     """Scene -> :class:`~cvtfem.machines.chain_cvt.ChainCVT`: the chain of :func:`chain_geometry` on two rigid
-    shafts with Hertz contact at the pin-axis ends (H1), the scene's friction, shafts, loops and regime.
+    shafts with Hertz contact at the pin-axis ends (H1) or refined (H2, ``effects.contact = "hertz-refined"``),
+    the scene's friction, shafts, loops and regime.
 
     The prescribed clamping forces are those the band models get (:class:`~cvtfem.control.clamping.Clamping`
     at the regime's start: torque, ratio, safety factor, split); the ratio loop corrects ``F1`` from there.
     Only what runs is accepted: ``chain-S2`` (no pin bending) and ``chain-S3`` (pin bending), rigid shafts,
-    ``effects.contact = "hertz"``, friction on.
+    ``effects.contact = "hertz"`` or ``"hertz-refined"``, friction on.
     """
     from cvtfem.control.clamping import Clamping
     from cvtfem.machines.chain_cvt import from_scene
@@ -250,9 +251,10 @@ def chain_loop(scene: Scene):
     if eff.shaft_elasticity:
         raise InputError("cvt.effects.shaft_elasticity", True, f"is not available for `{model}` yet: the chain "
                          "runs on rigid shafts (set it false)")
-    if eff.contact != "hertz":
-        raise InputError("cvt.effects.contact", eff.contact, f"must be 'hertz' for `{model}`: Hertz contact at the "
-                         "pin-axis end (the refined and impact contacts are not coupled to a running chain yet)")
+    if eff.contact not in ("hertz", "hertz-refined"):
+        raise InputError("cvt.effects.contact", eff.contact, f"must be 'hertz' or 'hertz-refined' for `{model}`: Hertz "
+                         "contact at the pin-axis end or refined (the rigid and impact contacts are not coupled to a "
+                         "running chain yet)")
     if not eff.friction:
         raise InputError("cvt.effects.friction", False, "must be true for a chain transmission: the chain "
                          "transmits torque only by pin-sheave friction")
@@ -260,7 +262,7 @@ def chain_loop(scene: Scene):
     clamping = Clamping(band_params(scene), rg.clamping_safety, rg.clamping_split, rg.min_clamping_force)
     F_appl = clamping.forces(rg.torque, rg.ratio)
     overrides = {} if eff.damping else {"damping_ratio": 0.0}
-    return from_scene(scene, chain_geometry(scene), F_appl, model=model, **overrides)
+    return from_scene(scene, chain_geometry(scene), F_appl, model=model, contact=eff.contact, **overrides)
 
 
 def _running_chain_layout(scene: Scene) -> tuple[Layout, ...]:

@@ -43,7 +43,7 @@ def test_describe_lists_every_output_of_the_running_chain_once():
 
 @pytest.mark.parametrize("override, key", [
     ({"cvt": {"model": "chain-A5", "effects": {"pin_bending": True}}}, "cvt.model"),
-    ({"cvt": {"effects": {"contact": "hertz-refined"}}}, "cvt.effects.contact"),
+    ({"cvt": {"effects": {"contact": "impact"}}}, "cvt.effects.contact"),
     ({"cvt": {"model": "chain-S3"}}, "cvt.effects.pin_bending"),
     ({"cvt": {"effects": {"friction": False}}}, "cvt.effects.friction"),
 ])
