@@ -5,6 +5,7 @@ from pathlib import Path
 
 import numpy as np
 
+from cvtfem.post.campbell import spread
 from cvtfem.post.figures import pyplot, save
 from cvtfem.post.spectrogram import OrderIntensity, Spectrogram
 
@@ -19,7 +20,7 @@ def plot_spectrogram(spec: Spectrogram, path: str | Path, lines=(), line_times=N
     plt = pyplot()
     db = spec.db()
     top = float(db.max())
-    fig, ax = plt.subplots(figsize=(8.0, 5.0), layout="constrained")
+    fig, ax = plt.subplots(figsize=(8.5, 5.0), layout="constrained")
     half = 0.5 * (spec.t[1] - spec.t[0]) if spec.t.size > 1 else 0.5 * spec.window
     edges_t = 1e3 * np.concatenate([spec.t - half, spec.t[-1:] + half])
     edges_f = np.concatenate([spec.f - 0.5 * spec.df, spec.f[-1:] + 0.5 * spec.df]).clip(0.0)
@@ -30,6 +31,7 @@ def plot_spectrogram(spec: Spectrogram, path: str | Path, lines=(), line_times=N
     if line_times is not None:
         tl = 1e3 * np.asarray(line_times)
         inside = (tl >= edges_t[0]) & (tl <= edges_t[-1])
+        ends = []
         for name, f in lines:
             f = np.asarray(f)[inside]
             if f.size == 0 or f.min() > fmax:
@@ -37,8 +39,13 @@ def plot_spectrogram(spec: Spectrogram, path: str | Path, lines=(), line_times=N
             style = dict(color="cyan", ls="--") if "link" in name else dict(color="white", ls=":")
             ax.plot(tl[inside], f, lw=0.9, **style)
             if f[-1] <= fmax:
-                ax.annotate(name, (tl[inside][-1], f[-1]), xytext=(3, 0), textcoords="offset points", fontsize=7,
-                            va="center", color="0.1", annotation_clip=False)
+                ends.append((name, float(f[-1])))
+        if ends:                                   # labels stacked without overlap at the right edge
+            ys = spread(np.array([y for _, y in ends]), 0.035 * fmax, 0.0, fmax)
+            for (name, y0), y in zip(ends, ys):
+                ax.annotate(name, (edges_t[-1], y0), xytext=(edges_t[-1] + 0.01 * (edges_t[-1] - edges_t[0]), y),
+                            textcoords="data", fontsize=7, va="center", annotation_clip=False,
+                            arrowprops={"arrowstyle": "-", "lw": 0.4, "color": "0.5"})
     ax.set_xlim(edges_t[0], edges_t[-1])
     ax.set_ylim(0.0, fmax)
     ax.set_xlabel("time, ms")
