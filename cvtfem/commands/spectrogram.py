@@ -63,7 +63,7 @@ def _run(args: argparse.Namespace, orders: tuple[int, ...]) -> int:
     t, y, label = sg.select_signal(results, args.series, args.component, args.start)
     window = args.window if args.window is not None else min(0.25 * (t[-1] - t[0]), 0.1)
     spec = sg.compute_spectrogram(t, y, window, args.overlap, args.fmax, results.units.get(args.series, ""))
-    freqs = None if args.no_lines else sg.chain_frequencies(results)
+    freqs = None if args.no_lines else sg.chain_frequencies(results, *chain_of(results))
     print(f"{label} from {t[0]:.6g} s to {t[-1]:.6g} s: {spec.t.size} windows of {1e3 * spec.window:.4g} ms, "
           f"resolution {spec.df:.4g} Hz, up to {spec.f[-1]:.6g} Hz")
     if freqs is not None:
@@ -97,3 +97,19 @@ def _run(args: argparse.Namespace, orders: tuple[int, ...]) -> int:
                                  unit=spec.unit)
             print(f"wrote {args.intensity_png}")
     return 0
+
+
+def chain_of(results) -> tuple[int, float, float]:
+    """``(n_pins, chain length m, centre distance m)`` of the CVT scene stored in a results file."""
+    import tomllib
+
+    from cvtfem.errors import InputError
+    from cvtfem.scene.loader import scene_from_dict
+    from cvtfem.scene.schema.cvt import mean_chain_length
+
+    scene = scene_from_dict(tomllib.loads(results.scene_toml), source=str(results.path))
+    if scene.kind != "cvt":
+        raise InputError("RESULTS", str(results.path), f"must hold a CVT run for the chain frequencies (its scene is "
+                         f"a {scene.kind} scene; use --no-lines)")
+    chain = scene.cvt.chain
+    return int(chain.n_pins), mean_chain_length(chain), float(scene.cvt.geometry.centre_distance)

@@ -104,10 +104,12 @@ class ChainCVT(ModelBase):
             OutputSpec("driven.torque", "N m", "External torque on the driven shaft."),
             OutputSpec("driving.clamping_force", "N", "Clamping force per sheave, driving pulley."),
             OutputSpec("driven.clamping_force", "N", "Clamping force per sheave, driven pulley."),
-            OutputSpec("driving.support_force", "N", "Bearing reaction on the rigid driving shaft in the chain plane "
-                       "(x1, x2): minus the resultant of the pin contact forces (normal + friction) on its sheaves.", 2),
-            OutputSpec("driven.support_force", "N", "Bearing reaction on the rigid driven shaft in the chain plane "
-                       "(x1, x2): minus the resultant of the pin contact forces (normal + friction) on its sheaves.", 2),
+            OutputSpec("driving.support_force", "N", "Bearing reaction on the rigid driving shaft in the chain "
+                       "plane (x1, x2): minus the resultant of the pin contact forces (normal + friction) on its "
+                       "sheaves.", 2),
+            OutputSpec("driven.support_force", "N", "Bearing reaction on the rigid driven shaft in the chain "
+                       "plane (x1, x2): minus the resultant of the pin contact forces (normal + friction) on its "
+                       "sheaves.", 2),
             OutputSpec("ratio", "-", "Speed ratio omega1 / omega2."),
             OutputSpec("efficiency", "-", "Output over input power (instantaneous)."),
             OutputSpec("power", "W", "Input, output, dissipated and clamping power.", 4),

@@ -7,7 +7,6 @@ Spec: low-order-models-control-regimes §3.4 (``f_link = v / l_link``, ``f_chain
 from __future__ import annotations
 
 import math
-import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -170,19 +169,11 @@ class ChainFrequencies:
         return np.interp(t, self.t, self.f_chain)
 
 
-def chain_frequencies(results: Results) -> ChainFrequencies:
-    """:class:`ChainFrequencies` of a CVT run: chain length and pin count from the stored scene, ``omega_1`` from
-    ``driving.speed``, ``r_1`` the mean contact radius of the pins on the driving sheaves (``contact.radius``,
-    discrete chains) or the band path's radius at ``band.span_angle`` (band models)."""
-    from cvtfem.scene.loader import scene_from_dict
-    from cvtfem.scene.schema.cvt import mean_chain_length
-
-    scene = scene_from_dict(tomllib.loads(results.scene_toml), source=str(results.path))
-    if scene.kind != "cvt":
-        raise InputError("RESULTS", str(results.path), f"must hold a CVT run for the chain frequencies (its scene is "
-                         f"a {scene.kind} scene)")
-    chain = scene.cvt.chain
-    length = mean_chain_length(chain)
+def chain_frequencies(results: Results, n_pins: int, chain_length: float, centre_distance: float) -> ChainFrequencies:
+    """:class:`ChainFrequencies` of a CVT run of a chain of ``n_pins`` pins and length ``chain_length`` (m) on pulleys
+    ``centre_distance`` (m) apart: ``omega_1`` from ``driving.speed``, ``r_1`` the mean contact radius of the pins on
+    the driving sheaves (``contact.radius``, discrete chains) or the band path's radius at ``band.span_angle``
+    (band models)."""
     if "driving.speed" not in results.series:
         raise InputError("RESULTS", str(results.path), "must hold `driving.speed` for the chain frequencies")
     w1 = results.series["driving.speed"][:, 0]
@@ -193,12 +184,12 @@ def chain_frequencies(results: Results) -> ChainFrequencies:
     elif "band.span_angle" in results.series:
         from cvtfem.elements.band.geometry import radii
 
-        L = scene.cvt.geometry.centre_distance
-        r1 = np.array([radii(phi, length, L)[0][0] for phi in results.series["band.span_angle"][:, 0]])
+        phi = results.series["band.span_angle"][:, 0]
+        r1 = np.array([radii(p, chain_length, centre_distance)[0][0] for p in phi])
     else:
         raise InputError("RESULTS", str(results.path), "must hold `contact.radius` or `band.span_angle` for the "
                          "contact radius of the driving pulley")
-    return ChainFrequencies(results.time, w1 * r1 / length, int(chain.n_pins))
+    return ChainFrequencies(results.time, w1 * r1 / chain_length, int(n_pins))
 
 
 def excitation_lines(freqs: ChainFrequencies, fmax: float, chain_orders=(1, 2, 3)) -> list[tuple[str, np.ndarray]]:

@@ -73,6 +73,6 @@ def test_running_support_force_balances_the_spans_and_shows_f_link(cli, tmp_path
     np.testing.assert_allclose(R2, -R1, rtol=0, atol=0.005 * np.hypot(*R1))
     t, y, _ = sg.select_signal(res, "driving.support_force", "0", 4e-3)
     spec = sg.compute_spectrogram(t, y, 4e-3, fmax=5000.0)
-    f_link = sg.chain_frequencies(res).f_link[late].mean()
+    f_link = sg.chain_frequencies(res, 84, length, L).f_link[late].mean()
     assert f_link == pytest.approx(v / 0.009, rel=1e-3)           # mean of w1 r1 against product of the means
     assert spec.f[1 + np.argmax(spec.psd[1:].mean(axis=1))] == pytest.approx(f_link, abs=spec.df)

@@ -5,6 +5,7 @@ import pytest
 import scipy.signal
 
 from cvtfem.cli import main
+from cvtfem.commands.spectrogram import chain_of
 from cvtfem.errors import InputError
 from cvtfem.io.results import ResultsWriter, read_results
 from cvtfem.outputs import OutputSpec
@@ -134,9 +135,13 @@ def run_file(tmp_path_factory):
 
 
 def test_chain_frequencies_of_a_run_follow_the_spec(run_file):
-    """f_chain = omega_1 r_1 / l_chain with the mean pitch 9 mm of the preset: 17.79 Hz, f_link = 84 f_chain."""
+    """The chain of the stored scene (84 pins, mean pitch 9 mm); f_chain = omega_1 r_1 / l_chain = 17.79 Hz,
+    f_link = 84 f_chain."""
     path, f_link = run_file
-    freqs = sg.chain_frequencies(read_results(path))
+    res = read_results(path)
+    n_pins, length, L = chain_of(res)
+    assert (n_pins, length, L) == (84, pytest.approx(0.756), load_scene("chain-S2").cvt.geometry.centre_distance)
+    freqs = sg.chain_frequencies(res, n_pins, length, L)
     np.testing.assert_allclose(freqs.f_chain, W1 * R1 / 0.756, rtol=1e-12)
     np.testing.assert_allclose(freqs.f_link, f_link, rtol=1e-12)
 

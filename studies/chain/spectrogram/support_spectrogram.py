@@ -22,6 +22,7 @@ import numpy as np
 from cvtfem.analysis.run import run_scene
 from cvtfem.analysis.timing import machine
 from cvtfem.cli import main as cli
+from cvtfem.commands.spectrogram import chain_of
 from cvtfem.io.results import read_results
 from cvtfem.post import spectrogram as sg
 from cvtfem.scene.loader import load_scene
@@ -81,7 +82,7 @@ def main() -> None:
                 run_scene(load_scene(HERE / f"chain-S2-{name}.toml"), until=args.until, results=path)
         res = read_results(path)
         R, expected, T, v = span_balance(res, args.start)
-        freqs = sg.chain_frequencies(res)
+        freqs = sg.chain_frequencies(res, *chain_of(res))
         late = res.time >= args.start
         pitch = mean_chain_length(load_scene_text(res).cvt.chain) / freqs.n_pins
         print(f"\n{name} chain: {path}, {res.time[-1] * 1e3:.4g} ms ({res.attrs.get('status')}), "
