@@ -10,7 +10,9 @@ Run:  .venv/bin/python studies/chain/spectrogram/support_spectrogram.py [--until
    is printed against the span balance ``(T_t + T_s - 2 m' v^2) cos(phi)``, ``(T_t - T_s) sin(phi)``.
 3. ``cvtfem spectrogram`` writes the spectrogram of the driving shaft's x1 reaction (line of centres) and its
    intensity over f / f_chain (PNG + CSV); the script prints the chain frequencies, the strongest line near
-   f_link against ``v / l_link``, and the level at f_link / 3 and at f_link against the median level of the band.
+   f_link against ``v / l_link``, the level at f_link / 3 and at f_link against the median level of the band,
+   and, from one window over the whole analysed run, how far the levels at k f_chain stand above those half-way
+   between (the randomised chain's bands; this needs a window of several chain revolutions).
 """
 from __future__ import annotations
 
@@ -62,6 +64,55 @@ def level_at(spec, f0):
     return float(db[np.argmin(abs(spec.f - f0))] - np.median(db))
 
 
+def long_window(t, y, f_link, n_pins, fmax=5000.0):
+    """One Hann window over all of ``y(t)``: the pin-entry line measured near ``f_link`` (Hz; the largest bin
+    within 5 %, refined by a parabola through the log-PSD of it and its neighbours), the chain frequency it
+    implies (line / n_pins), and the mean level (dB) at ``k f_chain`` minus the mean level half-way between over
+    the orders below ``fmax`` (the randomised chain's bands)."""
+    spec = sg.compute_spectrogram(t, y, t[-1] - t[0], overlap=0.0, fmax=fmax)
+    m = np.log(spec.psd[:, 0])
+    near = np.flatnonzero(abs(spec.f - f_link) < 0.05 * f_link)
+    j = near[np.argmax(m[near])]
+    line = spec.f[j] + 0.5 * spec.df * (m[j - 1] - m[j + 1]) / (m[j - 1] - 2 * m[j] + m[j + 1])
+    fc = line / n_pins
+    db = 10 * np.log10(spec.psd[:, 0])
+    k = np.arange(1, int(fmax / fc))
+    contrast = float(np.mean(np.interp(k * fc, spec.f, db) - np.interp((k + 0.5) * fc, spec.f, db)))
+    return line, fc, contrast, spec
+
+
+def pin_passing(res, start, pitch):
+    """Pin-passing rates ``omega_k / (2 asin(pitch / 2 r_k))`` of the two sheaves (chords on the arcs), Hz."""
+    late = res.time >= start - 1e-12
+    radius = res.series["contact.radius"][late].reshape(late.sum(), -1, 2)
+    rates = []
+    for k, name in enumerate(("driving.speed", "driven.speed")):
+        r = radius[:, :, k][radius[:, :, k] > 0].mean()
+        rates.append(res.series[name][late].mean() / (2 * np.arcsin(pitch / (2 * r))))
+    return rates
+
+
+def plot_zoom(spectra, path, band=(1100.0, 1900.0)):
+    """Long-window spectra ``{name: (spec, f_chain)}`` in ``band`` (Hz) with ticks at the orders k f_chain."""
+    from cvtfem.post.figures import pyplot, save
+
+    plt = pyplot()
+    fig, ax = plt.subplots(figsize=(8.0, 4.0), layout="constrained")
+    for (name, (spec, fc)), colour in zip(spectra.items(), ("tab:blue", "tab:red")):
+        sel = (spec.f >= band[0]) & (spec.f <= band[1])
+        ax.plot(spec.f[sel], 10 * np.log10(spec.psd[sel, 0]), color=colour, lw=0.8,
+                label=f"{name} chain ({1e3 * spec.window:.0f} ms window, {spec.df:.1f} Hz bins)")
+    fc = next(iter(spectra.values()))[1]
+    for k in range(int(band[0] / fc) + 1, int(band[1] / fc) + 1):
+        ax.axvline(k * fc, color="0.75", lw=0.5, zorder=0)
+    ax.set_xlim(*band)
+    ax.set_xlabel(f"frequency, Hz (grey: k f_chain, f_chain = {fc:.3f} Hz from the measured pin-entry line / 84)")
+    ax.set_ylabel("PSD, dB re 1 N$^2$/Hz")
+    ax.set_title("driving shaft support force x1 around f_link, one window over the run", fontsize=10)
+    ax.legend(fontsize=8)
+    return save(fig, path)
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--until", type=float, default=0.1)
@@ -74,6 +125,7 @@ def main() -> None:
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     print(machine())
+    spectra = {}
     for name in ("uniform", "random"):
         path = getattr(args, name)
         if path is None:
@@ -106,6 +158,15 @@ def main() -> None:
         print(f"  strongest line within 20 % of f_link: {spec.f[near][np.argmax(mean[near])]:.1f} Hz "
               f"(resolution {spec.df:.1f} Hz); above the median level: f_link/3 {level_at(spec, f_link / 3):+.1f} dB, "
               f"f_link {level_at(spec, f_link):+.1f} dB, 2 f_link {level_at(spec, 2 * f_link):+.1f} dB")
+        line, fc, contrast, long = long_window(t, y, f_link, freqs.n_pins)
+        spectra[name] = (long, fc)
+        rates = pin_passing(res, args.start, pitch)
+        print(f"  one window of {1e3 * long.window:.1f} ms ({long.window * fc:.2f} chain revolutions, {long.df:.2f} Hz "
+              f"bins): pin-entry line at {line:.1f} Hz ({100 * (line / f_link - 1):+.2f} % from v / l_link; pins pass "
+              f"the driving sheave at {rates[0]:.1f} Hz, the driven at {rates[1]:.1f} Hz), so f_chain = {fc:.4f} Hz; "
+              f"level at k f_chain above half-way between, mean over k f_chain < 5 kHz: {contrast:+.1f} dB")
+
+    print(f"wrote {plot_zoom(spectra, out / 'support-around-f_link.png')}")
 
 
 if __name__ == "__main__":
