@@ -23,6 +23,9 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--start", type=float, default=0.0, metavar="S", help="analyse from this time on, s (default 0)")
     p.add_argument("--chain-orders", default="1,2,3", metavar="K,...",
                    help="draw the lines k f_chain for these k (default 1,2,3; '' for none)")
+    p.add_argument("--f-chain", type=float, default=None, metavar="HZ",
+                   help="chain revolution frequency, Hz, instead of omega_1 r_1 / l_chain (e.g. the measured "
+                        "pin-entry line / n_pins)")
     p.add_argument("--no-lines", action="store_true", help="draw no excitation lines (a run without a chain)")
     p.add_argument("--png", metavar="OUT", help="write the spectrogram as PNG")
     p.add_argument("--intensity-png", metavar="OUT", help="write the intensity over f / f_chain as PNG")
@@ -56,6 +59,7 @@ def run(args: argparse.Namespace) -> int:
 def _run(args: argparse.Namespace, orders: tuple[int, ...]) -> int:
     import numpy as np
 
+    from cvtfem.errors import InputError
     from cvtfem.io.results import read_results
     from cvtfem.post import spectrogram as sg
 
@@ -64,6 +68,10 @@ def _run(args: argparse.Namespace, orders: tuple[int, ...]) -> int:
     window = args.window if args.window is not None else min(0.25 * (t[-1] - t[0]), 0.1)
     spec = sg.compute_spectrogram(t, y, window, args.overlap, args.fmax, results.units.get(args.series, ""))
     freqs = None if args.no_lines else sg.chain_frequencies(results, *chain_of(results))
+    if args.f_chain is not None and freqs is not None:
+        if not 0.0 < args.f_chain < spec.f[-1]:
+            raise InputError("--f-chain", args.f_chain, f"must be a frequency in Hz with 0 < f_chain < {spec.f[-1]:g}")
+        freqs = sg.ChainFrequencies(results.time, np.full(results.time.size, args.f_chain), freqs.n_pins)
     print(f"{label} from {t[0]:.6g} s to {t[-1]:.6g} s: {spec.t.size} windows of {1e3 * spec.window:.4g} ms, "
           f"resolution {spec.df:.4g} Hz, up to {spec.f[-1]:.6g} Hz")
     if freqs is not None:

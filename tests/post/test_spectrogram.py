@@ -171,8 +171,21 @@ def test_command_writes_both_figures_and_tables(capsys, run_file, tmp_path):
     (["--series", "driving.support_force", "--window", "1"], "--window"),
     (["--series", "driving.support_force", "--start", "0.2"], "--start"),
     (["--series", "driving.support_force", "--intensity-png", "x.jpg"], "--intensity-png"),
+    (["--series", "driving.support_force", "--f-chain", "-1"], "--f-chain"),
 ])
 def test_command_names_the_bad_argument(capsys, run_file, args, where):
     assert main(["spectrogram", str(run_file[0]), *args]) == 2
     err = capsys.readouterr().err
     assert f"`{where}`" in err, err
+
+
+def test_command_takes_a_given_chain_frequency(capsys, run_file, tmp_path):
+    """--f-chain replaces omega_1 r_1 / l_chain: with half the run's chain frequency the f_link line of the signal
+    sits at order 168 of the intensity."""
+    path, f_link = run_file
+    icsv = tmp_path / "i.csv"
+    assert main(["spectrogram", str(path), "--series", "driving.support_force", "--window", "0.01", "--f-chain",
+                 str(f_link / 168), "--intensity-csv", str(icsv)]) == 0
+    inten = np.loadtxt(icsv, delimiter=",", skiprows=1)
+    assert inten[np.nanargmax(inten[:, 1]), 0] == pytest.approx(168.0, abs=12.0)    # 100 Hz bins / 8.9 Hz
+    assert f"f_chain {f_link / 168:.5g}" in capsys.readouterr().out
