@@ -123,6 +123,12 @@ class ChainCVT(ModelBase):
             OutputSpec("driven.torque", "N m", "External torque on the driven shaft."),
             OutputSpec("driving.clamping_force", "N", "Clamping force per sheave, driving pulley."),
             OutputSpec("driven.clamping_force", "N", "Clamping force per sheave, driven pulley."),
+            OutputSpec("driving.support_force", "N", "Bearing reaction on the rigid driving shaft in the chain "
+                       "plane (x1, x2): minus the resultant of the pin contact forces (normal + friction) on its "
+                       "sheaves.", 2),
+            OutputSpec("driven.support_force", "N", "Bearing reaction on the rigid driven shaft in the chain "
+                       "plane (x1, x2): minus the resultant of the pin contact forces (normal + friction) on its "
+                       "sheaves.", 2),
             OutputSpec("ratio", "-", "Speed ratio omega1 / omega2."),
             OutputSpec("efficiency", "-", "Output over input power (instantaneous)."),
             OutputSpec("power", "W", "Input, output, dissipated and clamping power.", 4),
@@ -344,6 +350,7 @@ class ChainCVT(ModelBase):
             return out.ravel()
         P = dx[-4:]
         w, M, F = diag["w"], diag["M"], diag["F"]
+        support = np.column_stack([np.bincount(shafts, Y[:, j], 2) for j in (0, 1)])   # sum of 2F on the pins
         out = dict(self.family.outputs(q[:nc], v[:nc]))
         out.update({"chain.span_tension": self.span_tensions(q, v, pins, c["delta"]),
                     "contact.normal_force": per(c["N"]), "contact.penetration": per(c["delta"]),
@@ -354,6 +361,7 @@ class ChainCVT(ModelBase):
                     "contact.sheave_axial_force": -np.bincount(shafts, c["F"][:, 2], 2),
                     "driving.speed": w[0], "driven.speed": w[1], "driving.torque": M[0], "driven.torque": M[1],
                     "driving.clamping_force": F[0], "driven.clamping_force": F[1],
+                    "driving.support_force": support[0], "driven.support_force": support[1],
                     "ratio": w[0] / w[1] if w[1] else math.nan, "efficiency": P[1] / P[0] if P[0] else 0.0,
                     "power": P, "work": W, "energy": self.energy(x),
                     "control.ratio_estimate": diag["ratio_estimate"], "control.resistance": diag["resistance"]})
