@@ -65,7 +65,7 @@ class Stepper:
     #: Set by the driver in adaptive runs: ``(rtol, atol)`` (implicit methods tie Newton to it).
     tolerances: tuple | None = None
     #: Events are refined on :meth:`solution_at` (a step of the method itself to the event time) instead
-    #: of the cubic Hermite interpolant: methods of order > 3 without a continuous extension of their own.
+    #: of the cubic Hermite interpolant: explicit methods without a continuous extension of their own.
     substep_dense = False
 
     def __init__(self, system: OdeSystem, stats: Stats | None = None) -> None:
