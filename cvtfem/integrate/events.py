@@ -15,6 +15,13 @@ After an event the fired indicators restart at exactly 0; their sign just after 
 pass-through crossing does not re-fire and a rebound is detected when it comes back. An
 indicator that is exactly 0 at the initial state counts as coming from the other side, so
 leaving it in the firing direction is an event at ``t0``.
+
+Methods without a continuous extension of their own pass ``precise(t)`` (a step of the method itself to
+``t``, :meth:`~cvtfem.integrate.base.Stepper.solution_at`): detection and scan stay on the cheap
+interpolant, Brent's method then runs on the method's own solution (bracket widened where the
+interpolant's error moved the sign change out of it), and the state at the event is that solution. A
+cubic Hermite interpolant across a long step of an order-8 method errs by about h^4 |x^(4)| / 384
+(dopri78 at rtol 1e-10: 3e-4 in the event time, and the run went on from that state).
 """
 from __future__ import annotations
 
@@ -30,6 +37,20 @@ INTERIOR = (1e-10, 1e-6, 1e-3, 1 / 64, 1 / 8, 1 / 2)   # samples for indicators 
 EVENT_SAMPLES = 4          # interior samples per step that detect even crossings (dense mode)
 SCAN = 8                   # sub-intervals scanned for the earliest crossing (dense mode)
 TINY = np.finfo(float).tiny
+
+
+def _root_past(fun, ta: float, tb: float) -> float:
+    """Root of ``fun`` in ``[ta, tb]`` (signs differ) by Brent's method to a few ulps, moved by ulps towards
+    ``tb`` until ``fun`` has left the side of ``ta`` (or is 0): the state at the event is then past the
+    crossing, so the restarted indicator's reference sign is the new side (a state a few 1e-16 short of
+    it made the trapezoidal rule's tiny restart steps fire the same crossing again)."""
+    side = np.sign(fun(ta))
+    t = brentq(fun, ta, tb, xtol=4 * np.finfo(float).eps * max(abs(tb), 1e-300), rtol=1e-15)
+    step = float(np.spacing(abs(t)))
+    while t < tb and np.sign(fun(t)) == side:
+        t = min(t + step, tb)
+        step *= 2
+    return t
 
 
 def crossings(g0: np.ndarray, g1: np.ndarray, direction: np.ndarray) -> np.ndarray:
@@ -86,10 +107,11 @@ class EventLocator:
                 break
         return ta, ga, tb, gb
 
-    def locate(self, t0, x0, t1, x1, dense):
+    def locate(self, t0, x0, t1, x1, dense, precise=None):
         """Earliest crossing in ``[t0, t1]``: ``(t*, x*, fired mask, g1)`` or ``None``.
 
-        ``dense(t)`` evaluates the step's interpolant.
+        ``dense(t)`` evaluates the step's interpolant; ``precise(t)`` (optional) the method's own solution,
+        on which crossings are refined.
         """
         g1 = self.g(t1, x1)
         h = t1 - t0
@@ -111,6 +133,7 @@ class EventLocator:
         if not cross.any():
             self.g0 = g1
             return None
+        outer = (ta.copy(), ga.copy(), tb.copy(), gb.copy())
         if self.mode == "dense":   # scan the interpolant for the first sign change
             ta, ga, tb, gb = self._scan(ta, ga, tb, gb, dense, extra)
             cross = crossings(ga, gb, direction)
@@ -120,6 +143,9 @@ class EventLocator:
             return None
         if self.mode == "linear":
             t_k = ta[idx] + ga[idx] / (ga[idx] - gb[idx]) * (tb[idx] - ta[idx])
+        elif precise is not None:
+            t_k = np.array([self._refine_precise(k, (ta[k], ga[k], tb[k], gb[k]), [o[k] for o in outer], precise)
+                            for k in idx])
         else:
             t_k = np.array([self._refine(k, ta[k], ga[k], tb[k], gb[k], dense) for k in idx])
         t_star = float(t_k.min())
@@ -130,7 +156,7 @@ class EventLocator:
             th = (t_star - t0) / h
             x_star = (1 - th) * x0 + th * x1
         else:
-            x_star = dense(t_star)
+            x_star = dense(t_star) if precise is None else precise(t_star)
         return t_star, x_star, fired, g1
 
     def _scan(self, ta, ga, tb, gb, dense, extra=None):
@@ -167,6 +193,29 @@ class EventLocator:
         ta[last], ga[last] = prev_t[last], prev_g[last]
         return ta, ga, tb, gb
 
+    def _refine_precise(self, k, inner, outer, precise):
+        """Brent's method on ``e_k(t, precise(t))``, from the interpolant's bracket ``inner`` widened
+        (doubling, at most to ``outer``, the bracket before the scan, whose ends are the step's own
+        values) until the method's own solution changes sign in it."""
+        ta, _, tb, _ = inner
+        oa, oga, ob, ogb = outer
+
+        def fun(t):
+            return oga if t == oa else ogb if t == ob else self.g(t, precise(t))[k]
+
+        width = tb - ta
+        while True:
+            fa, fb = fun(ta), fun(tb)
+            if fb == 0.0:
+                return tb
+            if np.sign(fa) != np.sign(fb) or (ta == oa and tb == ob):
+                break
+            width *= 2
+            ta, tb = max(oa, ta - width), min(ob, tb + width)
+        if np.sign(fa) == np.sign(fb):   # no change on the method's own solution: keep the interpolant's
+            return inner[0] + inner[1] / (inner[1] - inner[3]) * (inner[2] - inner[0])
+        return _root_past(fun, ta, tb)
+
     def _refine(self, k, ta, ga, tb, gb, dense):
         """Brent's method on ``e_k(t, dense(t))`` over ``[ta, tb]`` (signs differ there)."""
         if gb == 0.0:
@@ -175,4 +224,4 @@ class EventLocator:
         def fun(t):
             return ga if t == ta else gb if t == tb else self.g(t, dense(t))[k]
 
-        return brentq(fun, ta, tb, xtol=4 * np.finfo(float).eps * max(abs(tb), 1e-300), rtol=1e-15)
+        return _root_past(fun, ta, tb)

@@ -64,6 +64,7 @@ class Extrapolator(Stepper):
     base_order = 1
     gamma = 1
     OPTIONS = frozenset({"stages", "sequence"})
+    substep_dense = True   # events on a step of the method itself (no continuous extension here)
 
     def __init__(self, system, stats=None, stages: int = 4, sequence: str = "harmonic") -> None:
         super().__init__(system, stats)

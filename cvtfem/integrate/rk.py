@@ -31,6 +31,8 @@ def rk_step(f, t, x, h, A, b, c, f0, b_err=None):
 class ExplicitRK(Stepper):
     """Tableau-driven explicit RK; subclasses set ``A``, ``b``, ``c`` and optionally ``b_low``."""
 
+    substep_dense = True   # events on a step of the method itself (no continuous extension here)
+
     A: np.ndarray
     b: np.ndarray
     c: np.ndarray

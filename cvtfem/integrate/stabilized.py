@@ -6,7 +6,10 @@ Second-order RKC of Sommeijer, Shampine & Verwer (J. Comput. Appl. Math. 88, 199
 ``R_s(z) = a_s + b_s T_s(w0 + w1 z)``, real stability length ``beta(s) = (1 + w0)/w1``
 (about ``0.653 s^2``). Stages ``s`` fixed (option ``stages``) or chosen each step from a
 spectral-radius estimate (nonlinear power iteration) so that ``h rho <= beta(s)``.
-Error estimate (SSV97): ``(12 (x0 - x1) + 6 h (F0 + F1)) / 15``.
+Error estimate (SSV97): ``(12 (x0 - x1) + 6 h (F0 + F1)) / 15``; adaptive runs control it against
+``rtol_int = 0.5 rtol^(3/2)`` (option ``proportional``, default on), so the global
+error of this order-2 method stays proportional to rtol
+(:func:`cvtfem.integrate.base.proportional_ratio`).
 """
 from __future__ import annotations
 
@@ -15,7 +18,7 @@ from functools import lru_cache
 import numpy as np
 
 from cvtfem.errors import InputError
-from cvtfem.integrate.base import Attempt, StepFailure, Stepper
+from cvtfem.integrate.base import Attempt, StepFailure, Stepper, proportional_ratio
 
 __all__ = ["RKC", "rkc_coefficients", "rkc_stability_length", "spectral_radius"]
 
@@ -102,6 +105,8 @@ class SpectralRadiusTracker:
     refreshed every ``rho_every`` accepted steps, times :data:`RHO_SAFETY`).
     """
 
+    substep_dense = True   # events on a step of the method itself (its stage count may change there)
+
     def _init_rho(self, spectral_radius_option, rho_every) -> None:
         self.rho_user, self.rho_every = spectral_radius_option, int(rho_every)
         self._rho, self._rho_age = None, 0
@@ -134,11 +139,14 @@ class RKC(SpectralRadiusTracker, Stepper):
     """Runge-Kutta-Chebyshev, order 2; ``stages`` fixed, or None for automatic selection."""
 
     name, order, error_order = "rkc", 2, 2
-    OPTIONS = frozenset({"stages", "spectral_radius", "rho_every"})
+    OPTIONS = frozenset({"stages", "spectral_radius", "rho_every", "proportional"})
 
     def __init__(self, system, stats=None, stages: int | None = None, spectral_radius=None,
-                 rho_every: int = 25) -> None:
+                 rho_every: int = 25, proportional: bool = True) -> None:
         super().__init__(system, stats)
+        if not isinstance(proportional, (bool, np.bool_)):
+            raise InputError("proportional", proportional, "must be true or false")
+        self.proportional = bool(proportional)
         if stages is not None and not (isinstance(stages, (int, np.integer)) and 2 <= stages <= MAX_STAGES):
             raise InputError("stages", stages, f"must be an integer in 2..{MAX_STAGES} or None (automatic)")
         if spectral_radius is not None and not (callable(spectral_radius) or spectral_radius > 0):
@@ -147,6 +155,10 @@ class RKC(SpectralRadiusTracker, Stepper):
         self.stages = stages or 2
         self._init_rho(spectral_radius, rho_every)
         self._coef: dict[int, tuple] = {}
+
+    def tolerance_ratio(self, rtol: float) -> float:
+        """Global error proportional to rtol unless ``proportional=False`` (module docstring)."""
+        return proportional_ratio(rtol, 2) if self.proportional else 1.0
 
     def _stage_count(self, t, x, f0, h) -> int:
         if self.fixed_stages:

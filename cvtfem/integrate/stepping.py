@@ -40,7 +40,8 @@ MODEL_FAILURES = (np.linalg.LinAlgError, FloatingPointError, ZeroDivisionError, 
 @dataclass
 class Candidate:
     """A step ``t0 -> t1 = t0 + h`` accepted by the method's error control, before the guards and
-    events; ``dense(t)`` evaluates its interpolant at one time ``t``, s."""
+    events; ``dense(t)`` evaluates its interpolant at one time ``t``, s; ``precise(t)``, when set, the
+    method's own solution there (:meth:`~cvtfem.integrate.base.Stepper.solution_at`, for event refinement)."""
 
     t0: float
     x0: np.ndarray
@@ -50,6 +51,7 @@ class Candidate:
     f0: np.ndarray | None
     dense: Callable[[float], np.ndarray]
     raw: object = field(default=None, repr=False)
+    precise: Callable[[float], np.ndarray] | None = field(default=None, repr=False)
 
 
 def initial_step(stepper, t0, y0, rtol, atol, span):
@@ -85,8 +87,9 @@ class NativeEngine:
         if not self.adaptive and h is None:
             raise InputError("h", h, "must be given for a fixed-step run")
         self.stepper.need_error = self.adaptive
-        self.stepper.tolerances = (rtol, atol) if self.adaptive else None
-        self.rtol, self.atol = rtol, atol
+        ratio = self.stepper.tolerance_ratio(rtol) if self.adaptive else 1.0   # internal tolerances
+        self.rtol, self.atol = rtol * ratio, atol * ratio
+        self.stepper.tolerances = (self.rtol, self.atol) if self.adaptive else None
         controller = controller or self.stepper.controller
         self.ctrl = (make_controller(controller, getattr(self.stepper, "STEP_QUANTUM", 1.0)) if self.adaptive
                      else FixedStep(h))
@@ -160,7 +163,11 @@ class NativeEngine:
                 att.f0 = stepper.f(att.t0, att.x0)
             return hermite(att, att.f1, tq)
 
-        return Candidate(att.t0, att.x0, att.h, att.t0 + att.h, att.x1, att.f0, dense, att)
+        precise = None
+        if stepper.substep_dense and self.adaptive:
+            def precise(tq):
+                return stepper.solution_at(att, tq)
+        return Candidate(att.t0, att.x0, att.h, att.t0 + att.h, att.x1, att.f0, dense, att, precise)
 
     def commit(self, cand: Candidate) -> None:
         self.stepper.accept(cand.raw)
@@ -283,7 +290,7 @@ class Stepping:
         counts = self.engine.counts()
         counts["nsteps"] += 1
         t1, x1 = cand.t1, cand.x1
-        hit = None if self.locator is None else self.locator.locate(t, x, t1, x1, cand.dense)
+        hit = None if self.locator is None else self.locator.locate(t, x, t1, x1, cand.dense, cand.precise)
         self.fired = None
         if hit is not None:
             t1, x1, self.fired, _ = hit

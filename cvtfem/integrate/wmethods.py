@@ -13,13 +13,17 @@ function), ``R(-inf) = 1 - 2/d + 1/(2 d^2)``: -1 at the source's d = 1/2 (no dam
 trapezoidal rule), -1/2 at d = 1, 0 at ``d = 1 - 1/sqrt(2)`` (L-stable and A-stable, as d >= 1/4;
 the default). W1-d has ``R = 1 + z/(1 - d z)``, ``R(-inf) = 1 - 1/d``: 0 at the default d = 1 (linearly
 implicit Euler), and every extrapolated W1-1 entry then also vanishes at ``-inf``.
+
+SW24 is order 2: adaptive runs control its local error against ``rtol_int = rtol^(3/2)`` (option
+``proportional``, default on; :func:`cvtfem.integrate.base.proportional_ratio`), so its global error stays
+proportional to rtol (docs/integrators.md, "Tolerance proportionality").
 """
 from __future__ import annotations
 
 import numpy as np
 
 from cvtfem.errors import InputError
-from cvtfem.integrate.base import Attempt, Stepper
+from cvtfem.integrate.base import Attempt, Stepper, proportional_ratio
 from cvtfem.integrate.extrapolation import Extrapolator
 from cvtfem.integrate.jacobian import JacobianProvider
 from cvtfem.integrate.linsolve import LU, reduced_matrix
@@ -75,6 +79,18 @@ class SW24(_WBase):
 
     name, order, error_order, stages = "sw24", 2, 2, 2
     default_d = 1.0 - 1.0 / np.sqrt(2.0)   # L-stable (see module docstring)
+    OPTIONS = _WBase.OPTIONS | {"proportional"}
+
+    def __init__(self, system, stats=None, d: float | None = None, jac_every: int = 1,
+                 proportional: bool = True) -> None:
+        super().__init__(system, stats, d=d, jac_every=jac_every)
+        if not isinstance(proportional, (bool, np.bool_)):
+            raise InputError("proportional", proportional, "must be true or false")
+        self.proportional = bool(proportional)
+
+    def tolerance_ratio(self, rtol: float) -> float:
+        """Global error proportional to rtol unless ``proportional=False`` (module docstring)."""
+        return proportional_ratio(rtol, 2, 1.0) if self.proportional else 1.0
 
     def attempt(self, t, x, h):
         self._refresh(t, x)

@@ -86,10 +86,20 @@ def plot_effective_order(curves, path: Path, title: str = "") -> Path:
     return save(fig, path)
 
 
-def plot_work_precision(rows, path: Path, title: str = "") -> Path:
-    """Error vs wall time and vs RHS calls, one line per ``label`` (rows from ``work_precision``)."""
+def _setting_label(row) -> str:
+    """A point's setting: its rtol (adaptive) or its step (fixed)."""
+    if "rtol" in row:
+        return f"{row['rtol']:.0e}"
+    return f"h={row['h']:.0e}" if "h" in row else ""
+
+
+def plot_work_precision(rows, path: Path, title: str = "", note: str = "") -> Path:
+    """Error vs wall time and vs RHS calls, one line per ``label`` (rows from ``work_precision``); each
+    point labelled with its rtol (or step), ``note`` (error measure, simulated span) under the panels."""
+    from matplotlib.ticker import LogLocator, NullFormatter
+
     plt = pyplot()
-    fig, (a1, a2) = plt.subplots(1, 2, figsize=(10, 4))
+    fig, (a1, a2) = plt.subplots(1, 2, figsize=(11, 4.8))
     labels = list(dict.fromkeys(r["label"] for r in rows))
     for i, label in enumerate(labels):
         sel = [r for r in rows if r["label"] == label and np.isfinite(r["error"]) and r["error"] > 0]
@@ -100,14 +110,23 @@ def plot_work_precision(rows, path: Path, title: str = "") -> Path:
         style = dict(color=f"C{i % 10}", ls=("-", "--", ":")[i // 10 % 3], marker="osv^D"[i // 10 % 5], ms=3)
         a1.loglog([r["time"] for r in sel], err, label=label, **style)
         a2.loglog([r["nfev"] for r in sel], err, label=label, **style)
+        for j, r in enumerate(sel):   # labels right of the point, methods staggered vertically
+            dy = (-9, 3, 9, -3)[(i + j) % 4]
+            for ax, x in ((a1, r["time"]), (a2, r["nfev"])):
+                ax.annotate(_setting_label(r), (x, r["error"]), xytext=(4, dy), textcoords="offset points",
+                            fontsize=5.5, color=f"C{i % 10}")
     a1.set_xlabel("wall time, s (median)")
     a2.set_xlabel("RHS calls (incl. Jacobians)")
     for ax in (a1, a2):
         ax.set_ylabel("relative error")
         ax.grid(True, which="both", lw=0.3)
+        ax.xaxis.set_major_locator(LogLocator(base=10, numticks=6))   # decades only: no overlapping labels
+        ax.xaxis.set_minor_formatter(NullFormatter())
     a1.legend(fontsize=7)
     fig.suptitle(title or "work-precision", fontsize=10)
-    fig.tight_layout()
+    if note:
+        fig.text(0.5, 0.01, note, ha="center", va="bottom", fontsize=7.5, wrap=True)
+    fig.tight_layout(rect=(0, 0.06 if note else 0, 1, 1))
     return save(fig, path)
 
 

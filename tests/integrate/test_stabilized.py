@@ -42,12 +42,13 @@ def test_spectral_radius_of_heat_equation():
 
 def test_automatic_stages_beat_rk4_tenfold():
     """Heat equation N=200: RKC with automatic stage selection at rel. error < 1e-4 uses far
-    fewer RHS calls than RK4 at its stability limit."""
+    fewer RHS calls than RK4 at its stability limit (rtol 1e-3: with the proportional tolerance map
+    the achieved error is 8e-5)."""
     p = heat1d(N=200, t_end=0.1)
     ref = p.reference()
-    res = solve(**p.solve_kwargs(), method="rkc", rtol=1e-4, atol=1e-7)
+    res = solve(**p.solve_kwargs(), method="rkc", rtol=1e-3, atol=1e-6)
     err = np.max(np.abs(res.y[:, -1] - ref)) / np.max(np.abs(ref))
-    assert res.success and err < 1e-3
+    assert res.success and err < 1e-4
     h_rk4 = 2.78 / p.info["rho"]
     nfev_rk4 = 4 * int(np.ceil(0.1 / h_rk4))
     assert res.stats["nfev"] * 10 < nfev_rk4
