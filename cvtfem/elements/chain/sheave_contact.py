@@ -161,16 +161,8 @@ class SheaveContact:
                    "potential": 2 * hertz_potential(delta, self.c[shafts])}
 
     def local_jacobian(self, X, shafts):
-        """``dY/dX`` (m, 6, 9) by central differences, all contacts at once (each contact depends only on
-        its own 9 inputs, so one perturbation per input column serves all contacts)."""
-        scale = np.array([1e-9] * 4 + [1e-6] * 4 + [1e-5])   # m, m/s, rad/s
-        J = np.empty((len(X), N_OUT, N_IN))
-        for j in range(N_IN):
-            Xp, Xm = X.copy(), X.copy()
-            Xp[:, j] += scale[j]
-            Xm[:, j] -= scale[j]
-            J[:, :, j] = (self.local(Xp, shafts) - self.local(Xm, shafts)) / (2 * scale[j])
-        return J
+        """``dY/dX`` (m, 6, 9) by central differences (:func:`central_local_jacobian`)."""
+        return central_local_jacobian(self.local, X, shafts, np.array([1e-9] * 4 + [1e-6] * 4 + [1e-5]), N_OUT)
 
     def scatter(self, Y, pins, shafts, n):
         """Sum local outputs: generalized forces on the pin ends (n, 3), on ``z`` (2), on ``phi`` (2), and
@@ -179,6 +171,19 @@ class SheaveContact:
         for j in range(3):
             Qp[:, j] = np.bincount(pins, Y[:, j], n)
         return Qp, np.bincount(shafts, Y[:, 3], 2), np.bincount(shafts, Y[:, 4], 2), float(Y[:, 5].sum())
+
+
+def central_local_jacobian(local, X, shafts, scale, n_out: int):
+    """``dY/dX`` (m, n_out, n_in) of ``local(X, shafts)`` by central differences with steps ``scale`` (one per
+    input: m, m/s, rad/s), all contacts at once: each contact depends only on its own inputs, so one
+    perturbation per input column serves all contacts."""
+    J = np.empty((len(X), n_out, X.shape[1]))
+    for j in range(X.shape[1]):
+        Xp, Xm = X.copy(), X.copy()
+        Xp[:, j] += scale[j]
+        Xm[:, j] -= scale[j]
+        J[:, :, j] = (local(Xp, shafts) - local(Xm, shafts)) / (2 * scale[j])
+    return J
 
 
 @dataclass(frozen=True)

@@ -39,6 +39,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from cvtfem.elements.band.geometry import Sheave
+from cvtfem.elements.chain.sheave_contact import central_local_jacobian
 from cvtfem.elements.chain.sheave_contact_refined_kernel import refined_local_kernel
 from cvtfem.elements.chain.symmetric import END_SLOPE_FACTOR
 from cvtfem.elements.contact.friction import _check, friction_force
@@ -274,19 +275,11 @@ class RefinedSheaveContact:
         return Y
 
     def local_jacobian(self, X, shafts):
-        """``dY/dX`` (m, n_out, n_in) by central differences, all contacts at once (each contact depends only
-        on its own inputs, so one perturbation per input column serves all contacts)."""
-        n = self.n_pos
+        """``dY/dX`` (m, n_out, n_in) by central differences (:func:`central_local_jacobian`)."""
         scale = np.full(self.n_in, 1e-6)                     # m/s and slope rates
-        scale[:n] = 1e-9                                     # m (slopes: 1e-9 too)
+        scale[:self.n_pos] = 1e-9                            # m (slopes: 1e-9 too)
         scale[-1] = 1e-5                                     # rad/s
-        J = np.empty((len(X), self.n_out, self.n_in))
-        for j in range(self.n_in):
-            Xp, Xm = X.copy(), X.copy()
-            Xp[:, j] += scale[j]
-            Xm[:, j] -= scale[j]
-            J[:, :, j] = (self.local(Xp, shafts) - self.local(Xm, shafts)) / (2 * scale[j])
-        return J
+        return central_local_jacobian(self.local, X, shafts, scale, self.n_out)
 
     def scatter(self, Y, pins, shafts, n):
         """Sum local outputs: generalized forces on the pin coordinates ``(n, 3 + 2 slopes)`` (``u``, ``u3``,
