@@ -573,17 +573,32 @@ class ChainCVT(ModelBase):
         constant (digest §4.3) for a pin end crowned with ``face_radius`` at the contact radius
         ``r_hertz`` (default: the mean radius of ratio 1, ``(l - 2 L) / (2 pi)``).
         """
-        if model not in FAMILIES:
-            raise InputError("cvt.model", model, "must be one of " + ", ".join(FAMILIES))
-        family = FAMILIES[model](geom, damping_from_ratio(geom, damping_ratio, b_joint))
+        family = cls._family_for(model, geom, damping_from_ratio(geom, damping_ratio, b_joint), E)
         face = Sheave(face.profile, face.gamma, face.R, face.y, geom.l / 2)
         r_h = (geom.length - 2 * centre_distance) / (2 * np.pi) if r_hertz is None else r_hertz
         c = hertz_constant(face, r_h, face_radius, E, poisson)
         contact = SheaveContact(np.array([[centre_distance, 0.0], [0.0, 0.0]]), (face, face), np.array([c, c]),
                                 r_outer, f0, v0, law)
         loop = OpenLoop() if control is None else Stabilisation(control)
-        return cls(family, contact, np.asarray(J, float), np.asarray(m_sheave, float), regime,
-                   np.asarray(F_appl, float), loop)
+        m_z = np.asarray(m_sheave, float) * cls.sheaves_per_z / 2      # mass moved by one z coordinate
+        return cls(family, cls._contact_for(contact), np.asarray(J, float), m_z, regime,
+                   np.asarray(F_appl, float), loop)._settled()
+
+    @classmethod
+    def _family_for(cls, model: str, geom, damping, E: float):
+        """The chain family of ``model`` (InputError naming ``cvt.model`` for another)."""
+        if model not in FAMILIES:
+            raise InputError("cvt.model", model, "must be one of " + ", ".join(FAMILIES))
+        return FAMILIES[model](geom, damping)
+
+    @classmethod
+    def _contact_for(cls, contact: SheaveContact):
+        """The contact kernel of this model's pin ends (the mirrored pair: as is)."""
+        return contact
+
+    def _settled(self) -> "ChainCVT":
+        """The model with the parameters that depend on the built model (none here)."""
+        return self
 
 
 def from_scene(scene, geom, F_appl, model: str = "chain-S2", **overrides) -> ChainCVT:
@@ -607,7 +622,10 @@ def from_scene(scene, geom, F_appl, model: str = "chain-S2", **overrides) -> Cha
               F_appl=F_appl, control=loop if cvt.effects.stabilisation else None,
               damping_ratio=cvt.chain.damping_ratio, E=cvt.young_modulus)
     kw.update(overrides)
-    return ChainCVT.from_parameters(geom, **kw)
+    if kw["model"] in FAMILIES:
+        return ChainCVT.from_parameters(geom, **kw)
+    from cvtfem.machines.chain_a_cvt import ChainACVT   # the whole-pin chains build on this module
+    return ChainACVT.from_parameters(geom, **kw)
 
 
 def band_span_tensions(band, x) -> np.ndarray:
