@@ -75,11 +75,13 @@ class WholePinFamily:
 
     def __init__(self, chain, geom):
         self.chain, self.geom = chain, geom
+        self._a1 = getattr(chain, "base", chain)        # the ChainA1 layout of A3/A4
         self.n, self.size = chain.n_pins, chain.n2
         self.dof_index = chain.dof_index
         self.ip1 = (np.arange(self.n) + 1) % self.n
         self.on = geom.link_on
         self._free = FreeChainA(chain, np.zeros(chain.n2))
+        self._last: tuple = (None, None, None)       # the blocks of the last state asked for
 
     @property
     def blocks(self):
@@ -95,7 +97,11 @@ class WholePinFamily:
 
     def split(self, q):
         """``(u (4, n, 2), w (2, n))`` views (chain-models-2 §2.1)."""
-        return self.chain.split(q)
+        return self._a1.split(q)
+
+    def join(self, u, w):
+        """Inverse of :meth:`split`."""
+        return self._a1.join(u, w)
 
     def forces(self, q, v):
         return self.chain.forces(q, v)
@@ -124,8 +130,12 @@ class WholePinFamily:
     def jacobian(self, q, v, part: str = "all", wrt: tuple = (0, 1)):
         """``(dQ/dq, dQ/dq')`` (CSR) of all forces, or with ``part="dissipative"`` of the damping forces alone
         (their ``dQ/dq`` is the total's less the one at ``q' = 0``, where the damping forces vanish)."""
-        lin = self._free.linearize(np.concatenate([q, v]))
-        dq, dv = -lin.K, -lin.C
+        x = np.concatenate([q, v])
+        key = x.tobytes()
+        if self._last[0] != key:                      # ChainCVT.jac asks for both parts at one state
+            lin = self._free.linearize(x)
+            self._last = (key, -lin.K, -lin.C)
+        dq, dv = self._last[1:]
         if part == "dissipative":
             dq = dq + self._free.linearize(np.concatenate([q, np.zeros_like(v)])).K
         return tuple(sp.csr_matrix(dq if k == 0 else dv) for k in wrt)
@@ -221,7 +231,7 @@ class ChainACVT(ChainCVT):
     def _placed(self, pl, u3):
         u = np.zeros((4, self.family.n, 2))
         u[0] = pl.u
-        return self.family.chain.join(u, np.stack([np.zeros(self.family.n), u3]))
+        return self.family.join(u, np.stack([np.zeros(self.family.n), u3]))
 
     def _turn_with_sheave(self, q_chain, v_chain, pins, w, centre):
         """The pins' in-plane vectors (position about ``centre``, tilt, slopes) turn at ``w`` (rad/s)."""

@@ -157,7 +157,7 @@ def chain_geometry(scene: Scene):
 
 
 #: Discrete-chain models that run as a transmission (the others exist as element families only).
-RUNNING_CHAINS = ("chain-S2", "chain-S3")
+RUNNING_CHAINS = ("chain-S2", "chain-S3", "chain-A1")
 
 
 def band_model(scene: Scene, **overrides: Any):
@@ -233,8 +233,10 @@ def chain_loop(scene: Scene):
 
     The prescribed clamping forces are those the band models get (:class:`~cvtfem.control.clamping.Clamping`
     at the regime's start: torque, ratio, safety factor, split); the ratio loop corrects ``F1`` from there.
-    Only what runs is accepted: ``chain-S2`` (no pin bending) and ``chain-S3`` (pin bending), rigid shafts,
-    ``effects.contact = "hertz"``, friction on.
+    Only what runs is accepted: ``chain-S2`` (no pin bending), ``chain-S3`` and the whole-pin chain ``chain-A1``
+    (pin bending; :mod:`~cvtfem.machines.chain_a_cvt`, a fixed and a movable sheave per shaft), rigid shafts,
+    ``effects.contact = "hertz"``, friction on.  (A3/A4 build through the same interface, but their quasi-static
+    start does not converge yet: docs/chain.md.)
     """
     from cvtfem.control.clamping import Clamping
     from cvtfem.machines.chain_cvt import from_scene
@@ -244,8 +246,8 @@ def chain_loop(scene: Scene):
     if model not in RUNNING_CHAINS:
         raise InputError("cvt.model", model, "must be a discrete chain that runs in time: " + ", ".join(RUNNING_CHAINS)
                          + " (the other chain models exist as element families only so far, docs/chain.md)")
-    if model == "chain-S3" and not eff.pin_bending:
-        raise InputError("cvt.effects.pin_bending", False, "must be true for `chain-S3` (S2 plus pin bending); "
+    if model != "chain-S2" and not eff.pin_bending:
+        raise InputError("cvt.effects.pin_bending", False, f"must be true for `{model}` (its pins bend); "
                          "without pin bending use `chain-S2`")
     if eff.shaft_elasticity:
         raise InputError("cvt.effects.shaft_elasticity", True, f"is not available for `{model}` yet: the chain "
@@ -267,6 +269,7 @@ def _running_chain_layout(scene: Scene) -> tuple[Layout, ...]:
     """Components of :func:`chain_loop`'s model with the outputs it writes, grouped by name prefix."""
     model = chain_loop(scene)
     n, per_pin = model.family.n, CHAIN_COORDS_PER_PIN[scene.cvt.model]
+    sheave = "sheave pair" if model.sheaves_per_z == 2 else "movable sheave"
 
     def outputs(*prefixes: str) -> tuple[OutputSpec, ...]:
         return tuple(o for o in model.output_specs if o.name.startswith(prefixes))
@@ -274,8 +277,8 @@ def _running_chain_layout(scene: Scene) -> tuple[Layout, ...]:
     parts = [Layout("chain", scene.cvt.model, n * per_pin, outputs=outputs("chain.", "contact."),
                     note=f"{n} pins x {per_pin}; Hertz contact at both pin ends with each shaft's sheaves "
                          "(continuous: no discrete state)"),
-             Layout("driving pulley", "rigid-shaft", 2, outputs=outputs("driving."), note="spin angle, sheave axial"),
-             Layout("driven pulley", "rigid-shaft", 2, outputs=outputs("driven."), note="spin angle, sheave axial")]
+             Layout("driving pulley", "rigid-shaft", 2, outputs=outputs("driving."), note=f"spin angle, {sheave} axial"),
+             Layout("driven pulley", "rigid-shaft", 2, outputs=outputs("driven."), note=f"spin angle, {sheave} axial")]
     if scene.cvt.effects.stabilisation:
         parts.append(Layout("stabilisation", "speed-ratio-control", 0, n1=Stabilisation.size,
                             outputs=outputs("control."), note="smoothed speeds, F1 integral, b2 integral"))
