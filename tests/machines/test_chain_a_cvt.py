@@ -183,3 +183,19 @@ def test_stationary_regime_against_the_band_model(scene):
     clamp = np.mean([[o["driving.clamping_force"], o["driven.clamping_force"]] for o in outs], axis=0)
     np.testing.assert_allclose(axial, clamp, rtol=0.01)
     np.testing.assert_allclose(T, T_band, rtol=0.05)
+
+
+def test_scene_path_builds_a1_and_describes_its_outputs_once():
+    from cvtfem.machines import layout
+    from cvtfem.machines.cvt import chain_loop
+
+    scene = load_scene("chain-A1")
+    m = chain_loop(scene)
+    assert isinstance(m, ChainACVT) and m.family.size == 10 * scene.cvt.chain.n_pins
+    listed = [o.name for part in layout(scene) for o in part.outputs]
+    assert sorted(listed) == sorted(o.name for o in m.output_specs)
+    assert sum(p.n2 for p in layout(scene)) == m.n2
+    with pytest.raises(InputError, match=r"cvt\.model"):
+        chain_loop(scene.replace({"cvt": {"model": "chain-A4"}}))
+    with pytest.raises(InputError, match=r"cvt\.effects\.pin_bending"):
+        chain_loop(scene.replace({"cvt": {"effects": {"pin_bending": False}}}))
