@@ -10,9 +10,13 @@ pair mass, ``delta W = -2 P delta z + M delta phi`` (1.229)), the states of the 
 Frame of the chain models: driven shaft axis at the origin, driving at ``(L, 0)``, chain counter-clockwise.
 
 The contacts (:mod:`cvtfem.elements.chain.sheave_contact`) load both pin ends of every pin near a shaft
-(mirror symmetry, ``2F``); the clamping forces ``F_k`` act per sheave.  The Jacobian is assembled from
-the chain family's complex-step blocks, per-contact central differences of the local contact kernel
-(9 inputs, 6 outputs, all contacts at once) and differences of the cheap loop outputs.
+(mirror symmetry, ``2F``); the clamping forces ``F_k`` act per sheave.  A contact reads its local inputs
+through the *contact map* (weighted state columns, :meth:`ChainCVT._contact_map`) and its forces act back
+through the same map, so a family whose pin ends are linear combinations of its coordinates plugs in by
+overriding the end hooks (:class:`~cvtfem.machines.chain_a_cvt.ChainACVT`, the whole-pin chains).  The
+Jacobian is assembled from the chain family's blocks, per-contact central differences of the local contact
+kernel (9 inputs, 6 outputs, all contacts at once) mapped on both sides, and differences of the cheap loop
+outputs.
 """
 from __future__ import annotations
 
