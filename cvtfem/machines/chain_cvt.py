@@ -518,8 +518,8 @@ class ChainCVT(ModelBase):
             Kc = fam.jacobian(qq[:nc], vel[:nc], wrt=(0,))[0].tocoo()
             _, shafts, cols, coef, X, _ = self._contact_set(qq, vel)
             r, c, d = self._contact_entries(cols, coef, self.contact.local_jacobian(X, shafts), n_in=4)
-            K = sp.csr_matrix((np.concatenate([Kc.data, d]), (np.concatenate([Kc.row, r]), np.concatenate([Kc.col, c]))),
-                              shape=(n2, n2))
+            rows, cols = np.concatenate([Kc.row, r]), np.concatenate([Kc.col, c])
+            K = sp.csr_matrix((np.concatenate([Kc.data, d]), (rows, cols)), shape=(n2, n2))
             return (K[free][:, free] / F2).toarray()
         sol = least_squares(residual, q[free], jac=jacobian, method="lm", xtol=tol, ftol=tol, gtol=tol,
                             x_scale=1e-5, max_nfev=200)

@@ -102,8 +102,8 @@ def test_contact_forces_are_minus_the_gradient_of_the_hertz_potential(model, sta
     touching = np.unique(model.pin_of(ends[c["delta"] > 0]))
     assert len(touching) > 40
     rng = np.random.default_rng(3)
-    cols = np.concatenate([model.family.dof_index[rng.choice(touching, 8, replace=False)][:, [0, 1, 2, 3, 8, 9]].ravel(),
-                           model._idx[2]])
+    pins = rng.choice(touching, 8, replace=False)
+    cols = np.concatenate([model.family.dof_index[pins][:, [0, 1, 2, 3, 8, 9]].ravel(), model._idx[2]])
     scale = np.abs(Q).max()
     for j in cols:
         h = 1e-10
@@ -158,8 +158,9 @@ def test_energy_balance_over_a_short_run(model, static):
 
 
 @pytest.mark.slow
-@pytest.mark.xfail(strict=True, reason="open: after 10 ms the A1 slack span is +9.7 % above the band's (+6.3 % at 14-20 ms; tight +0.8 %, "
-                   "axial balance 0.03 %; studies/chain/chain_cvt_stationary.py --model chain-A1, docs/chain.md); "
+@pytest.mark.xfail(strict=True, reason="open: after 10 ms the A1 slack span is +9.7 % above the band's "
+                   "(+6.3 % at 14-20 ms; tight +0.8 %, axial balance 0.03 %; "
+                   "studies/chain/chain_cvt_stationary.py --model chain-A1, docs/chain.md); "
                    "the run takes ~35 min on the loaded 2-core machine")
 def test_stationary_regime_against_the_band_model(scene):
     """Acceptance of issue 13 for A1, as S2's: 3500 rpm, 200 N m, ratio 2.4, A1 from its quasi-static state with
