@@ -10,16 +10,20 @@ pair mass, ``delta W = -2 P delta z + M delta phi`` (1.229)), the states of the 
 Frame of the chain models: driven shaft axis at the origin, driving at ``(L, 0)``, chain counter-clockwise.
 
 The contacts (:mod:`cvtfem.elements.chain.sheave_contact`) load both pin ends of every pin near a shaft
-(mirror symmetry, ``2F``); the clamping forces ``F_k`` act per sheave.  The Jacobian is assembled from
-the chain family's complex-step blocks, per-contact central differences of the local contact kernel
-(9 inputs, 6 outputs, all contacts at once) and differences of the cheap loop outputs.
+(mirror symmetry, ``2F``); the clamping forces ``F_k`` act per sheave.  A contact reads its local inputs
+through the *contact map* (weighted state columns, :meth:`ChainCVT._contact_map`) and its forces act back
+through the same map, so a family whose pin ends are linear combinations of its coordinates plugs in by
+overriding the end hooks (:class:`~cvtfem.machines.chain_a_cvt.ChainACVT`, the whole-pin chains).  The
+Jacobian is assembled from the chain family's blocks, per-contact central differences of the local contact
+kernel (9 inputs, 6 outputs, all contacts at once) mapped on both sides, and differences of the cheap loop
+outputs.
 """
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass, replace
 from functools import cached_property
-from typing import Any
+from typing import Any, ClassVar
 
 import numpy as np
 import scipy.sparse as sp
@@ -59,12 +63,15 @@ class ChainCVT(ModelBase):
     """
 
     family: Any
-    contact: SheaveContact
+    contact: Any
     J: np.ndarray
     m_sheave: np.ndarray
     regime: Regime
     F_appl: np.ndarray
     control: Any
+
+    #: Sheaves the clamping force ``F`` acts on through one ``z`` coordinate: both of the symmetric pair.
+    sheaves_per_z: ClassVar[float] = 2.0
 
     # ----- layout ------------------------------------------------------------------------------
     @cached_property
@@ -102,7 +109,7 @@ class ChainCVT(ModelBase):
 
     @cached_property
     def output_specs(self) -> tuple[OutputSpec, ...]:
-        n = self.family.n
+        n = self.n_ends
         return tuple(self.family.output_specs) + (
             OutputSpec("contact.normal_force", "N",
                        "Hertz force N per pin end and shaft (pin-major, driving then driven).", 2 * n),
@@ -142,12 +149,75 @@ class ChainCVT(ModelBase):
         F, M2, dz, diag = self.control.outputs(w, z, i_d, w1d / i_d, M1, self.F_appl)
         return np.asarray(F, float), np.array([M1, M2]), dz, diag
 
+    # ----- contact ends (the hooks a chain family with other pin ends overrides) --------------------
+    @property
+    def n_ends(self) -> int:
+        """Pin ends that touch sheaves (one per pin: the mirror end is implied)."""
+        return self.family.n
+
+    def pin_of(self, ends):
+        """Pin of each contact end."""
+        return ends
+
+    def pin_positions(self, q_chain):
+        """In-plane pin positions (n, 2) m, a view of the chain coordinates."""
+        return self.family.split(q_chain)[0]
+
+    def _all_pairs(self):
+        """Every ``(end, shaft)`` pair the broad phase may return (the structural pattern)."""
+        return np.repeat(np.arange(self.n_ends), 2), np.tile(np.arange(2), self.n_ends)
+
+    def _candidates(self, q):
+        """Broad phase: ``(ends, shafts)`` within the sheaves' outer radius."""
+        return self.contact.candidates(self.pin_positions(q[:self._idx[0]]))
+
+    @property
+    def _constants(self) -> np.ndarray:
+        """Values appended to ``[q, v]`` that contact inputs may read (none here)."""
+        return np.zeros(0)
+
+    def _contact_map(self, ends, shafts):
+        """``(cols, coef)`` (m, 9, k): local input ``j`` of a contact is ``sum_a coef[j, a] y[cols[j, a]]`` of
+        ``y = [q, v, constants]``; its generalized forces act on the same coordinates (virtual work)."""
+        cols = self._contact_columns(ends, shafts)
+        return cols[:, :, None], np.ones(cols.shape + (1,))
+
+    def _contact_set(self, q, v, details=False):
+        """Broad phase, the input map, local inputs and outputs of the contacts."""
+        ends, shafts = self._candidates(q)
+        cols, coef = self._contact_map(ends, shafts)
+        X = (coef * np.concatenate([q, v, self._constants])[cols]).sum(axis=2)
+        return ends, shafts, cols, coef, X, self.contact.local(X, shafts, details)
+
     def _contacts(self, q, v, details=False):
-        """Broad phase, local inputs and outputs of the contacts."""
-        nc = self._idx[0]
-        pins, shafts = self.contact.candidates(self.family.split(q[:nc])[0])
-        X = self._gather(pins, shafts, q, v)
-        return pins, shafts, X, self.contact.local(X, shafts, details)
+        """``(ends, shafts, X, Y)``: broad phase, local inputs and outputs of the contacts."""
+        ends, shafts, _, _, X, Y = self._contact_set(q, v, details)
+        return ends, shafts, X, Y
+
+    def _output_rows(self, cols, coef):
+        """Rows (in ``q``) and weights (m, n_force, k) of the local force outputs: one per position input (the
+        first ``(n_in - 1) / 2`` inputs: pin-end and sheave coordinates) and the last on ``phi`` (whose rate is
+        the last input); weight 0 where an output acts on a constant (a fixed sheave)."""
+        n2 = self.n2
+        pick = list(range((cols.shape[1] - 1) // 2)) + [cols.shape[1] - 1]
+        rows = cols[:, pick].copy()
+        rows[:, -1] -= n2
+        w = np.where(rows < n2, coef[:, pick], 0.0)
+        return np.where(w != 0, rows, 0), w
+
+    def _contact_entries(self, cols, coef, Jl, n_in: int | None = None):
+        """``(rows, cols, values)`` of ``dQ/dy`` from the local Jacobians ``Jl`` (m, n_force + 1, n_in) over the
+        first ``n_in`` inputs (default all; ``y = [q, v]``; constants dropped): ``R^T Jl P`` contact by contact
+        (the last output, the friction power, is not a force)."""
+        n_in = cols.shape[1] if n_in is None else n_in
+        rows, rw = self._output_rows(cols, coef)
+        cw = np.where(cols[:, :n_in] < 2 * self.n2, coef[:, :n_in], 0.0)
+        vals = rw[:, :, :, None, None] * Jl[:, :-1, None, :n_in, None] * cw[:, None, None, :, :]
+        shape = vals.shape
+        R = np.broadcast_to(rows[:, :, :, None, None], shape)
+        C = np.broadcast_to(cols[:, None, None, :n_in, :], shape)
+        keep = vals != 0
+        return R[keep], C[keep], vals[keep]
 
     def _forces(self, q, v, F, M, slip: bool = False):
         """Generalized forces on all coordinates (N, N m) and the friction power (W); with ``slip`` also the
@@ -155,15 +225,16 @@ class ChainCVT(ModelBase):
         nc, iphi, iz, _ = self._idx
         Q = np.zeros(self.n2)
         Q[:nc] = self.family.forces(q[:nc], v[:nc])
-        pins, shafts, _, Y = self._contacts(q, v, details=slip)
+        _, shafts, cols, coef, _, Y = self._contact_set(q, v, details=slip)
         if slip:
             Y, det = Y
             N = np.bincount(shafts, det["N"], 2)
             mean_slip = np.bincount(shafts, det["N"] * np.linalg.norm(det["slip"], axis=1), 2) / np.maximum(N, 1e-300)
-        Qp, Qz, Qphi, Pf = self.contact.scatter(Y, pins, shafts, self.family.n)
-        Q[self.family.dof_index[:, :Qp.shape[1]]] += Qp
-        Q[iphi] += Qphi + M
-        Q[iz] += Qz - 2 * F
+        rows, w = self._output_rows(cols, coef)
+        Q += np.bincount(rows.ravel(), (w * Y[:, :-1, None]).ravel(), self.n2)
+        Pf = float(Y[:, -1].sum())
+        Q[iphi] += M
+        Q[iz] -= self.sheaves_per_z * F
         return (Q, Pf, mean_slip) if slip else (Q, Pf)
 
     def solve_mass(self, Q):
@@ -183,7 +254,7 @@ class ChainCVT(ModelBase):
         F, M, dz, diag = self._controls(t, w, zc)
         Q, Pf, *mean_slip = self._forces(q, v, F, M, slip)
         D = 2 * self.family.rayleigh(q[:nc], v[:nc]) - Pf
-        dW = np.array([M[0] * w[0], -M[1] * w[1], D, -2 * float(F @ v[iz])])
+        dW = np.array([M[0] * w[0], -M[1] * w[1], D, -self.sheaves_per_z * float(F @ v[iz])])
         diag = dict(diag, F=F, M=M, w=w, friction_power=Pf, targets=self.regime.targets(t))
         if slip:
             diag["slip"] = mean_slip[0]
@@ -216,22 +287,6 @@ class ChainCVT(ModelBase):
             G[:, j] = (np.concatenate([Fp, Mp[1:], dzp]) - u0) / h
         return F, M, G
 
-    def _gather(self, pins, shafts, q, v):
-        """Local inputs of the contacts (``SheaveContact.gather``)."""
-        nc, iphi, iz, _ = self._idx
-        u, u3, _ = self.family.split(q[:nc])
-        ud, u3d, _ = self.family.split(v[:nc])
-        return self.contact.gather(pins, shafts, u, u3, ud, u3d, q[iz], v[iz], v[iphi])
-
-    def _extra_approach(self, k: int, r: float) -> float:
-        """Penetration of the contact beyond H1's for a pin end at radius ``r`` (m) on shaft ``k`` (0 for H1)."""
-        return 0.0
-
-    def _contact_rows(self, pins, shafts):
-        """State rows of the local contact force outputs (all but the last, the friction power), (m, 5)."""
-        _, iphi, iz, dof3 = self._idx
-        return np.column_stack([dof3[pins], iz[shafts], iphi[shafts]])
-
     def _contact_columns(self, pins, shafts):
         """State columns of the 9 local contact inputs, (m, 9)."""
         nc, iphi, iz, dof3 = self._idx
@@ -256,13 +311,10 @@ class ChainCVT(ModelBase):
             vals.append(np.ravel(d))
         for Mx, off in ((Kc.tocoo(), 0), (Cc.tocoo(), n2)):
             add(Mx.row, Mx.col + off, Mx.data)
-        pins, shafts, X, _ = self._contacts(q, v)
+        _, shafts, ccols, coef, X, _ = self._contact_set(q, v)
         Jl = self.contact.local_jacobian(X, shafts)            # (m, outputs, inputs)
-        cin = self._contact_columns(pins, shafts)
-        out_rows = self._contact_rows(pins, shafts)
-        add(np.repeat(out_rows[:, :, None], cin.shape[1], 2), np.repeat(cin[:, None, :], out_rows.shape[1], 1),
-            Jl[:, :-1, :])
-        add(np.repeat(iz, len(in_cols)), np.tile(in_cols, 2), -2 * G[:2].ravel())    # -2 F on z
+        add(*self._contact_entries(ccols, coef, Jl))
+        add(np.repeat(iz, len(in_cols)), np.tile(in_cols, 2), -self.sheaves_per_z * G[:2].ravel())   # -2 F on z
         add(np.full(len(in_cols), iphi[1]), in_cols, G[2])                              # M2 on phi2
         dQ = sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))), shape=(n2, N))
         acc = self._inv_mass @ dQ
@@ -276,12 +328,13 @@ class ChainCVT(ModelBase):
         d2phi = np.concatenate([-(Kd.T @ v[:nc]), -2 * Qd])
         chain_cols = np.concatenate([np.arange(nc), n2 + np.arange(nc)])
         dPf = np.zeros(N)
-        np.add.at(dPf, cin.ravel(), Jl[:, -1, :].ravel())
+        cw = np.where(ccols < 2 * n2, coef, 0.0)
+        np.add.at(dPf, np.where(cw != 0, ccols, 0).ravel(), (cw * Jl[:, -1, :, None]).ravel())
         dD = -dPf
         dD[chain_cols] += d2phi
         Wr[2, :] = dD
-        Wr[3, n2 + iz] = -2 * F
-        Wr[3, in_cols] = -2 * (v[iz] @ G[:2])
+        Wr[3, n2 + iz] = -self.sheaves_per_z * F
+        Wr[3, in_cols] = -self.sheaves_per_z * (v[iz] @ G[:2])
         ctrl_rows = sp.csr_matrix((G[3:].ravel(), (np.repeat(np.arange(nz), 2 + nz), np.tile(in_cols, nz))),
                                   shape=(nz, N))
         top = sp.csr_matrix((np.ones(n2), (np.arange(n2), n2 + np.arange(n2))), shape=(n2, N))
@@ -291,18 +344,17 @@ class ChainCVT(ModelBase):
     def jac_sparsity(self) -> sp.csr_matrix:
         """Structural pattern: chain stencil (pins ``p +- 2``), every pin with every shaft (broad phase
         may take any pin), the loops, and dense work-rate rows (all but the angles)."""
-        nc, iphi, iz, _ = self._idx
-        n2, nz, N, n = self.n2, self.control.size, self.size, self.family.n
+        iphi, iz = self._idx[1:3]
+        n2, nz, N = self.n2, self.control.size, self.size
         ctrl = 2 * n2 + np.arange(nz)
         P = sp.csr_matrix(self.family.jac_sparsity, dtype=float).tocoo()
         rows = [P.row, P.row]
         cols = [P.col, P.col + n2]
-        pins = np.repeat(np.arange(n), 2)
-        shafts = np.tile(np.arange(2), n)
-        cin = self._contact_columns(pins, shafts)
-        out_rows = self._contact_rows(pins, shafts)
-        rows.append(np.repeat(out_rows[:, :, None], cin.shape[1], 2).ravel())
-        cols.append(np.repeat(cin[:, None, :], out_rows.shape[1], 1).ravel())
+        ccols, coef = self._contact_map(*self._all_pairs())
+        n_force = (ccols.shape[1] - 1) // 2 + 1
+        r, c, _ = self._contact_entries(ccols, coef, np.ones((len(ccols), n_force + 1, ccols.shape[1])))
+        rows.append(r)
+        cols.append(c)
         in_cols = np.concatenate([n2 + iphi, ctrl])
         rows.append(np.repeat(np.concatenate([iz, iphi]), len(in_cols)))
         cols.append(np.tile(in_cols, 4))
@@ -339,7 +391,7 @@ class ChainCVT(ModelBase):
         dx, diag = self.evaluate(t, x, slip=False)      # the contact details come below
         q, v, _, W = self.split(x)
         nc = self._idx[0]
-        n = self.family.n
+        n = self.n_ends
         pins, shafts, _, (Y, c) = self._contacts(q, v, details=True)
         on = c["delta"] > 0
         k = 2 * pins + shafts
@@ -350,7 +402,7 @@ class ChainCVT(ModelBase):
             return out.ravel()
         P = dx[-4:]
         w, M, F = diag["w"], diag["M"], diag["F"]
-        support = np.column_stack([np.bincount(shafts, Y[:, j], 2) for j in (0, 1)])   # sum of 2F on the pins
+        support = np.column_stack([np.bincount(shafts, Y[:, j], 2) for j in (0, 1)])   # forces on the pin ends
         out = dict(self.family.outputs(q[:nc], v[:nc]))
         out.update({"chain.span_tension": self.span_tensions(q, v, pins, c["delta"]),
                     "contact.normal_force": per(c["N"]), "contact.penetration": per(c["delta"]),
@@ -358,7 +410,7 @@ class ChainCVT(ModelBase):
                     "contact.slip_speed": per(np.where(on, np.linalg.norm(c["slip"], axis=1), 0.0)),
                     "contact.friction_force": per(c["F_fr"], 3),
                     "contact.friction_power": np.bincount(shafts, Y[:, -1], 2),
-                    "contact.sheave_axial_force": -np.bincount(shafts, c["F"][:, 2], 2),
+                    **self._sheave_outputs(pins, shafts, c),
                     "driving.speed": w[0], "driven.speed": w[1], "driving.torque": M[0], "driven.torque": M[1],
                     "driving.clamping_force": F[0], "driven.clamping_force": F[1],
                     "driving.support_force": support[0], "driven.support_force": support[1],
@@ -372,14 +424,58 @@ class ChainCVT(ModelBase):
         (``pins``, ``delta`` of the candidate contacts), split by the sign of the link midpoint's ``x2``."""
         nc = self._idx[0]
         fam = self.family
-        u = fam.split(q[:nc])[0]
+        u = self.pin_positions(q[:nc])
         touching = np.zeros(fam.n, bool)
-        touching[pins[delta > 0]] = True
+        touching[self.pin_of(pins)[delta > 0]] = True
         free = ~touching & ~touching[fam.ip1] & (fam.on > 0)
         y = 0.5 * (u[:, 1] + u[fam.ip1, 1])
         T = fam.outputs(q[:nc], v[:nc])[f"{fam.name}.link_tension"]
         return np.array([T[free & (y < 0)].mean() if (free & (y < 0)).any() else math.nan,
                          T[free & (y > 0)].mean() if (free & (y > 0)).any() else math.nan])
+
+    def _sheave_outputs(self, ends, shafts, c) -> dict[str, np.ndarray]:
+        """Axial force of the chain on one sheave of each shaft (N, positive pushing it open)."""
+        return {"contact.sheave_axial_force": -np.bincount(shafts, c["F"][:, 2], 2)}
+
+    def _elastic_link_tension(self, q_chain):
+        """Elastic link tensions (n,) N."""
+        return self.family.outputs(q_chain, np.zeros_like(q_chain))[f"{self.family.name}.link_tension_elastic"]
+
+    def _placed(self, pl, u3):
+        """Chain coordinates of the pins at ``pl.u`` with their pin-axis ends at ``x3 = +-u3`` (n,) m."""
+        fam = self.family
+        return fam.join(*([pl.u, u3] + ([np.zeros((fam.n, 2))] if fam.ndof == 5 else [])))
+
+    def _turn_with_sheave(self, q_chain, v_chain, pins, w, centre):
+        """Set the velocities of ``pins`` to those of a rigid turn at ``w`` (rad/s) about ``centre`` (2,) m."""
+        vu = self.pin_positions(v_chain)
+        vu[pins] = w * (self.pin_positions(q_chain)[pins] - centre) @ np.array([[0.0, 1.0], [-1.0, 0.0]])
+
+    def wedge_guess(self, ratio: float, F2: float):
+        """The start of the quasi-static solve at ``ratio`` and driven clamping force ``F2`` (N): placement
+        (:func:`~cvtfem.elements.chain.placement.place_on_path`), the pin-end axial coordinates (n,) m of the
+        wedge estimate (tension ``T = F2 tan(g2) / theta2*``, per-pin axial forces ``T L / (2 r tan g)``, pin
+        compression) and the sheave positions ``z`` (2,) m with the Hertz penetration of those forces."""
+        fam, faces = self.family, self.contact.faces
+        pl = place_on_path(fam.geom.L, ratio, self.contact.centres[0, 0])
+        if not (pl.r.max() < self.contact.r_outer and pl.r.min() > fam.geom.L.max()):
+            raise InputError("ratio", ratio, f"must put both arcs between one pitch and the sheaves' outer radius "
+                             f"{self.contact.r_outer:g} m (radii {pl.r[0]:.4g}, {pl.r[1]:.4g} m)")
+        l = fam.geom.l
+        tg = np.array([faces[k].tan_gamma(pl.r[k]) for k in range(2)])
+        T = F2 * tg[1] / (np.pi / 2 - pl.phi)
+        Nk = T * fam.geom.L.mean() / (2 * pl.r * tg)
+        dk = (Nk / self.contact.c) ** (2 / 3)
+        u3 = np.full(fam.n, l / 2)
+        for k in range(2):
+            u3[pl.piece == k] -= Nk[k] / (2 * fam.geom.c_pin[pl.piece == k])
+        u3k = l / 2 - Nk / (2 * fam.geom.c_pin.mean())
+        return pl, u3, np.array([u3k[k] - faces[k].lever(pl.r[k]) - dk[k] + self._extra_approach(k, pl.r[k])
+                                 for k in range(2)])
+
+    def _extra_approach(self, k: int, r: float) -> float:
+        """Penetration of the contact beyond H1's for a pin end at radius ``r`` (m) on shaft ``k`` (0 for H1)."""
+        return 0.0
 
     # ----- initial state -----------------------------------------------------------------------
     def static_state(self, ratio: float, w1: float, tension: float | None = None, tol: float = 1e-10):
@@ -428,30 +524,15 @@ class ChainCVT(ModelBase):
         """:meth:`static_state` at the driven clamping force ``F2`` (N)."""
         fam, nc = self.family, self._idx[0]
         _, iphi, iz, _ = self._idx
-        pl = place_on_path(fam.geom.L, ratio, self.contact.centres[0, 0])
-        if not (pl.r.max() < self.contact.r_outer and pl.r.min() > fam.geom.L.max()):
-            raise InputError("ratio", ratio, f"must put both arcs between one pitch and the sheaves' outer radius "
-                             f"{self.contact.r_outer:g} m (radii {pl.r[0]:.4g}, {pl.r[1]:.4g} m)")
+        pl, u3, z = self.wedge_guess(ratio, F2)
         speed = w1 * pl.r[0]
-        n2, l = self.n2, fam.geom.l
-        faces = self.contact.faces
-        # guess: wedge tension T = F2 tan(g2) / theta2*, per-pin axial forces T L / (2 r tan g), Hertz penetration
-        tg = np.array([faces[k].tan_gamma(pl.r[k]) for k in range(2)])
-        theta2 = np.pi / 2 - pl.phi
-        T = F2 * tg[1] / theta2
-        Nk = T * fam.geom.L.mean() / (2 * pl.r * tg)
-        dk = (Nk / self.contact.c) ** (2 / 3)
-        u3 = np.full(fam.n, l / 2)
-        for k in range(2):
-            u3[pl.piece == k] -= Nk[k] / (2 * fam.geom.c_pin[pl.piece == k])
+        n2 = self.n2
         q = np.zeros(n2)
-        parts = [pl.u, u3] + ([np.zeros((fam.n, 2))] if fam.ndof == 5 else [])
-        q[:nc] = fam.join(*parts)
-        u3k = l / 2 - Nk / (2 * fam.geom.c_pin.mean())
-        q[iz] = [u3k[k] - faces[k].lever(pl.r[k]) - dk[k] + self._extra_approach(k, pl.r[k]) for k in range(2)]
+        q[:nc] = self._placed(pl, u3)
+        q[iz] = z
         vel = np.zeros(n2)
         a = np.zeros(nc)
-        au = fam.split(a)[0]
+        au = self.pin_positions(a)
         for k in range(2):
             sel = pl.piece == k
             au[sel] = -speed ** 2 / pl.r[k] * (pl.u[sel] - self.contact.centres[k]) / pl.r[k]
@@ -472,40 +553,34 @@ class ChainCVT(ModelBase):
         def jacobian(y):
             qq = q.copy()
             qq[free] = y
-            Kc = fam.jacobian(qq[:nc], vel[:nc], wrt=(0,))[0]
-            pins, shafts, X, _ = self._contacts(qq, vel)
-            Jl = self.contact.local_jacobian(X, shafts)
-            cin = self._contact_columns(pins, shafts)
-            rws = self._contact_rows(pins, shafts)
-            r, c = np.repeat(rws[:, :, None], cin.shape[1], 2), np.repeat(cin[:, None, :], rws.shape[1], 1)
-            pos = c < n2                                       # the position inputs
-            Kc = Kc.tocoo()
-            K = sp.csr_matrix((Kc.data, (Kc.row, Kc.col)), shape=(n2, n2)) + sp.csr_matrix(
-                (Jl[:, :-1, :][pos], (r[pos], c[pos])), shape=(n2, n2))
+            Kc = fam.jacobian(qq[:nc], vel[:nc], wrt=(0,))[0].tocoo()
+            _, shafts, cols, coef, X, _ = self._contact_set(qq, vel)
+            r, c, d = self._contact_entries(cols, coef, self.contact.local_jacobian(X, shafts),
+                                            n_in=(cols.shape[1] - 1) // 2)            # the position inputs
+            rows, cols = np.concatenate([Kc.row, r]), np.concatenate([Kc.col, c])
+            K = sp.csr_matrix((np.concatenate([Kc.data, d]), (rows, cols)), shape=(n2, n2))
             return (K[free][:, free] / F2).toarray()
         sol = least_squares(residual, q[free], jac=jacobian, method="lm", xtol=tol, ftol=tol, gtol=tol,
                             x_scale=1e-5, max_nfev=200)
         q[free] = sol.x
         Q = forces(sol.x)
         pins, shafts, _, (_, c) = self._contacts(q, vel, details=True)
-        F1 = float(Q[iz[0]] / 2)                               # reaction that holds z_1 (Q excludes F1)
+        F1 = float(Q[iz[0]] / self.sheaves_per_z)                             # reaction that holds z_1 (Q excludes F1)
         res = float(np.abs(Q[free]).max() / F2)
         if not res <= 1e-6:
             raise NumericalError(f"the quasi-static solve at ratio {ratio} ended with a residual of {res:.3g} of the "
                                  f"clamping force after {sol.nfev} evaluations ({sol.message})",
                                  component="ChainCVT.static_state")
-        out = fam.outputs(q[:nc], np.zeros(nc))
         v = np.zeros(n2)
-        vu = fam.split(v[:nc])[0]
-        vu[:] = speed * pl.tangent
+        self.pin_positions(v[:nc])[:] = speed * pl.tangent
         v[iphi] = speed / pl.r
-        u = fam.split(q[:nc])[0]
+        pins = self.pin_of(pins)
         for k in (0, 1):                                        # pins in contact turn with their sheave
-            on = pins[(shafts == k) & (c["delta"] > 0)]
-            vu[on] = v[iphi[k]] * (u[on] - self.contact.centres[k]) @ np.array([[0.0, 1.0], [-1.0, 0.0]])
+            on = np.unique(pins[(shafts == k) & (c["delta"] > 0)])
+            self._turn_with_sheave(q[:nc], v[:nc], on, v[iphi[k]], self.contact.centres[k])
         x0 = np.concatenate([q, v, self.control.initial_state(*v[iphi]), np.zeros(4)])
         report = {"residual": res, "max_penetration": float(c["delta"].max()), "F1": F1, "F2": F2,
-                  "tension": float(out[f"{fam.name}.link_tension_elastic"].mean()), "placement": pl,
+                  "tension": float(self._elastic_link_tension(q[:nc]).mean()), "placement": pl,
                   "nfev": sol.nfev, "status": sol.status}
         return x0, report
 
@@ -543,23 +618,38 @@ class ChainCVT(ModelBase):
         constant (digest §4.3) for a pin end crowned with ``face_radius`` at the contact radius
         ``r_hertz`` (default: the mean radius of ratio 1, ``(l - 2 L) / (2 pi)``).
         """
-        if model not in FAMILIES:
-            raise InputError("cvt.model", model, "must be one of " + ", ".join(FAMILIES))
-        family = FAMILIES[model](geom, damping_from_ratio(geom, damping_ratio, b_joint))
+        family = cls._family_for(model, geom, damping_from_ratio(geom, damping_ratio, b_joint), E)
         face = Sheave(face.profile, face.gamma, face.R, face.y, geom.l / 2)
         r_h = (geom.length - 2 * centre_distance) / (2 * np.pi) if r_hertz is None else r_hertz
         c = hertz_constant(face, r_h, face_radius, E, poisson)
         centres = np.array([[centre_distance, 0.0], [0.0, 0.0]])
-        if contact == "hertz-refined":
+        if contact == "hertz-refined" and cls is ChainCVT:
             from cvtfem.machines.chain_cvt_refined import RefinedChainCVT, refined_contact
             cls, pair = RefinedChainCVT, refined_contact(family, centres, face, c, r_outer, f0, v0, law, face_radius)
         elif contact == "hertz":
-            pair = SheaveContact(centres, (face, face), np.array([c, c]), r_outer, f0, v0, law)
+            pair = cls._contact_for(SheaveContact(centres, (face, face), np.array([c, c]), r_outer, f0, v0, law))
         else:
-            raise InputError("cvt.effects.contact", contact, "must be 'hertz' or 'hertz-refined' for a running chain")
+            raise InputError("cvt.effects.contact", contact, "must be 'hertz' (or 'hertz-refined' for chain-S2 and "
+                             "chain-S3) for a running chain")
         loop = OpenLoop() if control is None else Stabilisation(control)
-        return cls(family, pair, np.asarray(J, float), np.asarray(m_sheave, float), regime,
-                   np.asarray(F_appl, float), loop)
+        m_z = np.asarray(m_sheave, float) * cls.sheaves_per_z / 2      # mass moved by one z coordinate
+        return cls(family, pair, np.asarray(J, float), m_z, regime, np.asarray(F_appl, float), loop)._settled()
+
+    @classmethod
+    def _family_for(cls, model: str, geom, damping, E: float):
+        """The chain family of ``model`` (InputError naming ``cvt.model`` for another)."""
+        if model not in FAMILIES:
+            raise InputError("cvt.model", model, "must be one of " + ", ".join(FAMILIES))
+        return FAMILIES[model](geom, damping)
+
+    @classmethod
+    def _contact_for(cls, contact: SheaveContact):
+        """The contact kernel of this model's pin ends (the mirrored pair: as is)."""
+        return contact
+
+    def _settled(self) -> "ChainCVT":
+        """The model with the parameters that depend on the built model (none here)."""
+        return self
 
 
 def from_scene(scene, geom, F_appl, model: str = "chain-S2", **overrides) -> ChainCVT:
@@ -583,7 +673,10 @@ def from_scene(scene, geom, F_appl, model: str = "chain-S2", **overrides) -> Cha
               F_appl=F_appl, control=loop if cvt.effects.stabilisation else None,
               damping_ratio=cvt.chain.damping_ratio, E=cvt.young_modulus)
     kw.update(overrides)
-    return ChainCVT.from_parameters(geom, **kw)
+    if kw["model"] in FAMILIES:
+        return ChainCVT.from_parameters(geom, **kw)
+    from cvtfem.machines.chain_a_cvt import ChainACVT   # the whole-pin chains build on this module
+    return ChainACVT.from_parameters(geom, **kw)
 
 
 def band_span_tensions(band, x) -> np.ndarray:

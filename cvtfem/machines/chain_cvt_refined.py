@@ -24,11 +24,6 @@ def refined_contact(family, centres, face, c, r_outer, f0, v0, law, face_radius)
 class RefinedChainCVT(ChainCVT):
     """ChainCVT with H2 contact (``contact`` a :class:`RefinedSheaveContact`)."""
 
-    def _gather(self, pins, shafts, q, v):
-        nc, iphi, iz, _ = self._idx
-        return self.contact.gather(pins, shafts, self.family.split(q[:nc]), self.family.split(v[:nc]),
-                                   q[iz], v[iz], v[iphi])
-
     def _static(self, ratio, w1, F2, tol):
         """ChainCVT's quasi-static start, with the slopes of the S3 pins in contact turning with their sheave
         (``u'' = phi_k' k x u'``): the material at the offset contact point then does not slip."""

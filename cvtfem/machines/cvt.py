@@ -102,7 +102,7 @@ def _components(scene: Scene, body: Layout) -> tuple[Layout, ...]:
 def layout(scene: Scene) -> tuple[Layout, ...]:
     """Components of the CVT model the scene calls for, in DOF order (a running chain: from its model)."""
     cvt = scene.cvt
-    if cvt.model in RUNNING_CHAINS:
+    if cvt.model in RUNNING_CHAINS and chain_refusal(scene) is None:
         return _running_chain_layout(scene)
     body = _band(cvt.model, cvt.ritz_order, cvt.quadrature_nodes) if cvt.model.startswith("band") else _chain(scene)
     return _components(scene, body)
@@ -157,7 +157,7 @@ def chain_geometry(scene: Scene):
 
 
 #: Discrete-chain models that run as a transmission (the others exist as element families only).
-RUNNING_CHAINS = ("chain-S2", "chain-S3")
+RUNNING_CHAINS = ("chain-S2", "chain-S3", "chain-A1")
 
 
 def band_model(scene: Scene, **overrides: Any):
@@ -227,6 +227,33 @@ def closed_loop(scene: Scene, **overrides: Any):
     return BandCVT(model, clamping, regime, control, parts)
 
 
+def chain_refusal(scene: Scene) -> InputError | None:
+    """Why :func:`chain_loop` cannot build the scene's chain as a running transmission yet (the error naming the
+    key), or None when it can."""
+    cvt = scene.cvt
+    model, eff = cvt.model, cvt.effects
+    if model not in RUNNING_CHAINS:
+        return InputError("cvt.model", model, "must be a discrete chain that runs in time: " + ", ".join(RUNNING_CHAINS)
+                          + " (the other chain models exist as element families only so far, docs/chain.md)")
+    if model != "chain-S2" and not eff.pin_bending:
+        return InputError("cvt.effects.pin_bending", False, f"must be true for `{model}` (its pins bend); "
+                          "without pin bending use `chain-S2`")
+    if eff.shaft_elasticity:
+        return InputError("cvt.effects.shaft_elasticity", True, f"is not available for `{model}` yet: the chain "
+                          "runs on rigid shafts (set it false)")
+    if eff.contact not in ("hertz", "hertz-refined"):
+        return InputError("cvt.effects.contact", eff.contact, f"must be 'hertz' or 'hertz-refined' for `{model}`: Hertz "
+                          "contact at the pin-axis end or refined (the rigid and impact contacts are not coupled to a "
+                          "running chain yet)")
+    if eff.contact == "hertz-refined" and model not in ("chain-S2", "chain-S3"):
+        return InputError("cvt.effects.contact", eff.contact, f"must be 'hertz' for `{model}`: the refined contact "
+                          "runs with the symmetric chains chain-S2 and chain-S3 only so far")
+    if not eff.friction:
+        return InputError("cvt.effects.friction", False, "must be true for a chain transmission: the chain "
+                          "transmits torque only by pin-sheave friction")
+    return None
+
+
 def chain_loop(scene: Scene):
     """Scene -> :class:`~cvtfem.machines.chain_cvt.ChainCVT`: the chain of :func:`chain_geometry` on two rigid
     shafts with Hertz contact at the pin-axis ends (H1) or refined (H2, ``effects.contact = "hertz-refined"``),
@@ -234,30 +261,19 @@ def chain_loop(scene: Scene):
 
     The prescribed clamping forces are those the band models get (:class:`~cvtfem.control.clamping.Clamping`
     at the regime's start: torque, ratio, safety factor, split); the ratio loop corrects ``F1`` from there.
-    Only what runs is accepted: ``chain-S2`` (no pin bending) and ``chain-S3`` (pin bending), rigid shafts,
-    ``effects.contact = "hertz"`` or ``"hertz-refined"``, friction on.
+    Only what runs is accepted: ``chain-S2`` (no pin bending), ``chain-S3`` and the whole-pin chain ``chain-A1``
+    (pin bending; :mod:`~cvtfem.machines.chain_a_cvt`, a fixed and a movable sheave per shaft), rigid shafts,
+    ``effects.contact = "hertz"`` (all three) or ``"hertz-refined"`` (S2, S3), friction on.  (A3/A4 build through
+    the same interface, but their quasi-static start does not converge yet: docs/chain.md.)
     """
     from cvtfem.control.clamping import Clamping
     from cvtfem.machines.chain_cvt import from_scene
 
+    refusal = chain_refusal(scene)
+    if refusal is not None:
+        raise refusal
     cvt = scene.cvt
     model, eff, rg = cvt.model, cvt.effects, cvt.regime
-    if model not in RUNNING_CHAINS:
-        raise InputError("cvt.model", model, "must be a discrete chain that runs in time: " + ", ".join(RUNNING_CHAINS)
-                         + " (the other chain models exist as element families only so far, docs/chain.md)")
-    if model == "chain-S3" and not eff.pin_bending:
-        raise InputError("cvt.effects.pin_bending", False, "must be true for `chain-S3` (S2 plus pin bending); "
-                         "without pin bending use `chain-S2`")
-    if eff.shaft_elasticity:
-        raise InputError("cvt.effects.shaft_elasticity", True, f"is not available for `{model}` yet: the chain "
-                         "runs on rigid shafts (set it false)")
-    if eff.contact not in ("hertz", "hertz-refined"):
-        raise InputError("cvt.effects.contact", eff.contact, f"must be 'hertz' or 'hertz-refined' for `{model}`: Hertz "
-                         "contact at the pin-axis end or refined (the rigid and impact contacts are not coupled to a "
-                         "running chain yet)")
-    if not eff.friction:
-        raise InputError("cvt.effects.friction", False, "must be true for a chain transmission: the chain "
-                         "transmits torque only by pin-sheave friction")
     check_ratio_range(scene)
     clamping = Clamping(band_params(scene), rg.clamping_safety, rg.clamping_split, rg.min_clamping_force)
     F_appl = clamping.forces(rg.torque, rg.ratio)
@@ -269,6 +285,7 @@ def _running_chain_layout(scene: Scene) -> tuple[Layout, ...]:
     """Components of :func:`chain_loop`'s model with the outputs it writes, grouped by name prefix."""
     model = chain_loop(scene)
     n, per_pin = model.family.n, CHAIN_COORDS_PER_PIN[scene.cvt.model]
+    sheave = "sheave pair" if model.sheaves_per_z == 2 else "movable sheave"
 
     def outputs(*prefixes: str) -> tuple[OutputSpec, ...]:
         return tuple(o for o in model.output_specs if o.name.startswith(prefixes))
@@ -276,8 +293,8 @@ def _running_chain_layout(scene: Scene) -> tuple[Layout, ...]:
     parts = [Layout("chain", scene.cvt.model, n * per_pin, outputs=outputs("chain.", "contact."),
                     note=f"{n} pins x {per_pin}; Hertz contact at both pin ends with each shaft's sheaves "
                          "(continuous: no discrete state)"),
-             Layout("driving pulley", "rigid-shaft", 2, outputs=outputs("driving."), note="spin angle, sheave axial"),
-             Layout("driven pulley", "rigid-shaft", 2, outputs=outputs("driven."), note="spin angle, sheave axial")]
+             Layout("driving pulley", "rigid-shaft", 2, outputs=outputs("driving."), note=f"spin angle, {sheave} axial"),
+             Layout("driven pulley", "rigid-shaft", 2, outputs=outputs("driven."), note=f"spin angle, {sheave} axial")]
     if scene.cvt.effects.stabilisation:
         parts.append(Layout("stabilisation", "speed-ratio-control", 0, n1=Stabilisation.size,
                             outputs=outputs("control."), note="smoothed speeds, F1 integral, b2 integral"))

@@ -8,7 +8,8 @@ Run:  .venv/bin/python studies/chain/chain_cvt_stationary.py [--t-end 0.01] [--w
    F_appl = the band's (F1, F2) starts from its quasi-static state at the ratio and runs ``t_end`` (Radau,
    rtol 1e-3, atol 1e-6); means over the last ``window`` of the span tensions and of the sheave axial
    forces against the clamping forces are printed, with the wall time per simulated ms and the cost
-   of one RHS and one Jacobian (median of 1000 / 20 calls), machine named.  ``--png``: the span tensions,
+   of one RHS and one Jacobian (median of 1000 / 20 calls), machine named; for the whole-pin chains (``--model
+   chain-A1``) also the link twist and shear and the fixed sheaves' axial forces.  ``--png``: the span tensions,
    axial force balance and ratio over the whole run (outputs every 25 us).
 """
 from __future__ import annotations
@@ -111,6 +112,12 @@ def main() -> None:
     bal = A.mean(axis=0) / Fc.mean(axis=0) - 1
     print(f"sheave axial force / clamping force - 1: driving {bal[0]:+.2%}, driven {bal[1]:+.2%}; "
           f"ratio {np.mean([o['ratio'] for o in outs]):.4f}, efficiency {np.mean([o['efficiency'] for o in outs]):.4f}")
+    if "chain.twist" in outs[0]:                     # the whole-pin chains: twist, shear, fixed sheaves
+        tw = np.array([np.abs(o["chain.twist"]).max() for o in outs])
+        sh = np.array([np.abs(o["chain.shear"]).max() for o in outs])
+        fx = np.mean([o["contact.fixed_sheave_axial_force"] for o in outs], axis=0)
+        print(f"largest link twist {tw.mean():.2e} rad (mean over the window of the per-sample maximum), shear "
+              f"{sh.mean():.2e}; fixed sheaves' axial force / clamping force - 1: {fx / Fc.mean(axis=0) - 1}")
     x = res.y[:, -1]
     t_rhs = median_s(lambda: m.rhs(0.0, x), 1000)
     t_jac = median_s(lambda: m.jac(0.0, x), 20)

@@ -100,10 +100,6 @@ class SheaveContact:
         pins, shafts = np.nonzero(near)
         return pins, shafts
 
-    def gather(self, pins, shafts, u, u3, ud, u3d, z, zd, w):
-        """Local inputs ``X`` (m, 9) of the contacts from the chain and shaft states (see :data:`N_IN`)."""
-        return np.column_stack([u[pins], u3[pins], z[shafts], ud[pins], u3d[pins], zd[shafts], w[shafts]])
-
     def local(self, X, shafts, details: bool = False, reference: bool = False):
         """Local outputs ``Y`` (m, 6) of contacts with inputs ``X`` on shafts ``shafts``: ``2F`` on the pin end
         (N), the generalized forces on ``z`` (N) and ``phi`` (N m) of the shaft, and the friction power
@@ -163,14 +159,6 @@ class SheaveContact:
     def local_jacobian(self, X, shafts):
         """``dY/dX`` (m, 6, 9) by central differences (:func:`central_local_jacobian`)."""
         return central_local_jacobian(self.local, X, shafts, np.array([1e-9] * 4 + [1e-6] * 4 + [1e-5]), N_OUT)
-
-    def scatter(self, Y, pins, shafts, n):
-        """Sum local outputs: generalized forces on the pin ends (n, 3), on ``z`` (2), on ``phi`` (2), and
-        the friction power (W)."""
-        Qp = np.zeros((n, 3))
-        for j in range(3):
-            Qp[:, j] = np.bincount(pins, Y[:, j], n)
-        return Qp, np.bincount(shafts, Y[:, 3], 2), np.bincount(shafts, Y[:, 4], 2), float(Y[:, 5].sum())
 
 
 def central_local_jacobian(local, X, shafts, scale, n_out: int):

@@ -149,17 +149,6 @@ class RefinedSheaveContact:
         d = u[:, None, :] - self.centres[None, :, :]
         return np.nonzero((d[..., 0] ** 2 + d[..., 1] ** 2) < self.r_outer ** 2)
 
-    def gather(self, pins, shafts, q_parts, v_parts, z, zd, w):
-        """Local inputs ``X`` (m, n_in) from the chain's ``split`` parts ``(u, u3, up)`` of coordinates and
-        velocities and the shaft states ``z``, ``z'``, ``phi'`` (2,)."""
-        def pos(parts, zz):
-            u, u3, up = parts
-            cols = [u[self.im1[pins]], u[pins], u[self.ip1[pins]], u3[pins][:, None]]
-            if self.slopes:
-                cols.append(up[pins])
-            return cols + [zz[shafts][:, None]]
-        return np.column_stack(pos(q_parts, z) + pos(v_parts, zd) + [w[shafts]])
-
     # ----- local evaluation ------------------------------------------------------------------------
     def _unpack(self, X):
         n = self.n_pos

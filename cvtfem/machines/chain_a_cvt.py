@@ -1,0 +1,254 @@
+"""The whole-pin asymmetric chains (A1; A3/A4) on two rigid shafts: :class:`ChainACVT`, the transmission of
+:class:`~cvtfem.machines.chain_cvt.ChainCVT` with no symmetry plane.
+
+Each pulley has a fixed sheave on one side of the chain and a movable sheave on the other (model 1 of
+the shafts digest without its mirror plane, as the elastic models place them, digest §7): the movable
+sheave's position ``z_k`` (counted outwards from the chain, m) is the coordinate ``shaft.z``, its mass half
+the pair's, its virtual work ``-F_k dz_k`` with ``F_k`` the clamping force; the fixed sheave stays where
+the wedge estimate puts it at the regime's ratio (aligned pulleys: the chain runs centred at ``x3 = 0``).
+The default places the driving pulley's movable sheave at ``x3 > 0`` and the driven one's at ``x3 < 0``,
+as in chain CVTs.  Every pin end touches the sheave on its side of each shaft (H1,
+:class:`~cvtfem.elements.chain.end_contact.EndContact`); the ends are linear in the pin coordinates
+(``u_0 -+ u_1``, ``w_0 -+ w_1``, chain-models-2 §2.1), which is the contact map of ChainCVT with two
+columns per input.  The chain family is wrapped in :class:`WholePinFamily`, the interface ChainCVT drives.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+from functools import cached_property
+from typing import ClassVar
+
+import numpy as np
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+from cvtfem.elements.chain.asymmetric import ChainA1
+from cvtfem.elements.chain.end_contact import EndContact
+from cvtfem.elements.chain.per_plate import ChainPerPlate
+from cvtfem.errors import InputError
+from cvtfem.machines.chain import FreeChainA
+from cvtfem.machines.chain_cvt import ChainCVT
+from cvtfem.outputs import OutputSpec
+
+#: Plate thickness along the pin (m): assumed, the per-plate models' default.
+PLATE_THICKNESS = 1.5e-3
+#: Plate height across the chain in its plane (m): assumed, a 9 mm pitch chain's plate.
+PLATE_HEIGHT = 8e-3
+#: Poisson's ratio of the steel plates (torsion stiffness ``G = E / (2 (1 + nu))``).
+POISSON = 0.3
+#: The whole-pin models that run on the sheaves.
+A_MODELS = {"chain-A1": None, "chain-A3": "A3", "chain-A4": "A4"}
+
+
+def whole_pin_family(model: str, geom, damping, E: float, plate_height: float = PLATE_HEIGHT,
+                     plate_thickness: float = PLATE_THICKNESS, use_numba: bool = True):
+    """A1 (or A3/A4) of a :class:`~cvtfem.elements.chain.geometry.ChainGeometry` with ``damping``
+    (:class:`~cvtfem.elements.chain.symmetric.ChainDamping`): plates ``plate_height`` x ``plate_thickness``
+    (m) of Young's modulus ``E`` (Pa) give the out-of-plane bending stiffness ``a = E b h^3 / 12`` (N m^2)
+    and the torsion stiffness ``G b h^3 / (3 L)`` (N m/rad, chain-models-2 §2.4 [non-source]); the link
+    damping time serves extension, twist and shear (rule (1.86) with one time), pins as the S models."""
+    if model not in A_MODELS:
+        raise InputError("cvt.model", model, "must be one of " + ", ".join(A_MODELS))
+    b, h = plate_height, plate_thickness
+    G = E / (2 * (1 + POISSON))
+    args = dict(pitch=geom.L, plate_xi=geom.xi, n_plates=geom.plate_mask.sum(axis=1),
+                plate_stiffness=geom.c_plate, plate_bending_stiffness=E * b * h ** 3 / 12,
+                plate_torsion_stiffness=(G * b * h ** 3 / 3) / geom.L[:, None], pin_length=geom.l,
+                pin_mass=geom.m_eff, pin_axial_stiffness=geom.c_pin, pin_bending_tau=geom.A_tau,
+                pin_bending_n=geom.A_n, beta_link_ext=damping.beta_link, beta_link_tors=damping.beta_link,
+                beta_link_shear=damping.beta_link, beta_bend=damping.beta_bend,
+                pin_axial_damping=damping.beta_pin * geom.c_pin, joint_damping=damping.b_joint,
+                closed=geom.closed, use_numba=use_numba)
+    if A_MODELS[model] is None:
+        return WholePinFamily(ChainA1(**args), geom)
+    return WholePinFamily(ChainPerPlate(model=A_MODELS[model], plate_thickness=h, **args), geom)
+
+
+class WholePinFamily:
+    """An A-family chain (``ChainA1`` or ``ChainPerPlate``) with the interface of the symmetric families that
+    :class:`~cvtfem.machines.chain_cvt.ChainCVT` drives (``forces``, ``solve_mass``, ``jacobian``, ...).
+
+    The Jacobian blocks are those of :class:`~cvtfem.machines.chain.FreeChainA` (exact elastic and damping
+    matrices plus coloured differences of the damping forces in ``q``)."""
+
+    name = "chain"
+
+    def __init__(self, chain, geom):
+        self.chain, self.geom = chain, geom
+        self._a1 = getattr(chain, "base", chain)        # the ChainA1 layout of A3/A4
+        self.n, self.size = chain.n_pins, chain.n2
+        self.dof_index = chain.dof_index
+        self.ip1 = (np.arange(self.n) + 1) % self.n
+        self.on = geom.link_on
+        self._free = FreeChainA(chain, np.zeros(chain.n2))
+        self._last: tuple = (None, None, None)       # the blocks of the last state asked for
+
+    @property
+    def blocks(self):
+        return self.chain.blocks
+
+    @property
+    def output_specs(self) -> tuple[OutputSpec, ...]:
+        return tuple(self.chain.output_specs)
+
+    @property
+    def jac_sparsity(self) -> sp.csr_matrix:
+        return self.chain.jac_sparsity
+
+    def split(self, q):
+        """``(u (4, n, 2), w (2, n))`` views (chain-models-2 §2.1)."""
+        return self._a1.split(q)
+
+    def join(self, u, w):
+        """Inverse of :meth:`split`."""
+        return self._a1.join(u, w)
+
+    def forces(self, q, v):
+        return self.chain.forces(q, v)
+
+    def dissipative_forces(self, q, v):
+        return self.chain.dissipative_forces(q, v)
+
+    def rayleigh(self, q, v) -> float:
+        return float(self.chain.rayleigh(q, v))
+
+    def energy(self, q, v) -> float:
+        """Kinetic plus elastic energy of the chain, J."""
+        return float(self.chain.kinetic_energy(v) + self.chain.potential_energy(q))
+
+    def mass_matrix(self) -> sp.csr_matrix:
+        return self.chain.mass_matrix
+
+    @cached_property
+    def _inv_mass(self) -> sp.csr_matrix:
+        return sp.csr_matrix(spla.inv(sp.csc_matrix(self.chain.mass_matrix)))
+
+    def solve_mass(self, Q):
+        """``M^-1 Q`` (per-pin blocks)."""
+        return self._inv_mass @ Q
+
+    def jacobian(self, q, v, part: str = "all", wrt: tuple = (0, 1)):
+        """``(dQ/dq, dQ/dq')`` (CSR) of all forces, or with ``part="dissipative"`` of the damping forces alone
+        (their ``dQ/dq`` is the total's less the one at ``q' = 0``, where the damping forces vanish)."""
+        x = np.concatenate([q, v])
+        key = x.tobytes()
+        if self._last[0] != key:                      # ChainCVT.jac asks for both parts at one state
+            lin = self._free.linearize(x)
+            self._last = (key, -lin.K, -lin.C)
+        dq, dv = self._last[1:]
+        if part == "dissipative":
+            dq = dq + self._free.linearize(np.concatenate([q, np.zeros_like(v)])).K
+        return tuple(sp.csr_matrix(dq if k == 0 else dv) for k in wrt)
+
+    def outputs(self, q, v):
+        return self.chain.outputs(q, v)
+
+
+_ROT = np.array([[0.0, 1.0], [-1.0, 0.0]])      # a @ _ROT = k x a
+
+
+@dataclass(frozen=True, eq=False)
+class ChainACVT(ChainCVT):
+    """A whole-pin chain (A1, A3, A4) on two rigid shafts, each with a fixed and a movable sheave.
+
+    Attributes (besides ChainCVT's; ``m_sheave`` is the movable sheave's mass, ``z`` its position)
+    ----------
+    movable_side : (2,) +-1
+        Side (sign of ``x3``) of the movable sheave of each shaft (driving, driven).
+    fixed_z : (2,) m
+        Position of each fixed sheave, counted outwards from ``x3 = 0`` as ``z`` (set by ``from_parameters``
+        from the wedge estimate at the regime's ratio).
+    """
+
+    movable_side: tuple = (1, -1)
+    fixed_z: tuple = (0.0, 0.0)
+
+    sheaves_per_z: ClassVar[float] = 1.0
+
+    def __post_init__(self):
+        if not set(self.movable_side) <= {1, -1} or len(self.movable_side) != 2:
+            raise InputError("movable_side", self.movable_side, "must be two signs (+1 or -1), driving then driven")
+
+    @cached_property
+    def output_specs(self) -> tuple[OutputSpec, ...]:
+        return super().output_specs + (
+            OutputSpec("contact.fixed_sheave_axial_force", "N",
+                       "Sum of the pin axial contact forces on the fixed sheave of each shaft.", 2),)
+
+    # ----- contact ends: far (x3 < 0) and near (x3 > 0) end of each pin, end e = 2 p + (near) -------------
+    @property
+    def n_ends(self) -> int:
+        return 2 * self.family.n
+
+    def pin_of(self, ends):
+        return ends // 2
+
+    def pin_positions(self, q_chain):
+        return self.family.split(q_chain)[0][0]
+
+    def _candidates(self, q):
+        u = self.family.split(q[:self._idx[0]])[0]
+        ends = np.stack([u[0] - u[1], u[0] + u[1]], axis=1).reshape(-1, 2)
+        return self.contact.candidates(ends)
+
+    @property
+    def _constants(self) -> np.ndarray:
+        return np.array([*self.fixed_z, 0.0])
+
+    def _contact_map(self, ends, shafts):
+        """Inputs in the mirrored frame of each end: ``x_perp = u_0 + s u_1``, ``x3 = s w_0 + w_1`` with ``s``
+        the end's side; the sheave on that side is the movable one (``z_k``) or the fixed one (a constant)."""
+        _, iphi, iz, _ = self._idx
+        n2, m = self.n2, len(ends)
+        d = self.family.dof_index[ends // 2]
+        side = np.where(ends % 2 == 1, 1.0, -1.0)
+        one = np.ones(m)
+        movable = np.asarray(self.movable_side)[shafts] == side
+        zc = np.where(movable, iz[shafts], 2 * n2 + shafts)             # z_k or the fixed sheave's constant
+        zv = np.where(movable, n2 + iz[shafts], 2 * n2 + 2)             # its rate (0 for the fixed one)
+        pos = [(d[:, 0], d[:, 2], one, side), (d[:, 1], d[:, 3], one, side), (d[:, 8], d[:, 9], side, one)]
+        cols = np.empty((m, 9, 2), np.int64)
+        coef = np.zeros((m, 9, 2))
+        for j, (a, b, ca, cb) in enumerate(pos):
+            cols[:, j] = np.column_stack([a, b])
+            cols[:, 4 + j] = n2 + cols[:, j]
+            coef[:, j] = coef[:, 4 + j] = np.column_stack([ca, cb])
+        for j, c in ((3, zc), (7, zv), (8, n2 + iphi[shafts])):
+            cols[:, j] = c[:, None]
+            coef[:, j, 0] = 1.0
+        return cols, coef
+
+    def _sheave_outputs(self, ends, shafts, c) -> dict[str, np.ndarray]:
+        movable = np.asarray(self.movable_side)[shafts] == np.where(ends % 2 == 1, 1, -1)
+        F3 = c["F"][:, 2]
+        return {"contact.sheave_axial_force": -np.bincount(shafts[movable], F3[movable], 2),
+                "contact.fixed_sheave_axial_force": -np.bincount(shafts[~movable], F3[~movable], 2)}
+
+    # ----- quasi-static start ----------------------------------------------------------------------
+    def _elastic_link_tension(self, q_chain):
+        return self.family.outputs(q_chain, None)["chain.link_tension"]
+
+    def _placed(self, pl, u3):
+        u = np.zeros((4, self.family.n, 2))
+        u[0] = pl.u
+        return self.family.join(u, np.stack([np.zeros(self.family.n), u3]))
+
+    def _turn_with_sheave(self, q_chain, v_chain, pins, w, centre):
+        """The pins' in-plane vectors (position about ``centre``, tilt, slopes) turn at ``w`` (rad/s)."""
+        u, vu = self.family.split(q_chain)[0], self.family.split(v_chain)[0]
+        vu[0, pins] = w * (u[0, pins] - centre) @ _ROT
+        vu[1:, pins] = w * u[1:, pins] @ _ROT
+
+    # ----- construction ----------------------------------------------------------------------------
+    @classmethod
+    def _family_for(cls, model: str, geom, damping, E: float):
+        return whole_pin_family(model, geom, damping, E)
+
+    @classmethod
+    def _contact_for(cls, contact):
+        return EndContact(contact)
+
+    def _settled(self) -> "ChainACVT":
+        """The fixed sheaves where the wedge estimate at the regime's start ratio and ``F_appl[1]`` puts them."""
+        _, _, z = self.wedge_guess(self.regime.targets(0.0)[2], float(self.F_appl[1]))
+        return replace(self, fixed_z=tuple(float(zk) for zk in z))
