@@ -2,6 +2,7 @@
 error of the pin force against wall time and RHS calls."""
 from __future__ import annotations
 
+import textwrap
 from pathlib import Path
 
 import matplotlib
@@ -57,7 +58,7 @@ def plot_accuracy_cost(rows, path: str | Path, accept: float, title: str = "") -
     finite = [r for r in rows if np.isfinite(r["error"]) and r["error"] > 0]
     for (ax, key, xlabel) in ((axes[0], "time", "wall time, s (median)"), (axes[1], "nfev", "RHS calls")):
         for label in dict.fromkeys(r["label"] for r in finite):
-            pts = sorted((r for r in finite if r["label"] == label), key=lambda r: r[key])
+            pts = [r for r in finite if r["label"] == label]        # in the order of the settings
             line, = ax.loglog([r[key] for r in pts], [r["error"] for r in pts], "o-", ms=4, label=label)
             for r in pts:
                 ax.annotate(r["setting"], (r[key], r["error"]), fontsize=6, color=line.get_color(),
@@ -68,8 +69,8 @@ def plot_accuracy_cost(rows, path: str | Path, accept: float, title: str = "") -
     axes[0].set_ylabel("E = max|P - P*| / max|P*| over the window")
     axes[1].legend(fontsize=7, loc="lower left")
     failed = sorted({f"{r['label']} {r['setting']}" for r in rows if not np.isfinite(r["error"])})
-    note = f"; failed or unstable: {', '.join(failed)}" if failed else ""
-    fig.suptitle((title or "accuracy against cost") + note, fontsize=9)
+    note = f"\nfailed or unstable: {', '.join(failed)}" if failed else ""
+    fig.suptitle(textwrap.fill(title or "accuracy against cost", 150) + note, fontsize=9)
     fig.tight_layout()
     fig.savefig(path, dpi=120)
     plt.close(fig)
