@@ -224,6 +224,10 @@ class ResultsWriter:
                                  "series hold fewer")
             specs = [OutputSpec(name, str(d.attrs.get("unit", "")), str(d.attrs.get("doc", "")), d.shape[1])
                      for name, d in group.items() if name != "time"]
+            texts = [n for n, _ in layout.fields] + [t for sp in specs for t in (sp.name, sp.unit, sp.doc)]
+            if not all(_is_utf8(t) for t in texts):   # h5py hands damaged bytes over as surrogates
+                raise InputError(where, str(path), "is damaged: a series or checkpoint name, unit or description "
+                                 "stored in it is not UTF-8 text")
             kept = {name: d[:rows] for name, d in group.items()}
             bad = next((name for name, a in kept.items() if not np.isfinite(a).all()), None)
             if bad is not None:   # the writer never stores one: the file is damaged
@@ -455,6 +459,15 @@ def _utf8(text: str) -> bool:
     """False for a string h5py decoded from invalid UTF-8 (it maps the bad bytes to surrogates)."""
     try:
         text.encode()
+    except UnicodeEncodeError:
+        return False
+    return True
+
+
+def _is_utf8(text: str) -> bool:
+    """True if ``text`` encodes as UTF-8 (a string read from damaged bytes carries lone surrogates)."""
+    try:
+        text.encode("utf-8")
     except UnicodeEncodeError:
         return False
     return True

@@ -117,12 +117,18 @@ def plot_work_precision(rows, path: Path, title: str = "", note: str = "") -> Pa
                             fontsize=5.5, color=f"C{i % 10}")
     a1.set_xlabel("wall time, s (median)")
     a2.set_xlabel("RHS calls (incl. Jacobians)")
+    plotted = any(np.isfinite(r["error"]) and r["error"] > 0 for r in rows)
     for ax in (a1, a2):
         ax.set_ylabel("relative error")
         ax.grid(True, which="both", lw=0.3)
-        ax.xaxis.set_major_locator(LogLocator(base=10, numticks=6))   # decades only: no overlapping labels
-        ax.xaxis.set_minor_formatter(NullFormatter())
-    a1.legend(fontsize=7)
+        if plotted:
+            ax.xaxis.set_major_locator(LogLocator(base=10, numticks=6))   # decades only: no overlapping labels
+            ax.xaxis.set_minor_formatter(NullFormatter())
+        else:
+            ax.text(0.5, 0.5, "no run reached a finite error\n(all failed or unstable: see the table)",
+                    ha="center", va="center", transform=ax.transAxes)
+    if plotted:
+        a1.legend(fontsize=7)
     fig.suptitle(title or "work-precision", fontsize=10)
     if note:
         fig.text(0.5, 0.01, note, ha="center", va="bottom", fontsize=7.5, wrap=True)

@@ -275,3 +275,25 @@ def test_study_arguments_refused_up_front(tmp_path, cli, argv, needles):
     line = _one_line_error(cli(*argv, cwd=tmp_path, timeout=60), *needles)
     assert not list(tmp_path.iterdir())   # nothing written
     assert "\x1e" not in line
+
+
+def test_resume_refuses_names_that_are_not_utf8(tmp_path, cli):
+    """A damaged byte in a stored name came back from h5py as a lone surrogate and the resume wrote it into the
+    new file: UnicodeEncodeError after the file was reopened (found by the long results-file fuzz)."""
+    from tests.hard.test_fuzz_commands import _killed_run
+
+    blob = bytearray(_killed_run())
+    at = blob.find(b"retry")                  # a checkpoint field name
+    assert at > 0
+    blob[at] = 0x80
+    path = tmp_path / "r.h5"
+    path.write_bytes(bytes(blob))
+    _one_line_error(cli("run", "--resume", str(path)), "`--resume`", "not UTF-8")
+
+
+def test_work_precision_figure_when_every_run_fails(tmp_path):
+    """Every run unstable: the figure says so instead of failing on empty log axes (found by the study fuzz)."""
+    from cvtfem.post.integrators import plot_work_precision
+
+    rows = [{"label": "rk4", "method": "rk4", "error": float("inf"), "time": 0.01, "nfev": 20, "h": 0.1}]
+    assert plot_work_precision(rows, tmp_path / "w.png").stat().st_size > 1000
