@@ -4,7 +4,8 @@ The values in ``tests/data/baseline.json`` were recorded on main at the commit t
 (``python -m tests.test_baseline`` rewrites them); the structure may change, the numbers may not.
 Run summaries are compared to 1e-9 relative (they differ between OpenBLAS kernels in the last bits),
 modal results to 1e-10, harmonic-balance peaks to 1e-8 (Newton stops at a relative step below 1e-10);
-the work-precision study (HIRES) gives the same cost counters and errors to 1e-9 (recorded with the
+the work-precision study (HIRES) gives the same cost counters and errors to 1e-9 relative or 1e-11 absolute (an
+error is a relative difference of nearly equal values: kernel-level bits of y move it absolutely; recorded with the
 code of f26a565, before the restructuring).  Stabilized methods are left out: their adaptive steps follow
 a power-iteration estimate whose last bits, and so the step counts, depend on the BLAS kernel.
 """
@@ -96,7 +97,10 @@ def test_study_unchanged(tmp_path, baseline):
     assert sorted(now) == sorted(then)
     for key, row in then.items():
         assert {k: now[key][k] for k in STUDY_COUNTS} == {k: row[k] for k in STUDY_COUNTS}, key
-        assert now[key]["error"] == pytest.approx(row["error"], rel=1e-9), key
+        # the error is |y - y_ref| / |y_ref|: a difference of nearly equal values, so the last bits of y that a
+        # BLAS kernel changes (1e-12 of y after Newton's stop in an implicit run) move it by 1e-12 absolute, i.e.
+        # by 1e-12 / error relative (sw24 at rtol 1e-4: error 9e-6, moved 2.7e-7 under Haswell)
+        assert now[key]["error"] == pytest.approx(row["error"], rel=1e-9, abs=1e-11), key
 
 
 if __name__ == "__main__":
