@@ -8,10 +8,10 @@ from cvtfem.assembly.model import Model
 from cvtfem.elements.chain.end_contact import EndContact
 from cvtfem.elements.chain.geometry import reference_geometry
 from cvtfem.errors import InputError
-from cvtfem.integrate import solve
 from cvtfem.machines.chain_a_cvt import ChainACVT
 from cvtfem.machines.chain_cvt import from_scene
 from cvtfem.scene.loader import load_scene
+from tests.machines.chain_checks import assert_energy_balance, assert_jacobian_columns
 
 RATIO = 2.4
 F_APPL = np.array([30000.0, 35000.0])   # N per sheave, as the S2 tests
@@ -132,29 +132,13 @@ def test_jacobian_against_differences_and_on_its_pattern(model, static):
     n2, nc = model.n2, model.family.size
     cols = np.concatenate([rng.choice(nc, 16, replace=False), n2 + rng.choice(nc, 16, replace=False),
                            np.arange(nc, n2), n2 + np.arange(nc, n2), np.arange(2 * n2, 2 * n2 + 4)])
-    rows = slice(n2, None)
-    scale = np.abs(J[rows]).max(axis=1)
-    for c in cols:
-        h = 1e-9 if c < n2 else 1e-6 * max(1.0, abs(x[c]))
-        xp, xm = x.copy(), x.copy()
-        xp[c] += h
-        xm[c] -= h
-        fd = (model.rhs(0.0, xp) - model.rhs(0.0, xm))[rows] / (2 * h)
-        err = np.abs(J[rows, c] - fd)
-        assert np.all(err <= 1e-5 * scale + 1e-6), (c, err.max())
+    assert_jacobian_columns(model, x, J, cols)
 
 
 def test_energy_balance_over_a_short_run(model, static):
     x0, rep = static
     m = model.with_clamping([rep["F1"], F_APPL[1]])
-    res = solve(m, (0.0, 5e-5), x0, method="Radau", rtol=1e-6, atol=1e-9, n2=m.n2, jac=m.jac,
-                jac_sparsity=m.jac_sparsity)
-    assert res.status == 0
-    x1 = res.y[:, -1]
-    W = m.split(x1)[3]
-    dE = m.energy(x1) - m.energy(x0)
-    assert W[0] > 1.0 and W[2] > 0.0
-    assert dE == pytest.approx(W[0] - W[1] + W[3] - W[2], abs=1e-6 * W[0])
+    assert_energy_balance(m, x0, 5e-5)
 
 
 def test_scene_path_builds_a1_and_describes_its_outputs_once():
