@@ -23,6 +23,8 @@ from cvtfem.scene.schema.base import validate
 PRESET_PACKAGE = "cvtfem.scene.presets"
 #: Sub-folder of the partial scenes (regimes, chain patterns) combined with a preset.
 PARTS = "parts"
+#: Presets and parts one scene may combine.
+MAX_PRESETS = 16
 
 
 @dataclass(frozen=True)
@@ -167,6 +169,8 @@ def _preset_list(value: Any) -> list[str]:
     names = [n.strip() for n in names]
     if not all(names):
         raise InputError("preset", value, "must not hold an empty name")
+    if len(names) > MAX_PRESETS:
+        raise InputError("preset", f"{len(names)} names", f"must hold at most {MAX_PRESETS} presets and parts")
     return names
 
 

@@ -73,6 +73,7 @@ def test_chain_parts_set_the_link_pattern():
     ("regime-A,chain-uniform", "are parts"),
     ("band-4dof,regime-Q", "did you mean"),
     ("band-4dof,,regime-A", "empty name"),
+    (",".join(["band-4dof"] * 17), "at most 16"),
 ])
 def test_bad_combinations_are_clear_errors(value, needle):
     with pytest.raises(InputError, match=needle):
