@@ -50,9 +50,41 @@ def parse_orders(text: str | None) -> tuple[float, ...]:
         raise InputError("--orders", text, "must be comma-separated numbers, e.g. 14,28,42") from None
 
 
+def sweep_speeds(text: str):
+    """``--speeds`` as an array of speeds (rad/s) starting at >= 0."""
+    from cvtfem.errors import InputError
+    from cvtfem.units import parse_speeds
+
+    speeds = parse_speeds(text)
+    if speeds[0] < 0:
+        raise InputError("--speeds", text, "must start at a speed >= 0")
+    return speeds
+
+
+def print_crossings(crossings, order_width: int, whirl_width: int) -> None:
+    """One line per Campbell crossing of an order line (order, mode, whirl, speed in rpm)."""
+    import math
+
+    for c in crossings:
+        rpm = c["speed_rad_s"] * 30 / math.pi
+        print(f"    {c['order']:>{order_width}} mode {c['mode']:>2} ({c['whirl']:<{whirl_width}}) at {rpm:9.5g} rpm")
+
+
+def write_data(res, scene, args, write_results) -> None:
+    """``--results`` (HDF5 by ``write_results``) and ``--json`` of a response or spectrum ``res``."""
+    import json
+
+    if args.results:
+        write_results(res, args.results, scene)
+        print(f"wrote {args.results}")
+    if args.json:
+        with open(args.json, "w") as fh:
+            json.dump({"scene": scene.source, **res.to_dict()}, fh)
+        print(f"wrote {args.json}")
+
+
 def run(args: argparse.Namespace) -> int:
     import csv
-    import json
     from pathlib import Path
 
     import numpy as np
@@ -60,11 +92,8 @@ def run(args: argparse.Namespace) -> int:
     from cvtfem.analysis.response import scene_response, write_results
     from cvtfem.errors import InputError
     from cvtfem.scene.loader import load_scene
-    from cvtfem.units import parse_speeds
 
-    speeds = parse_speeds(args.speeds)
-    if speeds[0] < 0:
-        raise InputError("--speeds", args.speeds, "must start at a speed >= 0")
+    speeds = sweep_speeds(args.speeds)
     if args.n_modes < 1:
         raise InputError("--n-modes", args.n_modes, "must be >= 1")
     unbalances = [_unbalance(u) for u in args.unbalance]
@@ -81,16 +110,8 @@ def run(args: argparse.Namespace) -> int:
             m = int(np.argmax(res.order_amplitude[:, j]))
             print(f"  order {k:g}: peak {res.order_amplitude[m, j]:.4g} m/N at {rpm[m]:.5g} rpm")
         print("  Campbell crossings of the order lines (lateral, torsional, axial):")
-        for c in res.campbell.crossings:
-            rpm_c = c["speed_rad_s"] * 30 / np.pi
-            print(f"    {c['order']:>8} mode {c['mode']:>2} ({c['whirl']:<9}) at {rpm_c:9.5g} rpm")
-    if args.results:
-        write_results(res, args.results, scene)
-        print(f"wrote {args.results}")
-    if args.json:
-        with open(args.json, "w") as fh:
-            json.dump({"scene": scene.source, **res.to_dict()}, fh)
-        print(f"wrote {args.json}")
+        print_crossings(res.campbell.crossings, 8, 9)
+    write_data(res, scene, args, write_results)
     if args.csv:
         with open(args.csv, "w", newline="") as fh:
             csv.writer(fh).writerows(res.csv_rows())

@@ -77,20 +77,16 @@ def _ripple(text: str):
 
 
 def run(args: argparse.Namespace) -> int:
-    import json
     from pathlib import Path
 
     import numpy as np
 
     from cvtfem.analysis.spectrum import read_user_lines, scene_spectrum, write_results
-    from cvtfem.commands.response import parse_orders
+    from cvtfem.commands.response import parse_orders, print_crossings, sweep_speeds, write_data
     from cvtfem.errors import InputError
     from cvtfem.scene.loader import load_scene
-    from cvtfem.units import parse_speeds
 
-    speeds = parse_speeds(args.speeds)
-    if speeds[0] < 0:
-        raise InputError("--speeds", args.speeds, "must start at a speed >= 0")
+    speeds = sweep_speeds(args.speeds)
     if not 1 <= args.n_modes <= 500:
         raise InputError("--n-modes", args.n_modes, "must be 1..500")
     if not 2 <= args.n_freqs <= 20_000:
@@ -114,20 +110,12 @@ def run(args: argparse.Namespace) -> int:
         m = int(np.argmax(res.order_amplitude[:, j]))
         print(f"  order {k:.5g}: largest response {res.order_amplitude[m, j]:.4g} per unit at {rpm[m]:.5g} rpm")
     print("  Campbell crossings of the order lines:")
-    for c in res.campbell.crossings:
-        rpm_c = c["speed_rad_s"] * 30 / np.pi
-        print(f"    {c['order']:>10} mode {c['mode']:>2} ({c['whirl']:<10}) at {rpm_c:9.5g} rpm")
+    print_crossings(res.campbell.crossings, 10, 10)
     if res.line_labels:
         i = int(np.nanargmax(np.where(np.isfinite(res.erp_a_db), res.erp_a_db, -np.inf)))
         print(f"  {len(res.line_labels)} excitation lines; sheave-face ERP up to {np.nanmax(res.erp_db[1:]):.1f} dB, "
               f"A-weighted {res.erp_a_db[i]:.1f} dB(A) re 1 pW at {rpm[i]:.5g} rpm")
-    if args.results:
-        write_results(res, args.results, scene)
-        print(f"wrote {args.results}")
-    if args.json:
-        with open(args.json, "w") as fh:
-            json.dump({"scene": scene.source, **res.to_dict()}, fh)
-        print(f"wrote {args.json}")
+    write_data(res, scene, args, write_results)
     if args.png:
         from cvtfem.post.response import plot_erp, plot_spectrum_map
 
