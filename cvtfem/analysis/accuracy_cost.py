@@ -49,14 +49,20 @@ class PinForceProblem(Problem):
     t_eval: np.ndarray = field(default_factory=lambda: np.zeros(0))
     p_ref: np.ndarray = field(default_factory=lambda: np.zeros(0))
 
-    def pin_forces(self, t, y) -> np.ndarray:
-        """Axial force of every pin (N), (samples, n_pins), at the states ``y`` (n, samples)."""
-        return np.array([self.loop.outputs(ti, yi)[PIN_FORCE] for ti, yi in zip(t, np.asarray(y).T)])
+    def pin_forces(self, y) -> np.ndarray:
+        """Axial force of every pin (N), (samples, n_pins), at the states ``y`` (n, samples): the chain family's
+        output alone (the contacts and loops of the full output set are not needed for it)."""
+        fam = self.loop.family
+        out = []
+        for yi in np.asarray(y).T:
+            q, v = self.loop.split(yi)[:2]
+            out.append(fam.outputs(q[:fam.size], v[:fam.size])[PIN_FORCE])
+        return np.array(out)
 
     def error(self, res) -> float:
         if not res.success or len(res.t) != len(self.t_eval):
             return float("inf")
-        return window_error(self.pin_forces(res.t, res.y)[:, self.pin], self.p_ref)
+        return window_error(self.pin_forces(res.y)[:, self.pin], self.p_ref)
 
 
 def pin_force_problem(scene, window: tuple[float, float] = (1e-3, 5e-3), sample: float = 1e-5,
@@ -90,7 +96,7 @@ def pin_force_problem(scene, window: tuple[float, float] = (1e-3, 5e-3), sample:
         res = solve(**base.solve_kwargs(), method=method, rtol=rtol, atol=1e-3 * rtol, t_eval=t_eval)
         if not res.success:
             raise InputError("reference", method, f"must complete the reference run: {res.message}")
-        forces[method] = base.pin_forces(res.t, res.y)
+        forces[method] = base.pin_forces(res.y)
     p_all = forces[reference[0]]
     pin = int(np.argmax(np.ptp(p_all, axis=0)))
     problem = PinForceProblem("chain", loop.rhs, x0, (0.0, t2), n2=loop.n2, jac=loop.jac,
