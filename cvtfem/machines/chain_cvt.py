@@ -111,6 +111,9 @@ class ChainCVT(ModelBase):
     def output_specs(self) -> tuple[OutputSpec, ...]:
         n = self.n_ends
         return tuple(self.family.output_specs) + (
+            OutputSpec("chain.coordinates", "m, rad",
+                       "The chain family's coordinates q (its layout, `state_label`): the pin positions for "
+                       "renderings and per-pin post-processing of a results file.", self.family.size),
             OutputSpec("contact.normal_force", "N",
                        "Hertz force N per pin end and shaft (pin-major, driving then driven).", 2 * n),
             OutputSpec("contact.penetration", "m",
@@ -404,7 +407,7 @@ class ChainCVT(ModelBase):
         w, M, F = diag["w"], diag["M"], diag["F"]
         support = np.column_stack([np.bincount(shafts, Y[:, j], 2) for j in (0, 1)])   # forces on the pin ends
         out = dict(self.family.outputs(q[:nc], v[:nc]))
-        out.update({"chain.span_tension": self.span_tensions(q, v, pins, c["delta"]),
+        out.update({"chain.coordinates": q[:nc], "chain.span_tension": self.span_tensions(q, v, pins, c["delta"]),
                     "contact.normal_force": per(c["N"]), "contact.penetration": per(c["delta"]),
                     "contact.radius": per(np.where(on, c["radius"], 0.0)),
                     "contact.slip_speed": per(np.where(on, np.linalg.norm(c["slip"], axis=1), 0.0)),
