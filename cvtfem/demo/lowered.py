@@ -15,7 +15,8 @@ def run(outdir: pathlib.Path) -> list[str]:
     from cvtfem.analysis.run import run_scene
     from cvtfem.io.results import read_results
     from cvtfem.machines.cvt import band_model, closed_loop
-    from cvtfem.post.band import convergence_table, plot_normal_force, plot_regime
+    from cvtfem.post.band import convergence_table, plot_normal_force
+    from cvtfem.post.history import plot_history
     from cvtfem.scene.loader import load_scene
 
     outdir = pathlib.Path(outdir)
@@ -24,8 +25,8 @@ def run(outdir: pathlib.Path) -> list[str]:
     h5 = outdir / "lowered_4dof_run.h5"
     summary = run_scene(load_scene("band-4dof"), until=0.6, results=h5, show_progress=False, overwrite=True,
                         start={"ratio": 2.3, "speed_factor": 0.96})
-    png = plot_regime(read_results(h5), outdir / "lowered_4dof_regime.png",
-                      "4-DOF band model: loops pull ratio 2.3 -> 2.4 and 3360 -> 3500 rpm")
+    png = plot_history(read_results(h5), outdir / "lowered_4dof_regime.png",
+                       title="4-DOF band model: loops pull ratio 2.3 -> 2.4 and 3360 -> 3500 rpm")
     lines.append(f"{h5.name}: 4-DOF run, 0.6 s simulated in {summary.wall_time_s:.2f} s wall (HDF5 time histories)")
     lines.append(f"{png.name}: speeds, ratio, efficiency and clamping forces settling to the targets "
                  f"(final ratio {summary.ratio:.4f}, efficiency {summary.efficiency:.4f})")

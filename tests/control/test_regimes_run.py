@@ -3,7 +3,7 @@ import pytest
 
 from cvtfem.analysis.run import run_scene
 from cvtfem.io.results import read_results
-from cvtfem.post.band import windowed_efficiency
+from cvtfem.post.history import windowed_efficiency
 from cvtfem.scene.loader import load_scene
 
 

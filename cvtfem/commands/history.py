@@ -1,0 +1,41 @@
+"""``cvtfem history RESULTS [--window S] [--png OUT] [--csv OUT]``: regime history of a CVT run (speeds, ratio,
+efficiency steady and kinetic-energy corrected, slip, clamping forces)."""
+from __future__ import annotations
+
+import argparse
+
+
+def add_parser(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser("history", help="speeds, ratio, efficiency, slip and clamping forces of a CVT run over time")
+    p.add_argument("results", metavar="RESULTS", help="HDF5 results file of a CVT run (band or chain)")
+    p.add_argument("--window", type=float, default=None, metavar="S",
+                   help="efficiency window, s (default: a tenth of the run, at most 0.05 s)")
+    p.add_argument("--png", metavar="OUT", help="write the history as PNG")
+    p.add_argument("--csv", metavar="OUT", help="write the history columns as CSV")
+    p.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    import numpy as np
+
+    from cvtfem.io.results import read_results
+    from cvtfem.post.history import history, plot_history, write_history_csv
+
+    results = read_results(args.results)
+    t = results.time
+    window = args.window if args.window is not None else min(0.1 * (t[-1] - t[0]), 0.05)
+    cols = history(results, window)
+    last = {k: v[-1] for k, v in cols.items()}
+    print(f"{results.path.name}: {t[0]:.6g} .. {t[-1]:.6g} s, {t.size} rows; at the end: n1 {last['n1_rpm']:.1f} rpm, "
+          f"n2 {last['n2_rpm']:.1f} rpm, ratio {last['ratio']:.4f}")
+    print(f"efficiency over the last {window:g} s: {last['efficiency']:.4f} (kinetic-energy corrected "
+          f"{last['efficiency_kinetic']:.4f})")
+    if "slip_driving" in cols:
+        print(f"slip speed at the end: driving {last['slip_driving']:.4g} m/s, driven {last['slip_driven']:.4g} m/s")
+    if not np.isfinite(last["efficiency"]):
+        print("no input work in the last window: efficiency undefined (NaN)")
+    if args.csv:
+        print(f"wrote {write_history_csv(cols, args.csv)}")
+    if args.png:
+        print(f"wrote {plot_history(results, args.png, window, title=results.path.name)}")
+    return 0
