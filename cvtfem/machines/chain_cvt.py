@@ -37,12 +37,12 @@ from cvtfem.elements.band.geometry import Sheave
 from cvtfem.elements.base import Block
 from cvtfem.elements.chain.placement import place_on_path
 from cvtfem.elements.chain.sheave_contact import SheaveContact, hertz_constant
-from cvtfem.elements.chain.symmetric import ChainS2, ChainS3, damping_from_ratio
+from cvtfem.elements.chain.symmetric import ChainS1, ChainS2, ChainS3, damping_from_ratio
 from cvtfem.errors import InputError, NumericalError
 from cvtfem.machines.chain import pin_coordinate_label
 from cvtfem.outputs import OutputSpec
 
-FAMILIES = {"chain-S2": ChainS2, "chain-S3": ChainS3}
+FAMILIES = {"chain-S1": ChainS1, "chain-S2": ChainS2, "chain-S3": ChainS3}
 
 
 @dataclass(frozen=True, eq=False)
@@ -115,9 +115,10 @@ class ChainCVT(ModelBase):
                        "The chain family's coordinates q (its layout, `state_label`): the pin positions for "
                        "renderings and per-pin post-processing of a results file.", self.family.size),
             OutputSpec("contact.normal_force", "N",
-                       "Hertz force N per pin end and shaft (pin-major, driving then driven).", 2 * n),
+                       "Normal contact force N per pin end and shaft (pin-major, driving then driven).", 2 * n),
             OutputSpec("contact.penetration", "m",
-                       "Penetration Delta along the axis per pin end and shaft (<= 0: off).", 2 * n),
+                       "Penetration Delta along the axis per pin end and shaft (<= 0: off; S1: how far the face "
+                       "lies inside the free pin end).", 2 * n),
             OutputSpec("contact.radius", "m", "Contact radius per pin end and shaft (0 off contact).", 2 * n),
             OutputSpec("contact.slip_speed", "m/s", "Slip speed of the pin end on the sheave (0 off contact).", 2 * n),
             OutputSpec("contact.friction_force", "N",
@@ -613,11 +614,12 @@ class ChainCVT(ModelBase):
                         contact: str = "hertz") -> "ChainCVT":
         """Build the model from plain parameters (SI units).
 
-        ``geom`` a :class:`~cvtfem.elements.chain.geometry.ChainGeometry`; ``model`` ``chain-S2`` or
-        ``chain-S3``; ``face`` the sheave face (its ``w`` is replaced by half the pin length); ``J``,
+        ``geom`` a :class:`~cvtfem.elements.chain.geometry.ChainGeometry`; ``model`` ``chain-S1``, ``chain-S2``
+        or ``chain-S3``; ``face`` the sheave face (its ``w`` is replaced by half the pin length); ``J``,
         ``m_sheave`` per shaft (driving, driven); ``F_appl`` clamping forces per sheave; ``control``
-        the loop parameters (None: open loop, ``M2 = -b20 w2``); ``contact`` ``"hertz"`` (H1) or ``"hertz-refined"``
-        (H2, :class:`~cvtfem.machines.chain_cvt_refined.RefinedChainCVT`).  The Hertz stiffness is held
+        the loop parameters (None: open loop, ``M2 = -b20 w2``); ``contact`` ``"hertz"`` (H1), ``"hertz-refined"``
+        (H2, :class:`~cvtfem.machines.chain_cvt_refined.RefinedChainCVT`) or, for S1 and only for it, ``"rigid"``
+        (:class:`~cvtfem.machines.chain_s1_cvt.ChainS1CVT`).  The Hertz stiffness is held
         constant (digest §4.3) for a pin end crowned with ``face_radius`` at the contact radius
         ``r_hertz`` (default: the mean radius of ratio 1, ``(l - 2 L) / (2 pi)``).
         """
@@ -626,7 +628,15 @@ class ChainCVT(ModelBase):
         r_h = (geom.length - 2 * centre_distance) / (2 * np.pi) if r_hertz is None else r_hertz
         c = hertz_constant(face, r_h, face_radius, E, poisson)
         centres = np.array([[centre_distance, 0.0], [0.0, 0.0]])
-        if contact == "hertz-refined" and cls is ChainCVT:
+        if (contact == "rigid") != (model == "chain-S1"):
+            raise InputError("cvt.effects.contact", contact, "must be 'rigid' for chain-S1 (its pins have no axial "
+                             "coordinate: the ends follow the faces) and 'hertz' or 'hertz-refined' for the others")
+        if contact == "rigid" and cls is ChainCVT:
+            from cvtfem.elements.chain.sheave_contact_rigid import RigidSheaveContact
+            from cvtfem.machines.chain_s1_cvt import ChainS1CVT
+            cls, pair = ChainS1CVT, RigidSheaveContact(centres, (face, face), np.array([np.inf, np.inf]), r_outer, f0,
+                                                       v0, law, half_length=geom.l / 2)
+        elif contact == "hertz-refined" and cls is ChainCVT:
             from cvtfem.machines.chain_cvt_refined import RefinedChainCVT, refined_contact
             cls, pair = RefinedChainCVT, refined_contact(family, centres, face, c, r_outer, f0, v0, law, face_radius)
         elif contact == "hertz":

@@ -157,7 +157,7 @@ def chain_geometry(scene: Scene):
 
 
 #: Discrete-chain models that run as a transmission (the others exist as element families only).
-RUNNING_CHAINS = ("chain-S2", "chain-S3", "chain-A1")
+RUNNING_CHAINS = ("chain-S1", "chain-S2", "chain-S3", "chain-A1")
 
 
 def band_model(scene: Scene, **overrides: Any):
@@ -235,16 +235,19 @@ def chain_refusal(scene: Scene) -> InputError | None:
     if model not in RUNNING_CHAINS:
         return InputError("cvt.model", model, "must be a discrete chain that runs in time: " + ", ".join(RUNNING_CHAINS)
                           + " (the other chain models exist as element families only so far, docs/chain.md)")
-    if model != "chain-S2" and not eff.pin_bending:
+    if model not in ("chain-S1", "chain-S2") and not eff.pin_bending:
         return InputError("cvt.effects.pin_bending", False, f"must be true for `{model}` (its pins bend); "
                           "without pin bending use `chain-S2`")
     if eff.shaft_elasticity:
         return InputError("cvt.effects.shaft_elasticity", True, f"is not available for `{model}` yet: the chain "
                           "runs on rigid shafts (set it false)")
-    if eff.contact not in ("hertz", "hertz-refined"):
+    if model == "chain-S1" and eff.contact != "rigid":
+        return InputError("cvt.effects.contact", eff.contact, "must be 'rigid' for `chain-S1`: its pins have no axial "
+                          "coordinate, their ends follow the sheave faces (chain-models-1 2.2)")
+    if model != "chain-S1" and eff.contact not in ("hertz", "hertz-refined"):
         return InputError("cvt.effects.contact", eff.contact, f"must be 'hertz' or 'hertz-refined' for `{model}`: Hertz "
-                          "contact at the pin-axis end or refined (the rigid and impact contacts are not coupled to a "
-                          "running chain yet)")
+                          "contact at the pin-axis end or refined (the rigid contact runs with `chain-S1` only, the impact "
+                          "contact is not coupled to a running chain yet)")
     if eff.contact == "hertz-refined" and model not in ("chain-S2", "chain-S3"):
         return InputError("cvt.effects.contact", eff.contact, f"must be 'hertz' for `{model}`: the refined contact "
                           "runs with the symmetric chains chain-S2 and chain-S3 only so far")
@@ -261,7 +264,8 @@ def chain_loop(scene: Scene):
 
     The prescribed clamping forces are those the band models get (:class:`~cvtfem.control.clamping.Clamping`
     at the regime's start: torque, ratio, safety factor, split); the ratio loop corrects ``F1`` from there.
-    Only what runs is accepted: ``chain-S2`` (no pin bending), ``chain-S3`` and the whole-pin chain ``chain-A1``
+    Only what runs is accepted: ``chain-S1`` (rigid contact: the pin ends follow the faces), ``chain-S2`` (no pin
+    bending), ``chain-S3`` and the whole-pin chain ``chain-A1``
     (pin bending; :mod:`~cvtfem.machines.chain_a_cvt`, a fixed and a movable sheave per shaft), rigid shafts,
     ``effects.contact = "hertz"`` (all three) or ``"hertz-refined"`` (S2, S3), friction on.  (A3/A4 build through
     the same interface, but their quasi-static start does not converge yet: docs/chain.md.)
@@ -291,8 +295,10 @@ def _running_chain_layout(scene: Scene) -> tuple[Layout, ...]:
         return tuple(o for o in model.output_specs if o.name.startswith(prefixes))
 
     parts = [Layout("chain", scene.cvt.model, n * per_pin, outputs=outputs("chain.", "contact."),
-                    note=f"{n} pins x {per_pin}; Hertz contact at both pin ends with each shaft's sheaves "
-                         "(continuous: no discrete state)"),
+                    note=f"{n} pins x {per_pin}; " + ("rigid contact: the pin ends follow the sheave faces"
+                                                      if scene.cvt.model == "chain-S1" else
+                                                      "Hertz contact at both pin ends with each shaft's sheaves")
+                         + " (continuous: no discrete state)"),
              Layout("driving pulley", "rigid-shaft", 2, outputs=outputs("driving."), note=f"spin angle, {sheave} axial"),
              Layout("driven pulley", "rigid-shaft", 2, outputs=outputs("driven."), note=f"spin angle, {sheave} axial")]
     if scene.cvt.effects.stabilisation:
