@@ -110,7 +110,6 @@ def _render_run(args: argparse.Namespace) -> int:
     """A chain-CVT results file: the still at --time, the window as GIF/MP4 and as a VTU time series."""
     from cvtfem.errors import InputError
     from cvtfem.render.run_frames import check_animation, render_row, write_animation
-    from cvtfem.render.stored_run import StoredRun
     from cvtfem.render.vtk_series import write_vtu_series
 
     for name in ("mode", "speed"):
@@ -119,7 +118,7 @@ def _render_run(args: argparse.Namespace) -> int:
     scale = 1.0 if args.scale is None else args.scale
     if not (scale == scale and abs(scale) != float("inf") and scale > 0):
         raise InputError("--scale", args.scale, "must be a positive, finite exaggeration factor")
-    run = StoredRun.open(args.scene)
+    run = open_run(args.scene)
     if args.time is not None and not args.png:
         raise InputError("--time", args.time, "is the time of the --png still (animations take --window)")
     animated = args.gif or args.mp4 or args.vtu
@@ -147,3 +146,15 @@ def _render_run(args: argparse.Namespace) -> int:
         chain, sheaves = write_vtu_series(run, rows, args.vtu, scale)
         print(f"wrote {chain} and {sheaves}: {span}")
     return 0
+
+
+def open_run(path):
+    """The results file ``path`` of a chain-CVT run with its stored scene (:class:`StoredRun`)."""
+    import tomllib
+
+    from cvtfem.io.results import read_results
+    from cvtfem.render.stored_run import StoredRun
+    from cvtfem.scene.loader import scene_from_dict
+
+    results = read_results(path)
+    return StoredRun.of(results, scene_from_dict(tomllib.loads(results.scene_toml), source=str(results.path)))

@@ -8,7 +8,6 @@ per-pin-end series, so nothing is recomputed.
 from __future__ import annotations
 
 import math
-import tomllib
 from dataclasses import dataclass
 from functools import cached_property
 from pathlib import Path
@@ -16,7 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from cvtfem.errors import InputError
-from cvtfem.io.results import Results, read_results
+from cvtfem.io.results import Results
 from cvtfem.render.transmission import ChainFrame, chain_frame, check_colour
 
 #: Series a results file needs for drawing its chain.
@@ -38,14 +37,12 @@ class StoredRun:
         return chain_loop(self.scene)
 
     @classmethod
-    def open(cls, path: str | Path, where: str = "RESULTS") -> StoredRun:
-        """Read ``path``; InputError when it is not the results file of a chain-CVT run with its chain's geometry
-        and at least one row."""
+    def of(cls, results: Results, scene, where: str = "RESULTS") -> StoredRun:
+        """The results file ``results`` whose stored scene is ``scene`` (validated by the caller); InputError when it
+        is not the results file of a chain-CVT run with its chain's geometry and at least one row."""
         from cvtfem.machines.cvt import chain_refusal
-        from cvtfem.scene.loader import scene_from_dict
 
-        res = read_results(path)
-        scene = scene_from_dict(tomllib.loads(res.scene_toml), source=str(res.path))
+        res = results
         model_name = scene.cvt.model if scene.kind == "cvt" and scene.cvt is not None else None
         if model_name is None or not model_name.startswith("chain-") or chain_refusal(scene) is not None:
             what = f"a {scene.kind} scene" if model_name is None else f"cvt.model = {model_name!r}"

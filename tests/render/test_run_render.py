@@ -8,7 +8,7 @@ from cvtfem.io.results import ResultsWriter
 from cvtfem.outputs import OutputSpec
 from cvtfem.render import transmission as tr
 from cvtfem.render.run_frames import window_limits, write_animation
-from cvtfem.render.stored_run import StoredRun
+from cvtfem.commands.render import open_run
 from cvtfem.render.vtk_series import read_pvd, write_vtu_series
 from cvtfem.scene.loader import load_scene
 
@@ -28,7 +28,7 @@ def s2_file(tmp_path_factory):
 
 @pytest.fixture(scope="module")
 def run(s2_file):
-    return StoredRun.open(s2_file)
+    return open_run(s2_file)
 
 
 def test_drawn_pins_are_the_stored_coordinates_through_the_model(run):
@@ -114,7 +114,7 @@ def _band_file(path):
 
 def test_a_results_file_that_is_not_a_chain_cvt_is_refused(tmp_path):
     with pytest.raises(InputError, match=r"`RESULTS`.*must be the results file of a chain-CVT run.*'band-4dof'"):
-        StoredRun.open(_band_file(tmp_path / "band.h5"))
+        open_run(_band_file(tmp_path / "band.h5"))
 
 
 def test_a_chain_file_without_its_geometry_is_refused(tmp_path):
@@ -122,7 +122,7 @@ def test_a_chain_file_without_its_geometry_is_refused(tmp_path):
     with ResultsWriter(path, load_scene("chain-S2").to_toml(), "run", [OutputSpec("ratio", "-", "")]) as w:
         w.append(0.0, {"ratio": 2.4})
     with pytest.raises(InputError, match="lacks the series chain.coordinates, driving.sheave_position"):
-        StoredRun.open(path)
+        open_run(path)
 
 
 def test_gif_has_one_frame_per_row(run, tmp_path):
