@@ -141,8 +141,8 @@ def colour_kind(model, spec) -> str | None:
         return "end"
     if spec.size != n:
         return None
-    text = f"{spec.name} {spec.doc}".lower()
-    return "link" if "link" in text and "pin" not in spec.name else "pin"
+    doc = spec.doc.lower()
+    return "link" if "link" in spec.name or doc.startswith("link") or "per link" in doc else "pin"
 
 
 def check_colour(model, name: str, stored=None, option: str = "--color") -> str:

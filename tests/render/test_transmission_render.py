@@ -78,6 +78,9 @@ def test_colours_per_link_and_per_pin(running):
     np.testing.assert_allclose(v.sum(), out["contact.normal_force"].sum())
     assert tr.colour_values(model, "chain.link_tension", out["chain.link_tension"])[1] == "link"
     assert tr.colour_values(model, "chain.pin_axial_force", out["chain.pin_axial_force"])[1] == "pin"
+    kinds = {s.name: tr.colour_kind(model, s) for s in model.output_specs}
+    assert kinds["chain.joint_rate"] == "pin" and kinds["chain.link_tension_elastic"] == "link"
+    assert kinds["contact.normal_force"] == "end" and kinds["contact.friction_force"] is None
     with pytest.raises(InputError, match="--color"):
         tr.check_colour(model, "driving.speed")
 

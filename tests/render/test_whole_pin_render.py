@@ -43,6 +43,19 @@ def test_fixed_and_movable_sheaves(a1):
     assert a1.movable_side == (1, -1)
 
 
+def test_colour_kinds_of_the_whole_pin_chain(a1):
+    kinds = {s.name: tr.colour_kind(a1, s) for s in a1.output_specs}
+    assert kinds["chain.twist"] == kinds["chain.shear"] == kinds["chain.link_tension"] == "link"
+    assert kinds["chain.pin_axial_force"] == kinds["chain.pin_tilt_twist"] == "pin"
+    assert kinds["contact.normal_force"] == "end" and kinds["chain.pin_moment_far"] is None
+    n = a1.family.n
+    per_end_shaft = np.arange(4 * n, dtype=float)            # value 4 p + 2 end + shaft
+    v, kind = tr.colour_values(a1, "contact.normal_force", per_end_shaft)
+    assert kind == "end" and v.shape == (n, 2)
+    np.testing.assert_array_equal(v[:, 0], 8 * np.arange(n) + 1)     # far end: shafts 0 and 1 summed
+    np.testing.assert_array_equal(v[:, 1], 8 * np.arange(n) + 5)     # near end
+
+
 @pytest.mark.slow
 def test_drawn_pin_ends_penetrate_their_sheaves_by_the_model_penetration(a1, tmp_path):
     """In the quasi-static start state every pin end on an arc lies beyond the drawn face on its side (the
