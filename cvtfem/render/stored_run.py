@@ -10,13 +10,12 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from functools import cached_property
-from pathlib import Path
 
 import numpy as np
 
 from cvtfem.errors import InputError
 from cvtfem.io.results import Results
-from cvtfem.render.transmission import ChainFrame, chain_frame, check_colour
+from cvtfem.render.transmission import ChainFrame, chain_frame, check_colour, colour_kind
 
 #: Series a results file needs for drawing its chain.
 GEOMETRY = ("chain.coordinates", "driving.sheave_position", "driven.sheave_position")
@@ -115,7 +114,5 @@ class StoredRun:
 
     def colourable(self) -> list[str]:
         """Stored outputs that colour the chain (per link, per pin, per pin end and shaft)."""
-        from cvtfem.render.transmission import colour_kind
-
         return [s.name for s in self.model.output_specs
                 if s.name in self.results.series and colour_kind(self.model, s) is not None]
