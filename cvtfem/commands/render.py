@@ -1,5 +1,6 @@
 """``cvtfem render SCENE [--mode K] --png OUT``: off-screen rendering of a rotor or one of its modes, or of a
-chain transmission in its start state."""
+chain transmission in its start state; ``cvtfem render RESULTS.h5 [--time T] --png OUT``, ``--gif/--mp4 OUT``,
+``--vtu DIR`` with ``--window T0 T1``: stills, animations and VTU time series of a chain-CVT run."""
 from __future__ import annotations
 
 import argparse
@@ -8,15 +9,26 @@ import argparse
 def add_parser(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("render", help="render a rotor scene or a mode shape, or a chain transmission, off-screen "
                        "(PNG, GIF, VTU)")
-    p.add_argument("scene", metavar="SCENE", help="rotor or chain-CVT scene file (.toml) or preset name")
+    p.add_argument("scene", metavar="SCENE", help="rotor or chain-CVT scene file (.toml) or preset name, or the "
+                   "results file (.h5) of a chain-CVT run")
     p.add_argument("--mode", type=int, help="mode index (ascending damped frequency); omit for the geometry")
     p.add_argument("--speed", help="spin speed with unit (default [rotor].speed)")
-    p.add_argument("--scale", type=float, help="displacement scale (default: 8 %% of the shaft length)")
+    p.add_argument("--scale", type=float, help="rotor: displacement scale (default: 8 %% of the shaft length); "
+                   "results file: axial positions exaggerated by this factor about the first row (default 1)")
     p.add_argument("--color", default="chain.link_tension",
                    help="chain transmission: output colouring the links (per link, per pin, or per pin end and shaft)")
     p.add_argument("--png", metavar="OUT", help="PNG file")
-    p.add_argument("--gif", metavar="OUT", help="animated GIF of the mode over one period")
-    p.add_argument("--vtu", metavar="OUT", help="VTU file (meshio) with all computed modes for ParaView")
+    p.add_argument("--gif", metavar="OUT", help="animated GIF of the mode over one period, or of a run's window")
+    p.add_argument("--mp4", metavar="OUT", help="results file: MP4 of the window (needs imageio-ffmpeg)")
+    p.add_argument("--vtu", metavar="OUT", help="VTU file (meshio) with all computed modes for ParaView; results "
+                   "file: a directory for a VTU time series of the window (chain.pvd, sheaves.pvd)")
+    p.add_argument("--time", type=float, metavar="T", help="results file: time of the still, s (the nearest "
+                   "stored row is drawn; default the last)")
+    p.add_argument("--window", type=float, nargs=2, metavar=("T0", "T1"),
+                   help="results file: time window of --gif/--mp4/--vtu, s (default: every stored row)")
+    p.add_argument("--fps", type=float, default=10.0, help="results file: frames per second of --gif/--mp4")
+    p.add_argument("--frames", type=int, help="results file: frames of the window (the rows nearest equally "
+                   "spaced times; default every stored row)")
     p.set_defaults(func=run)
 
 
@@ -24,8 +36,13 @@ def run(args: argparse.Namespace) -> int:
     from cvtfem.commands.modes import load_rotor
     from cvtfem.errors import InputError
 
-    if not (args.png or args.gif or args.vtu):
-        raise InputError("--png/--gif/--vtu", None, "needs at least one output file")
+    if not (args.png or args.gif or args.vtu or args.mp4):
+        raise InputError("--png/--gif/--mp4/--vtu", None, "needs at least one output file")
+    if _is_results_file(args.scene):
+        return _render_run(args)
+    for name in ("time", "window", "frames", "mp4"):
+        if getattr(args, name) is not None:
+            raise InputError(f"--{name}", getattr(args, name), "is for the results file (.h5) of a chain-CVT run")
     from cvtfem.scene.loader import load_scene
 
     if load_scene(args.scene).kind == "cvt":
@@ -74,3 +91,70 @@ def _render_chain(args: argparse.Namespace) -> int:
                                title=f"{args.scene}: start state ({report['kind']}), links coloured by {args.color}")
     print(f"wrote {path}")
     return 0
+
+
+def _is_results_file(spec: str) -> bool:
+    """True for an existing file that starts with the HDF5 signature (a results file, whatever its suffix)."""
+    from pathlib import Path
+
+    from cvtfem.io.results import HDF5_SIGNATURE
+
+    path = Path(spec)
+    if not path.is_file():
+        return spec.endswith(".h5")      # a missing results file: read_results names it
+    with open(path, "rb") as f:
+        return f.read(8) == HDF5_SIGNATURE
+
+
+def _render_run(args: argparse.Namespace) -> int:
+    """A chain-CVT results file: the still at --time, the window as GIF/MP4 and as a VTU time series."""
+    from cvtfem.errors import InputError
+    from cvtfem.render.run_frames import check_animation, render_row, write_animation
+    from cvtfem.render.vtk_series import write_vtu_series
+
+    for name in ("mode", "speed"):
+        if getattr(args, name) is not None:
+            raise InputError(f"--{name}", getattr(args, name), "is for rotor scenes, not for a results file")
+    scale = 1.0 if args.scale is None else args.scale
+    if not (scale == scale and abs(scale) != float("inf") and scale > 0):
+        raise InputError("--scale", args.scale, "must be a positive, finite exaggeration factor")
+    run = open_run(args.scene)
+    if args.time is not None and not args.png:
+        raise InputError("--time", args.time, "is the time of the --png still (animations take --window)")
+    animated = args.gif or args.mp4 or args.vtu
+    if not animated and (args.window is not None or args.frames is not None):
+        raise InputError("--window/--frames", args.window or args.frames, "is for --gif, --mp4 or --vtu")
+    row = run.row_at(run.time[-1] if args.time is None else args.time)
+    if animated:
+        t0, t1 = args.window if args.window is not None else (run.time[0], run.time[-1])
+        rows = run.rows_in(t0, t1, args.frames)
+    run.check_colour(args.color)
+    for option, path in (("--gif", args.gif), ("--mp4", args.mp4)):
+        if path:
+            check_animation(path, args.fps, option)
+    if args.png:
+        asked = "" if args.time is None else f" (nearest to --time {args.time:g} s)"
+        path = render_row(run, row, args.png, args.color, scale)
+        print(f"wrote {path}: t = {run.time[row]:.9g} s, row {row}{asked}")
+    if not animated:
+        return 0
+    span = f"{len(rows)} frames, t = {run.time[rows[0]]:.9g} .. {run.time[rows[-1]]:.9g} s"
+    for option, path in (("--gif", args.gif), ("--mp4", args.mp4)):
+        if path:
+            print(f"wrote {write_animation(run, rows, path, args.color, scale, args.fps, option)}: {span}")
+    if args.vtu:
+        chain, sheaves = write_vtu_series(run, rows, args.vtu, scale)
+        print(f"wrote {chain} and {sheaves}: {span}")
+    return 0
+
+
+def open_run(path):
+    """The results file ``path`` of a chain-CVT run with its stored scene (:class:`StoredRun`)."""
+    import tomllib
+
+    from cvtfem.io.results import read_results
+    from cvtfem.render.stored_run import StoredRun
+    from cvtfem.scene.loader import scene_from_dict
+
+    results = read_results(path)
+    return StoredRun.of(results, scene_from_dict(tomllib.loads(results.scene_toml), source=str(results.path)))

@@ -132,6 +132,10 @@ class ChainCVT(ModelBase):
             OutputSpec("driven.speed", "rad/s", "Angular speed of the driven shaft."),
             OutputSpec("driving.torque", "N m", "External torque on the driving shaft."),
             OutputSpec("driven.torque", "N m", "External torque on the driven shaft."),
+            OutputSpec("driving.sheave_position", "m", "Axial position z of the driving pulley's sheave (the movable "
+                       "one of an A chain), counted outwards from the chain plane: renderings of a results file."),
+            OutputSpec("driven.sheave_position", "m", "Axial position z of the driven pulley's sheave (the movable "
+                       "one of an A chain), counted outwards from the chain plane: renderings of a results file."),
             OutputSpec("driving.clamping_force", "N", "Clamping force per sheave, driving pulley."),
             OutputSpec("driven.clamping_force", "N", "Clamping force per sheave, driven pulley."),
             OutputSpec("driving.support_force", "N", "Bearing reaction on the rigid driving shaft in the chain "
@@ -394,7 +398,7 @@ class ChainCVT(ModelBase):
         """Named outputs of :attr:`output_specs` at ``(t, x)``."""
         dx, diag = self.evaluate(t, x, slip=False)      # the contact details come below
         q, v, _, W = self.split(x)
-        nc = self._idx[0]
+        nc, _, iz, _ = self._idx
         n = self.n_ends
         pins, shafts, _, (Y, c) = self._contacts(q, v, details=True)
         on = c["delta"] > 0
@@ -416,6 +420,7 @@ class ChainCVT(ModelBase):
                     "contact.friction_power": np.bincount(shafts, Y[:, -1], 2),
                     **self._sheave_outputs(pins, shafts, c),
                     "driving.speed": w[0], "driven.speed": w[1], "driving.torque": M[0], "driven.torque": M[1],
+                    "driving.sheave_position": q[iz[0]], "driven.sheave_position": q[iz[1]],
                     "driving.clamping_force": F[0], "driven.clamping_force": F[1],
                     "driving.support_force": support[0], "driven.support_force": support[1],
                     "ratio": w[0] / w[1] if w[1] else math.nan, "efficiency": P[1] / P[0] if P[0] else 0.0,

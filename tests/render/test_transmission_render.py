@@ -19,7 +19,10 @@ def test_drawn_pin_ends_penetrate_the_drawn_faces_by_the_model_penetration(runni
     """The drawn face is x3 = z + s(r) of the band models' Sheave (s = -z0 of the face through the axis), and
     each pin end lies beyond it by exactly the penetration the contact model reports."""
     model, x = running
-    u, u3, z = tr.axial_positions(model, x)
+    q, z = tr.chain_state(model, x)
+    frame = tr.chain_frame(model, q, z)
+    u, u3 = frame.pin_axes[:, -1, :2], frame.pin_axes[:, -1, 2]
+    np.testing.assert_array_equal(frame.pin_axes[:, 0, 2], -u3)          # the mirror end
     delta = model.outputs(0.0, x)["contact.penetration"].reshape(-1, 2)
     contact = model.contact
     checked = 0
@@ -29,6 +32,7 @@ def test_drawn_pin_ends_penetrate_the_drawn_faces_by_the_model_penetration(runni
 
         def s(r):
             return -flat.z0(r)
+        np.testing.assert_array_equal(frame.sheaves[k], z[k])
         pts = np.asarray(tr.sheave_surface(face, c, z[k], -1.0, 0.01, contact.r_outer).points)
         np.testing.assert_allclose(pts[:, 2], -(z[k] + s(np.hypot(pts[:, 0] - c[0], pts[:, 1] - c[1]))),
                                    rtol=1e-12, atol=1e-15)
@@ -41,35 +45,42 @@ def test_drawn_pin_ends_penetrate_the_drawn_faces_by_the_model_penetration(runni
 
 def test_axial_exaggeration_about_a_reference(running):
     model, x = running
-    y = x.copy()
-    y[2 * model.family.n:3 * model.family.n] += 1e-5            # every pin end 10 um further out
-    y[model._idx[2]] += 2e-6
-    _, u3, z = tr.axial_positions(model, y, reference=x, axial_scale=50.0)
-    _, u3_0, z_0 = tr.axial_positions(model, x)
-    np.testing.assert_allclose(u3 - u3_0, 5e-4, rtol=1e-9)
-    np.testing.assert_allclose(z - z_0, 1e-4, rtol=1e-9)
+    q, z = tr.chain_state(model, x)
+    q2 = q.copy()
+    q2[2 * model.family.n:3 * model.family.n] += 1e-5            # every pin end 10 um further out
+    frame = tr.chain_frame(model, q2, z + 2e-6, reference=(q, z), axial_scale=50.0)
+    plain = tr.chain_frame(model, q, z)
+    np.testing.assert_allclose(frame.pin_axes[:, -1, 2] - plain.pin_axes[:, -1, 2], 5e-4, rtol=1e-9)
+    np.testing.assert_allclose(frame.pin_axes[:, 0, 2] - plain.pin_axes[:, 0, 2], -5e-4, rtol=1e-9)
+    np.testing.assert_allclose(frame.sheaves - plain.sheaves, 1e-4, rtol=1e-9)
+    np.testing.assert_array_equal(frame.pin_axes[..., :2], plain.pin_axes[..., :2])   # in-plane: as they are
 
 
 def test_links_are_ribbons_between_their_pins(running):
     model, x = running
-    u, u3, _ = tr.axial_positions(model, x)
-    pins, links = tr.chain_meshes(u, u3, 1e-3)
+    frame = tr.chain_frame(model, *tr.chain_state(model, x))
+    u, u3 = frame.pin_axes[:, -1, :2], frame.pin_axes[:, -1, 2]
+    pins, links = tr.chain_meshes(frame, 1e-3)
     n = len(u)
-    assert links.n_cells == n
+    assert links.n_cells == n and pins.n_cells == n
     corners = np.asarray(links.points).reshape(n, 4, 3)
     np.testing.assert_array_equal(corners[:, 0, :2], u)
     np.testing.assert_array_equal(corners[:, 2, :2], np.roll(u, -1, axis=0))
-    np.testing.assert_allclose(corners[:, 1, 2], tr.PACK_FRACTION * u3)
-    assert pins.n_points > 0
+    np.testing.assert_allclose(corners[:, 1, 2], tr.PACK_FRACTION * u3, rtol=1e-12)
+    np.testing.assert_allclose(corners[:, 0, 2], -tr.PACK_FRACTION * u3, rtol=1e-12)
 
 
 def test_colours_per_link_and_per_pin(running):
     model, x = running
     out = model.outputs(0.0, x)
-    v, per_link = tr.colour_values(model, out, "contact.normal_force")
-    assert not per_link and v.shape == (model.family.n,)
+    v, kind = tr.colour_values(model, "contact.normal_force", out["contact.normal_force"])
+    assert kind == "pin" and v.shape == (model.family.n,)
     np.testing.assert_allclose(v.sum(), out["contact.normal_force"].sum())
-    assert tr.colour_values(model, out, "chain.link_tension")[1]
+    assert tr.colour_values(model, "chain.link_tension", out["chain.link_tension"])[1] == "link"
+    assert tr.colour_values(model, "chain.pin_axial_force", out["chain.pin_axial_force"])[1] == "pin"
+    kinds = {s.name: tr.colour_kind(model, s) for s in model.output_specs}
+    assert kinds["chain.joint_rate"] == "pin" and kinds["chain.link_tension_elastic"] == "link"
+    assert kinds["contact.normal_force"] == "end" and kinds["contact.friction_force"] is None
     with pytest.raises(InputError, match="--color"):
         tr.check_colour(model, "driving.speed")
 

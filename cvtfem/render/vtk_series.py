@@ -1,0 +1,118 @@
+"""A window of a chain-CVT results file as a VTU time series for ParaView (meshio), one file per stored row
+and mesh, collected by a ``.pvd`` file per mesh (``chain.pvd``, ``sheaves.pvd``) with the stored times.
+
+``chain_NNNNN.vtu``: every pin a polyline of ``PIN_POINTS - 1`` line cells along its axis (block 0), every link
+a line cell between the mid-points of its two pins (block 1), with the chain's points of
+:func:`~cvtfem.render.transmission.chain_frame` (m); for each stored output that colours the chain, cell data
+(per-pin values on the pin cells, per-link values on the link cells, NaN on the other block; per-pin-end
+values: their mean on a pin's cells) and, for per-pin and per-pin-end outputs, point data (a pin end's value
+at its end, linear along the axis).  ``sheaves_NNNNN.vtu``: the four sheave faces as quads with cell data
+``shaft`` (0 driving, 1 driven) and ``side`` (-1, +1).  The times are in the ``.pvd`` files (meshio's VTU
+writer drops field data).  meshio reads a chain file back as one line block: the pin cells, then the links.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+from xml.etree import ElementTree
+
+import numpy as np
+
+from cvtfem.errors import InputError
+from cvtfem.render.stored_run import StoredRun
+from cvtfem.render.transmission import PIN_POINTS, SHAFT_FRACTION, colour_values, sheave_face_points
+
+
+def chain_mesh(run: StoredRun, row: int, names, axial_scale: float = 1.0):
+    """The chain at ``row`` as a meshio Mesh with the outputs ``names`` as point and cell data."""
+    import meshio
+
+    frame = run.frame(row, axial_scale)
+    n, m, _ = frame.pin_axes.shape
+    points = np.concatenate([frame.pin_axes.reshape(-1, 3), frame.pin_axes[:, (m - 1) // 2]])
+    start = m * np.arange(n)[:, None] + np.arange(m - 1)
+    pin_cells = np.stack([start, start + 1], axis=-1).reshape(-1, 2)
+    mid = n * m + np.arange(n)
+    link_cells = np.column_stack([mid, np.roll(mid, -1)])
+    point_data, cell_data = {}, {}
+    xi = np.linspace(-1.0, 1.0, m)
+    for name in names:
+        v, kind = colour_values(run.model, name, run.results.series[name][row])
+        if kind == "link":
+            cell_data[name] = [np.full(len(pin_cells), np.nan), v]
+            continue
+        ends = np.column_stack([v, v]) if kind == "pin" else v
+        along = ends[:, :1] + (ends[:, 1:] - ends[:, :1]) * (xi + 1) / 2
+        point_data[name] = np.concatenate([along.ravel(), ends.mean(axis=1)])
+        cell_data[name] = [np.repeat(ends.mean(axis=1), m - 1), np.full(n, np.nan)]
+    return meshio.Mesh(points, [("line", pin_cells), ("line", link_cells)], point_data=point_data,
+                       cell_data=cell_data)
+
+
+def sheave_mesh(run: StoredRun, row: int, axial_scale: float = 1.0, n_r: int = 8, n_theta: int = 72):
+    """The four sheave faces at ``row`` as one quad mesh (cell data ``shaft``, ``side``)."""
+    import meshio
+
+    model, sheaves = run.model, run.frame(row, axial_scale).sheaves
+    contact = model.contact
+    points, quads, shaft, side = [], [], [], []
+    for k in range(2):
+        for j, s in enumerate((-1.0, 1.0)):
+            X, Y, Z = sheave_face_points(contact.faces[k], contact.centres[k], sheaves[k, j], s,
+                                         SHAFT_FRACTION * contact.r_outer, contact.r_outer, n_r, n_theta)
+            base = sum(len(p) for p in points)
+            idx = base + np.arange(n_r * n_theta).reshape(n_r, n_theta)
+            q = np.stack([idx[:-1, :-1], idx[1:, :-1], idx[1:, 1:], idx[:-1, 1:]], axis=-1).reshape(-1, 4)
+            points.append(np.column_stack([X.ravel(), Y.ravel(), Z.ravel()]))
+            quads.append(q)
+            shaft.append(np.full(len(q), k))
+            side.append(np.full(len(q), int(s)))
+    return meshio.Mesh(np.concatenate(points), [("quad", np.concatenate(quads))],
+                       cell_data={"shaft": [np.concatenate(shaft)], "side": [np.concatenate(side)]})
+
+
+def write_pvd(path: Path, times, files) -> Path:
+    """A ParaView collection file listing ``files`` (relative names) at ``times`` (s)."""
+    root = ElementTree.Element("VTKFile", type="Collection", version="0.1", byte_order="LittleEndian")
+    coll = ElementTree.SubElement(root, "Collection")
+    for t, f in zip(times, files):
+        ElementTree.SubElement(coll, "DataSet", timestep=repr(float(t)), group="", part="0", file=str(f))
+    ElementTree.indent(root)
+    ElementTree.ElementTree(root).write(path, xml_declaration=True, encoding="utf-8")
+    return path
+
+
+def read_pvd(path: str | Path) -> tuple[np.ndarray, list[Path]]:
+    """Times (s) and file paths of a ``.pvd`` collection."""
+    path = Path(path)
+    sets = ElementTree.parse(path).getroot().iter("DataSet")
+    pairs = [(float(d.get("timestep")), path.parent / d.get("file")) for d in sets]
+    return np.array([t for t, _ in pairs]), [f for _, f in pairs]
+
+
+def write_vtu_series(run: StoredRun, rows, directory: str | Path, axial_scale: float = 1.0,
+                     names=None) -> list[Path]:
+    """``chain.pvd`` and ``sheaves.pvd`` with one VTU per stored row in ``directory`` (created; existing series
+    files there are refused); ``names``: the outputs written (default: every stored output that colours)."""
+    import meshio
+
+    directory = Path(directory)
+    if directory.exists() and not directory.is_dir():
+        raise InputError("--vtu", str(directory), "must be a directory (it is a file)")
+    directory.mkdir(parents=True, exist_ok=True)
+    if any(directory.glob("chain*.pvd")) or any(directory.glob("chain_*.vtu")):
+        raise InputError("--vtu", str(directory), "must not hold a series already (results are never overwritten)",
+                         "choose another directory")
+    if names is None:
+        names = run.colourable()
+    for name in names:
+        run.check_colour(name, "--vtu")
+    times, chain_files, sheave_files = [], [], []
+    for i, row in enumerate(rows):
+        row = int(row)
+        chain_files.append(f"chain_{i:05d}.vtu")
+        sheave_files.append(f"sheaves_{i:05d}.vtu")
+        meshio.write(directory / chain_files[-1], chain_mesh(run, row, names, axial_scale))
+        meshio.write(directory / sheave_files[-1], sheave_mesh(run, row, axial_scale))
+        times.append(run.time[row])
+    return [write_pvd(directory / "chain.pvd", times, chain_files),
+            write_pvd(directory / "sheaves.pvd", times, sheave_files)]
