@@ -150,3 +150,36 @@ def flexible_sheaves(scene: Scene, nodes: np.ndarray, first_extra: int) -> Flexi
         nxt += n_axial + n_torsion + 2 * n_lateral
         kinds += [2] * n_axial + [5] * n_torsion + [0, 1] * n_lateral
     return FlexibleSheaves(mass, stiffness, gyroscopic, np.array(kinds, dtype=np.int64), tuple(sheave_indices(scene)))
+
+
+def cvt_sheave_section(scene: Scene) -> SheaveSection:
+    """The section of a CVT scene's sheaves: bore, hub and rim from ``[sheave]``, the outer radius, face and flank
+    angle from ``cvt.geometry`` (a toroidal face as the arc of ``torus_radius`` through the face's end points)."""
+    opts, g = scene.sheave, scene.cvt.geometry
+    for name in ("bore_diameter", "hub_diameter", "rim_thickness"):
+        if not opts[name] > 0.0:
+            raise InputError(f"sheave.{name}", opts[name], "must be given (> 0) for flexible sheaves in a CVT scene")
+    return SheaveSection(bore_radius=opts.bore_diameter / 2, hub_radius=opts.hub_diameter / 2,
+                         outer_radius=g.sheave_outer_radius, hub_length=opts.hub_length,
+                         rim_thickness=opts.rim_thickness, flank_angle=g.flank_angle, face=g.sheave_profile,
+                         torus_radius=g.torus_radius, E=opts.young_modulus or scene.cvt.young_modulus,
+                         nu=opts.poisson_ratio, rho=opts.density)
+
+
+def band_faces(scene: Scene):  # noqa: ANN201 - tuple of FaceCompliance or None
+    """The face compliance of a band-model CVT scene's sheaves (``[sheave] flexibility = "reduced"``), one per
+    pulley, over the contact radii ``cvt.geometry.r_min..r_max``; None for rigid sheaves (no sheave code runs)."""
+    opts = scene.sheave
+    if opts is None or opts.flexibility == "rigid":
+        return None
+    model = scene.cvt.model
+    if opts.flexibility != "reduced" or model not in ("band-6+2n", "band-6+2n+8"):
+        raise InputError("sheave.flexibility", opts.flexibility,
+                         f"must be 'rigid' for `{model}`: the band-6+2n models run on 'reduced' sheaves "
+                         "(the faces' static compliance under the contact arcs); chain models and 'full' not yet")
+    from cvtfem.elements.sheave_face import face_compliance
+
+    g = scene.cvt.geometry
+    faces = face_compliance(cvt_sheave_section(scene), g.r_min, g.r_max, opts.harmonics,
+                            (opts.cells_radial, opts.cells_axial))
+    return faces, faces

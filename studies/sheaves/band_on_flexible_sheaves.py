@@ -1,0 +1,96 @@
+"""Band-6+2n at the reference stationary regime on rigid and on flexible sheaves (issue 20).
+
+For each sheave model: the driven clamping force F2 of the clamping schedule, the driving force F1 that holds the
+span angle of the target ratio in steady running (root of the span angle's acceleration), then the efficiency
+``-M2 w2 / (M1 w1)``, the speed ratio, the faces' opening and the running radius along each arc (nominal radius
+plus the band's radial Ritz displacement).  Prints a table; ``--png`` draws the opening and radius change.
+
+    .venv/bin/python studies/sheaves/band_on_flexible_sheaves.py [--png out.png]
+"""
+from __future__ import annotations
+
+import sys
+import time
+
+import numpy as np
+from scipy.optimize import newton
+
+from cvtfem.analysis.timing import machine
+from cvtfem.machines.cvt import closed_loop
+from cvtfem.scene.loader import load_scene
+
+
+def ratio_holding_state(loop):
+    """Steady running with the F1 that holds the target span angle: ``(F, q, v, M2)``."""
+    band = loop.model
+    w1, M1, i = loop.regime.targets(0.0)
+    F = loop.clamping.forces(M1, i)
+    phi = loop.clamping.span_angle(i)
+
+    def state(F1):
+        Fs = np.array([F1, F[1]])
+        q, v, M2, _ = band.steady_state(phi, w1, Fs, M1)
+        return Fs, q, v, M2
+
+    def span_accel(F1):
+        Fs, q, v, M2 = state(F1)
+        return band.accel(q, v, Fs, np.array([M1, M2]))[0][0]
+
+    F1 = newton(span_accel, F[0], x1=1.01 * F[0], tol=1e-3)        # secant: F1 within 1 mN
+    return state(F1)
+
+
+def running_radius(band, q):
+    """Nominal radius plus the band's radial displacement at each arc's Gauss nodes, m, (2, g)."""
+    g = band.arcs(q[0])
+    n = band.p.n_ritz
+    h = np.stack([q[6:6 + n], q[6 + n:6 + 2 * n]])
+    return g["r"][:, None] + np.einsum("kng,kn->kg", g["fr"], h), g["th"]
+
+
+def main(argv: list[str]) -> None:
+    rows = {}
+    for name in ("band-6+2n", "band-6+2n-flexible"):
+        loop = closed_loop(load_scene(name))
+        t = time.perf_counter()
+        F, q, v, M2 = ratio_holding_state(loop)
+        w1, M1, _ = loop.regime.targets(0.0)
+        r, th = running_radius(loop.model, q)
+        rows[name] = dict(F=F, eff=-M2 * v[3] / (M1 * v[2]), ratio=v[2] / v[3], r=r, th=th,
+                          w=loop.model.face_opening(q), secs=time.perf_counter() - t)
+    print(f"machine: {machine()}")
+    print(f"{'sheaves':22s} {'F1 kN':>8s} {'F2 kN':>8s} {'F1/F2':>8s} {'efficiency':>11s} {'w1/w2':>8s} "
+          f"{'max opening um (arc 1, 2)':>27s} {'solve s':>8s}")
+    for name, row in rows.items():
+        F, w = row["F"], row["w"]
+        print(f"{name:22s} {F[0] / 1e3:8.3f} {F[1] / 1e3:8.3f} {F[0] / F[1]:8.4f} {row['eff']:11.5f} "
+              f"{row['ratio']:8.4f} {w[0].max() * 1e6:13.1f} {w[1].max() * 1e6:13.1f} {row['secs']:8.1f}")
+    dr = rows["band-6+2n-flexible"]["r"] - rows["band-6+2n"]["r"]
+    for k in range(2):
+        print(f"arc {k + 1}: running radius change {dr[k].min() * 1e6:.1f} .. {dr[k].max() * 1e6:.1f} um "
+              f"(mean {dr[k].mean() * 1e6:.1f} um; nominal r = {rows['band-6+2n']['r'][k].mean() * 1e3:.2f} mm)")
+    if "--png" in argv:
+        import matplotlib
+
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+
+        fig, axes = plt.subplots(1, 2, figsize=(10, 4), sharex=True)
+        flex = rows["band-6+2n-flexible"]
+        for k, label in enumerate(("driving", "driven")):
+            deg = np.degrees(flex["th"][k])
+            axes[0].plot(deg, flex["w"][k] * 1e6, "o-", label=f"arc {k + 1} ({label})")
+            axes[1].plot(deg, dr[k] * 1e6, "o-", label=f"arc {k + 1} ({label})")
+        axes[0].set(xlabel="angle along the arc from its middle, deg", ylabel="face opening per sheave, um",
+                    title="wedge opening under the band (flexible)")
+        axes[1].set(xlabel="angle along the arc from its middle, deg", ylabel="running radius, flexible - rigid, um",
+                    title="running radius change")
+        for ax in axes:
+            ax.grid(True)
+            ax.legend()
+        fig.tight_layout()
+        fig.savefig(argv[argv.index("--png") + 1], dpi=110)
+
+
+if __name__ == "__main__":
+    main(sys.argv[1:])
