@@ -391,8 +391,8 @@ class CompressibleBand:
             if "A" not in g:
                 K = 2 * c["c_edge"] * (E * ds) @ E.T
                 rhs = 2 * c["c_edge"] * (E @ (g["z0"][k] * ds))
-            else:  # flexible faces: V = c' eps_r^T W eps_r with W = D A^-1 = (D^-1 + c' K_f)^-1
-                W = np.linalg.inv(np.diag(1.0 / ds) @ g["A"][k])
+            else:  # flexible faces: V = c' eps_r^T W eps_r, W = D A^-1 = (D^-1 A^T)^-1 = (D^-1 + c' K_f)^-1
+                W = np.linalg.inv(np.diag(1.0 / ds) @ g["A"][k].T)
                 K = 2 * c["c_edge"] * E @ W @ E.T
                 rhs = 2 * c["c_edge"] * (E @ W @ np.full_like(ds, g["z0"][k]))
             rhs[0] -= p.kappa * F[k]
