@@ -45,7 +45,7 @@ class FaceCompliance:
     def harmonics(self, r):  # noqa: ANN001, ANN201 - float or complex
         """``c_n(r)`` for n = 0..H (m/N); ``r`` may be complex."""
         x = (2 * r - (self.r_lo + self.r_hi)) / (self.r_hi - self.r_lo)
-        return np.array([np.polynomial.chebyshev.chebval(x, c) for c in self.coef])
+        return np.polynomial.chebyshev.chebval(x, self.coef.T)
 
     def kernel(self, r, dtheta):  # noqa: ANN001, ANN201
         """``K_r(dtheta)``, m/N: axial opening at angular distance ``dtheta`` (rad, any shape) from a unit force."""
@@ -54,8 +54,14 @@ class FaceCompliance:
         return np.sum(c.reshape(n.shape) * np.cos(n * dtheta), axis=0)
 
     def matrix(self, r, theta):  # noqa: ANN001, ANN201
-        """Influence matrix ``K_r(theta_i - theta_j)`` (m/N) of points at angles ``theta`` (rad, (g,)) on radius r."""
-        return self.kernel(r, theta[:, None] - theta[None, :])
+        """Influence matrix ``K_r(theta_i - theta_j)`` (m/N) of points at angles ``theta`` (rad, (g,)) on radius r,
+        as ``C^T diag(c) C + S^T diag(c) S`` with ``C = cos n theta``, ``S = sin n theta`` (2 (H + 1) g sines and
+        cosines instead of (H + 1) g^2)."""
+        c = self.harmonics(r)
+        nt = np.arange(len(c))[:, None] * theta[None, :]
+        C, S = np.cos(nt), np.sin(nt)
+        K = C.T @ (c[:, None] * C) + S.T @ (c[:, None] * S)
+        return 0.5 * (K + K.T)                                         # symmetric to the last bit (Maxwell)
 
 
 def _patch_load(model: HarmonicSheave, radius: float, width: float) -> np.ndarray:
