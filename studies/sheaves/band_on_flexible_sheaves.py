@@ -3,9 +3,11 @@
 For each sheave model: the driven clamping force F2 of the clamping schedule, the driving force F1 that holds the
 span angle of the target ratio in steady running (root of the span angle's acceleration), then the efficiency
 ``-M2 w2 / (M1 w1)``, the speed ratio, the faces' opening and the running radius along each arc (nominal radius
-plus the band's radial Ritz displacement).  Prints a table; ``--png`` draws the opening and radius change.
+plus the band's radial Ritz displacement).  Prints a table; ``--png`` draws the opening and radius change;
+``--bench`` times the right-hand side (median of 7 x 300 calls, interleaved): rigid (compiled kernel and its numpy
+twin) and flexible (numpy).
 
-    .venv/bin/python studies/sheaves/band_on_flexible_sheaves.py [--png out.png]
+    .venv/bin/python studies/sheaves/band_on_flexible_sheaves.py [--png out.png] [--bench]
 """
 from __future__ import annotations
 
@@ -15,7 +17,7 @@ import time
 import numpy as np
 from scipy.optimize import newton
 
-from cvtfem.analysis.timing import machine
+from cvtfem.analysis.timing import machine, median_us
 from cvtfem.machines.cvt import closed_loop
 from cvtfem.scene.loader import load_scene
 
@@ -48,6 +50,23 @@ def running_radius(band, q):
     return g["r"][:, None] + np.einsum("kng,kn->kg", g["fr"], h), g["th"]
 
 
+def bench() -> None:
+    """Median right-hand-side times, us: interleaved rounds of 300 calls at the steady start state."""
+    import dataclasses
+
+    rigid = closed_loop(load_scene("band-6+2n"))
+    loops = {"rigid (numba)": rigid,
+             "rigid (numpy twin)": dataclasses.replace(rigid, model=dataclasses.replace(rigid.model, use_numba=False)),
+             "flexible (numpy)": closed_loop(load_scene("band-6+2n-flexible"))}
+    x = rigid.initial_state()
+    times = {name: [] for name in loops}
+    for _ in range(7):
+        for name, loop in loops.items():
+            times[name].append(median_us(lambda: loop.rhs(0.0, x), 300, warm_up=True))
+    for name, t in times.items():
+        print(f"rhs {name:20s} {np.median(t):8.1f} us (rounds {min(t):.1f}..{max(t):.1f})")
+
+
 def main(argv: list[str]) -> None:
     rows = {}
     for name in ("band-6+2n", "band-6+2n-flexible"):
@@ -69,6 +88,8 @@ def main(argv: list[str]) -> None:
     for k in range(2):
         print(f"arc {k + 1}: running radius change {dr[k].min() * 1e6:.1f} .. {dr[k].max() * 1e6:.1f} um "
               f"(mean {dr[k].mean() * 1e6:.1f} um; nominal r = {rows['band-6+2n']['r'][k].mean() * 1e3:.2f} mm)")
+    if "--bench" in argv:
+        bench()
     if "--png" in argv:
         import matplotlib
 
