@@ -5,9 +5,9 @@ span angle of the target ratio in steady running (root of the span angle's accel
 ``-M2 w2 / (M1 w1)``, the speed ratio, the faces' opening and the running radius along each arc (nominal radius
 plus the band's radial Ritz displacement).  Prints a table; ``--png`` draws the opening and radius change;
 ``--bench`` times the right-hand side (median of 7 x 300 calls, interleaved): rigid (compiled kernel and its numpy
-twin) and flexible (numpy).
+twin) and flexible (numpy); ``--convergence`` repeats the flexible case with other harmonic counts and meshes.
 
-    .venv/bin/python studies/sheaves/band_on_flexible_sheaves.py [--png out.png] [--bench]
+    .venv/bin/python studies/sheaves/band_on_flexible_sheaves.py [--png out.png] [--bench] [--convergence]
 """
 from __future__ import annotations
 
@@ -67,6 +67,17 @@ def bench() -> None:
         print(f"rhs {name:20s} {np.median(t):8.1f} us (rounds {min(t):.1f}..{max(t):.1f})")
 
 
+def convergence() -> None:
+    """F1/F2, efficiency and largest opening of the flexible case against the face model's resolution."""
+    for harmonics, cells in ((12, (24, 2)), (24, (24, 2)), (48, (24, 2)), (24, (48, 4))):
+        loop = closed_loop(load_scene("band-6+2n-flexible", {"sheave": {
+            "harmonics": harmonics, "cells_radial": cells[0], "cells_axial": cells[1]}}))
+        F, q, v, M2 = ratio_holding_state(loop)
+        w1, M1, _ = loop.regime.targets(0.0)
+        print(f"harmonics {harmonics:3d}, cells {cells[0]} x {cells[1]}: F1/F2 {F[0] / F[1]:.5f}, efficiency "
+              f"{-M2 * v[3] / (M1 * v[2]):.6f}, largest opening {loop.model.face_opening(q).max() * 1e6:.1f} um")
+
+
 def main(argv: list[str]) -> None:
     rows = {}
     for name in ("band-6+2n", "band-6+2n-flexible"):
@@ -90,6 +101,8 @@ def main(argv: list[str]) -> None:
               f"(mean {dr[k].mean() * 1e6:.1f} um; nominal r = {rows['band-6+2n']['r'][k].mean() * 1e3:.2f} mm)")
     if "--bench" in argv:
         bench()
+    if "--convergence" in argv:
+        convergence()
     if "--png" in argv:
         import matplotlib
 
