@@ -5,9 +5,10 @@ span angle of the target ratio in steady running (root of the span angle's accel
 ``-M2 w2 / (M1 w1)``, the speed ratio, the faces' opening and the running radius along each arc (nominal radius
 plus the band's radial Ritz displacement).  Prints a table; ``--png`` draws the opening and radius change;
 ``--bench`` times the right-hand side (median of 7 x 300 calls, interleaved): rigid (compiled kernel and its numpy
-twin) and flexible (numpy); ``--convergence`` repeats the flexible case with other harmonic counts and meshes.
+twin) and flexible (numpy); ``--convergence`` repeats the flexible case with other harmonic counts and meshes;
+``--ratios`` compares rigid and flexible over the ratio range (same torque and speed).
 
-    .venv/bin/python studies/sheaves/band_on_flexible_sheaves.py [--png out.png] [--bench] [--convergence]
+    .venv/bin/python studies/sheaves/band_on_flexible_sheaves.py [--png out.png] [--bench] [--convergence] [--ratios]
 """
 from __future__ import annotations
 
@@ -78,6 +79,23 @@ def convergence() -> None:
               f"{-M2 * v[3] / (M1 * v[2]):.6f}, largest opening {loop.model.face_opening(q).max() * 1e6:.1f} um")
 
 
+def ratios() -> None:
+    """F1/F2, efficiency and largest opening, rigid and flexible, at ratios across the range."""
+    print(f"{'ratio':>6s} {'F1/F2 rigid':>12s} {'flexible':>9s} {'change':>8s} {'eff. rigid':>11s} {'flexible':>9s} "
+          f"{'F1, F2 kN':>14s} {'opening um':>14s}")
+    loops = {name: closed_loop(load_scene(name)) for name in ("band-6+2n", "band-6+2n-flexible")}
+    for ratio in (0.5, 1.0, 1.6, 2.4):
+        out = {}
+        for name, loop in loops.items():
+            loop = loop.with_regime(ratio=ratio)
+            F, q, v, M2 = ratio_holding_state(loop)
+            w1, M1, _ = loop.regime.targets(0.0)
+            out[name] = (F, -M2 * v[3] / (M1 * v[2]), loop.model.face_opening(q).max(axis=1))
+        (Fr, er, _), (Ff, ef, wf) = out.values()
+        print(f"{ratio:6.2f} {Fr[0] / Fr[1]:12.4f} {Ff[0] / Ff[1]:9.4f} {(Ff[0] / Ff[1]) / (Fr[0] / Fr[1]) - 1:+8.2%} "
+              f"{er:11.5f} {ef:9.5f} {Ff[0] / 1e3:6.1f} {Ff[1] / 1e3:6.1f}   {wf[0] * 1e6:5.1f} {wf[1] * 1e6:6.1f}")
+
+
 def main(argv: list[str]) -> None:
     rows = {}
     for name in ("band-6+2n", "band-6+2n-flexible"):
@@ -103,6 +121,8 @@ def main(argv: list[str]) -> None:
         bench()
     if "--convergence" in argv:
         convergence()
+    if "--ratios" in argv:
+        ratios()
     if "--png" in argv:
         import matplotlib
 
