@@ -4,8 +4,8 @@ For each sheave model: the driven clamping force F2 of the clamping schedule, th
 span angle of the target ratio in steady running (root of the span angle's acceleration), then the efficiency
 ``-M2 w2 / (M1 w1)``, the speed ratio, the faces' opening and the running radius along each arc (nominal radius
 plus the band's radial Ritz displacement).  Prints a table; ``--png`` draws the opening and radius change;
-``--bench`` times the right-hand side (median of 7 x 300 calls, interleaved): rigid (compiled kernel and its numpy
-twin) and flexible (numpy); ``--convergence`` repeats the flexible case with other harmonic counts and meshes;
+``--bench`` times the right-hand side (median of 7 x 300 calls, interleaved), rigid and flexible, each compiled
+and as its numpy twin; ``--convergence`` repeats the flexible case with other harmonic counts and meshes;
 ``--ratios`` compares rigid and flexible over the ratio range (same torque and speed).
 
     .venv/bin/python studies/sheaves/band_on_flexible_sheaves.py [--png out.png] [--bench] [--convergence] [--ratios]
@@ -58,7 +58,9 @@ def bench() -> None:
     rigid = closed_loop(load_scene("band-6+2n"))
     loops = {"rigid (numba)": rigid,
              "rigid (numpy twin)": dataclasses.replace(rigid, model=dataclasses.replace(rigid.model, use_numba=False)),
-             "flexible (numpy)": closed_loop(load_scene("band-6+2n-flexible"))}
+             "flexible (numba)": closed_loop(load_scene("band-6+2n-flexible"))}
+    loops["flexible (numpy twin)"] = dataclasses.replace(
+        loops["flexible (numba)"], model=dataclasses.replace(loops["flexible (numba)"].model, use_numba=False))
     x = rigid.initial_state()
     times = {name: [] for name in loops}
     for _ in range(7):

@@ -84,10 +84,30 @@ def test_flexible_sheaves_need_their_section_and_a_band_6_2n_model():
 
 
 def test_rigid_sheaves_run_the_compiled_kernel_unchanged():
-    """Without ``[sheave]`` (or with ``flexibility = "rigid"``) the band model has no faces and runs its compiled
-    kernel: the right-hand side is bitwise that of the scene without the table."""
+    """Without ``[sheave]`` (or with ``flexibility = "rigid"``) the band model has no faces: the right-hand side is
+    bitwise that of the scene without the table."""
     plain = closed_loop(load_scene("band-6+2n"))
     marked = closed_loop(load_scene("band-6+2n", {"sheave": {"flexibility": "rigid"}}))
     assert plain.model.faces is None and marked.model.faces is None
     x = plain.initial_state(ratio=1.3)
     assert np.array_equal(plain.rhs(0.01, x), marked.rhs(0.01, x))
+
+
+def test_compiled_flexible_faces_equal_the_numpy_twin(flexible_loop):
+    """The compiled kernel with flexible faces (Clenshaw for ``c_n(r)``, BLAS for ``K_f``, complex LU for ``A``)
+    against ``accel_numpy`` at random states: accelerations, normal forces, slips and powers within 1e-12 relative or
+    10 x the strain's rounding sensitivity (observed below 0.4 of that), energies to 1e-12."""
+    from tests.band.test_compressible_kernel import _random_states, _rounding_scale
+
+    pytest.importorskip("numba")
+    m = flexible_loop.model
+    assert m.backend == "numba"
+    for q, v, F, M in _random_states(m, np.random.default_rng(5), 3):
+        a1, i1 = m.accel(q, v, F, M)
+        a0, i0 = m.accel_numpy(q, v, F, M)
+        unit = _rounding_scale(m, q, v, F, M)
+        for key, ref, val in [("a", a0, a1)] + [(k, np.asarray(i0[k], float), np.asarray(i1[k], float))
+                                                for k in ("N", "slip", "slip_max", "dissipation", "clamp_power")]:
+            tol = max(1e-12 * np.abs(ref).max(), 10 * unit.get(key, 0.0))
+            assert np.abs(val - ref).max() <= tol, key
+        np.testing.assert_allclose(m.energies(q, v), (m.kinetic_energy(q, v), m.elastic_energy(q)), rtol=1e-12)

@@ -52,7 +52,7 @@ class CompressibleBand:
     ``use_numba``: evaluate :meth:`accel` and :meth:`jacobian` with the compiled kernels of
     ``compressible_kernel`` (when numba is installed); :meth:`accel_numpy` is their reference twin.
     ``faces``: the face compliance of the driving and driven sheaves
-    (:class:`~cvtfem.elements.sheave_face.FaceCompliance`), or None for rigid faces; flexible faces run on numpy.
+    (:class:`~cvtfem.elements.sheave_face.FaceCompliance`), or None for rigid faces.
     """
 
     p: BandParams
@@ -82,7 +82,7 @@ class CompressibleBand:
     @property
     def backend(self) -> str:
         """``"numba"`` (compiled right-hand side) or ``"numpy"`` (numba off or not installed)."""
-        return "numba" if self.use_numba and ker.HAVE_NUMBA and self.faces is None else "numpy"
+        return "numba" if self.use_numba and ker.HAVE_NUMBA else "numpy"
 
     @property
     def n2(self) -> int:
