@@ -60,7 +60,11 @@ def _face_system(fck, frk, ce, r, th, ds):
             b1, b2 = 2 * x * b1 - b2 + fck[n, k], b1
         c = x * b1 - b2 + fck[n, 0]
         for j in range(g):
-            C[n, j], S[n, j] = np.cos(n * th[j]), np.sin(n * th[j])
+            if n < 2:  # cos n theta, sin n theta: directly for n = 0, 1, then by the Chebyshev recurrence
+                C[n, j], S[n, j] = np.cos(n * th[j]), np.sin(n * th[j])
+            else:
+                C[n, j] = 2 * C[1, j] * C[n - 1, j] - C[n - 2, j]
+                S[n, j] = 2 * C[1, j] * S[n - 1, j] - S[n - 2, j]
             cC[n, j], cS[n, j] = c * C[n, j], c * S[n, j]
     K = C.T.copy() @ cC + S.T.copy() @ cS
     A = np.empty((g, g), np.complex128)
@@ -206,11 +210,16 @@ def accel_kernel(q, v, F, Mt, s, sh, sf, xidx, xi, wq, Fs, dF, fc, frng):
                     e += q[xidx[k, x]] * Ec[k, x, j]
                 er[j] = e
             A = _face_system(fc[k], frng[k], ce, rc[k], thc[k], dsc[k])
-            ec = np.linalg.solve(A, er)
+            rhs = np.empty((g, nx + 1), np.complex128)  # one LU: the strain and (real parts) A^-1 E^T
+            rhs[:, 0] = er
+            rhs[:, 1:] = E[k].T
+            X = np.linalg.solve(A, rhs)
             for j in range(g):
-                eps[k, j], deps[k, j] = ec[j].real, ec[j].imag / H
-                Pi_im += (ce * ec[j] * er[j] * dsc[k, j]).imag
-            Ed[k] = np.linalg.solve(np.ascontiguousarray(A.real), np.ascontiguousarray(E[k].T)).T
+                ec = X[j, 0]
+                eps[k, j], deps[k, j] = ec.real, ec.imag / H
+                Pi_im += (ce * ec * er[j] * dsc[k, j]).imag
+                for x in range(nx):
+                    Ed[k, x, j] = X[j, 1 + x].real
         else:
             for j in range(g):
                 e = -z0c[k]
