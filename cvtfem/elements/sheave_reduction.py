@@ -194,7 +194,8 @@ def spin_reduction(model: HarmonicSheave, reduced: ReducedSheave, prestress_unit
     zero = np.zeros((m, m))
     M = np.block([[reduced.M, zero], [zero, reduced.M]])
     K = np.block([[reduced.K, zero], [zero, reduced.K]])
-    K2 = [X.T @ ((h.geometric_stiffness(prestress_unit) - h.spin_softening) @ X) for h, X in ((model, Phi), (twin, Psi))]
+    K2 = [X.T @ ((h.geometric_stiffness(prestress_unit) - h.spin_softening) @ X)
+          for h, X in ((model, Phi), (twin, Psi))]
     K2 = np.block([[0.5 * (K2[0] + K2[0].T), zero], [zero, 0.5 * (K2[1] + K2[1].T)]])
     G = np.block([[zero, C], [Psi.T @ (B @ Phi), zero]])
     J = np.block([[zero, -np.eye(m)], [np.eye(m), zero]])

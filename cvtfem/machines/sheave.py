@@ -154,7 +154,8 @@ def flexible_sheaves(scene: Scene, nodes: np.ndarray, first_extra: int) -> Flexi
             gyroscopic.append(((S[:, None] * gyro[n] * S)[None], np.concatenate(pair_dofs[n])[None]))
         nxt += n_axial + n_torsion + 2 * n_lateral
         kinds += [2] * n_axial + [5] * n_torsion + [0, 1] * n_lateral
-    return FlexibleSheaves(mass, stiffness, gyroscopic, damping, np.array(kinds, dtype=np.int64), tuple(sheave_indices(scene)))
+    return FlexibleSheaves(mass, stiffness, gyroscopic, damping, np.array(kinds, dtype=np.int64),
+                           tuple(sheave_indices(scene)))
 
 
 def cvt_sheave_section(scene: Scene) -> SheaveSection:

@@ -25,7 +25,8 @@ def _rows(n, r, nu):
         w3 = r ** (p - 3) * ((p * (p - 1) * (p - 2) * L + 3 * p * p - 6 * p + 2) if m else p * (p - 1) * (p - 2))
         k2 = n * n
         cols.append([w, w1, w2 + nu * (w1 / r - k2 * w / r ** 2),
-                     w3 + w2 / r - w1 / r ** 2 - k2 * w1 / r ** 2 + 2 * k2 * w / r ** 3 - (1 - nu) * k2 * (w1 - w / r) / r ** 2])
+                     w3 + w2 / r - w1 / r ** 2 - k2 * w1 / r ** 2 + 2 * k2 * w / r ** 3
+                     - (1 - nu) * k2 * (w1 - w / r) / r ** 2])
     return np.array(cols).T
 
 

@@ -94,9 +94,10 @@ def test_rigid_sheaves_run_the_compiled_kernel_unchanged():
 
 
 def test_compiled_flexible_faces_equal_the_numpy_twin(flexible_loop):
-    """The compiled kernel with flexible faces (Clenshaw for ``c_n(r)``, the Chebyshev recurrence for ``cos n theta``, BLAS for ``K_f``, one complex LU for ``A``)
-    against ``accel_numpy`` at random states: accelerations, normal forces, slips and powers within 1e-12 relative or
-    10 x the strain's rounding sensitivity (observed below 0.4 of that), energies to 1e-12."""
+    """The compiled kernel with flexible faces (Clenshaw for ``c_n(r)``, the Chebyshev recurrence for
+    ``cos n theta``, BLAS for ``K_f``, one complex LU for ``A``) against ``accel_numpy`` at random states:
+    accelerations, normal forces, slips and powers within 1e-12 relative or 10 x the strain's rounding sensitivity
+    (observed below 0.4 of that), energies to 1e-12."""
     from tests.band.test_compressible_kernel import _random_states, _rounding_scale
 
     pytest.importorskip("numba")
