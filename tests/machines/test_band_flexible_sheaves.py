@@ -57,7 +57,7 @@ def test_static_state_balances_the_elastic_coordinates(flexible_loop):
 
 def test_stiff_sheaves_tend_to_the_rigid_model():
     """Steady running at the reference regime with sheaves 10 and 40 times as stiff as steel against the rigid
-    model (the compiled kernel, an independent implementation): the gap in the elastic coordinates falls as 1/E
+    model (the kernel's rigid path, untouched by the faces): the gap in the elastic coordinates falls as 1/E
     (log-log slope -1 +- 0.1) and the driven torque moves by less than 1e-3 relative at 40 x."""
     rigid = closed_loop(load_scene("band-6+2n"))
     w1, M1, i = rigid.regime.targets(0.0)
