@@ -127,3 +127,77 @@ def craig_bampton(model: HarmonicSheave, n_modes: int | None, ring_radius: float
     Kr, Mr = basis.T @ (K @ basis), basis.T @ (M @ basis)
     return ReducedSheave(tuple(labels) + tuple(f"mode_{k}" for k in range(n_modes)), 0.5 * (Mr + Mr.T),
                          0.5 * (Kr + Kr.T), basis, np.sqrt(np.maximum(lam, 0.0)) / (2 * np.pi))
+
+
+@dataclass(frozen=True)
+class ReducedSpin:
+    """A reduced harmonic ``n`` and its twin spinning: coordinates ``[cos basis Phi; twin basis P Phi]`` (``P`` turns
+    ``U_theta`` over), each of :attr:`ReducedSheave.labels`.
+
+    Attributes
+    ----------
+    M, K : (2m, 2m) arrays
+        Mass and stiffness of the pair (kg, N/m; block diagonal, both blocks the reduced model's).
+    G_rotating, K2_rotating : (2m, 2m) arrays
+        Per unit spin (kg) the Coriolis coupling of the families and per unit ``Omega^2`` (kg) the prestress
+        stiffness less the spin softening, ``K_sigma(1) - M_c``: in the frame turning with the disc,
+        ``M x'' + Omega G_rotating x' + (K + Omega^2 K2_rotating) x = 0``.
+    G_fixed, K2_fixed : (2m, 2m) arrays
+        The same motion seen by a fixed observer (amplitudes turned by ``n Omega t``, ``J = [[0, -I], [I, 0]]``):
+        ``G_rotating - 2 n M J`` and ``K2_rotating - n (n M + G_rotating J)``.
+    """
+
+    n: int
+    M: np.ndarray
+    K: np.ndarray
+    G_rotating: np.ndarray
+    K2_rotating: np.ndarray
+    G_fixed: np.ndarray
+    K2_fixed: np.ndarray
+
+    def waves(self, omega: float, frame: str = "rotating") -> np.ndarray:
+        """Frequencies (Hz, ascending, non-negative imaginary parts of the eigenvalues) of the reduced pair spinning
+        at ``omega`` (rad/s) in the ``"rotating"`` or ``"fixed"`` frame; a backward wave past the critical speed
+        comes out with its frequency's magnitude."""
+        G, K2 = (self.G_rotating, self.K2_rotating) if frame == "rotating" else (self.G_fixed, self.K2_fixed)
+        m = self.M.shape[0]
+        A = np.block([[np.zeros((m, m)), np.eye(m)], [-(self.K + omega ** 2 * K2), -omega * G]])
+        B = np.block([[np.eye(m), np.zeros((m, m))], [np.zeros((m, m)), self.M]])
+        lam = sla.eigvals(A, B)
+        return np.sort(np.abs(lam.imag[lam.imag >= -1e-9 * np.abs(lam).max()])) / (2 * np.pi)
+
+    def critical_speeds(self) -> np.ndarray:
+        """Spin speeds (rad/s, ascending) at which the fixed-frame stiffness ``K + Omega^2 K2_fixed`` is singular: a
+        wave stands still for the fixed observer (the backward wave of ``n`` diameters meets zero)."""
+        mu = sla.eigvals(self.K, -self.K2_fixed)
+        real = mu.real[(np.abs(mu.imag) <= 1e-9 * np.abs(mu)) & (mu.real > 0) & np.isfinite(mu.real)]
+        return np.sort(np.sqrt(real))
+
+
+def spin_reduction(model: HarmonicSheave, reduced: ReducedSheave, prestress_unit) -> ReducedSpin:  # noqa: ANN001
+    """Project the spinning disc's Coriolis, prestress and spin-softening matrices of harmonic ``model`` (family
+    ``cos``, ``n >= 1``) on the Craig–Bampton basis of ``reduced`` and its twin.  ``prestress_unit`` is the
+    axisymmetric stress at 1 rad/s (:meth:`HarmonicSheave.stress` of the ``n = 0`` model's
+    :meth:`~HarmonicSheave.centrifugal_displacement` at 1 rad/s): the linear prestress scales with ``Omega^2``."""
+    from dataclasses import replace
+
+    if model.family != "cos" or model.n < 1:
+        raise InputError("model", (model.n, model.family), "must be a 'cos' harmonic with n >= 1 (twins travel)")
+    twin = replace(model, family="sin")
+    flip = np.ones(model.basis.N)
+    flip[model.basis.split_indices()[1]] = -1.0
+    Phi = reduced.basis
+    Psi = flip[:, None] * Phi                                       # P Phi: the twin's coordinates
+    B = model.coriolis
+    C = Phi.T @ (B @ Psi)
+    m = Phi.shape[1]
+    zero = np.zeros((m, m))
+    M = np.block([[reduced.M, zero], [zero, reduced.M]])
+    K = np.block([[reduced.K, zero], [zero, reduced.K]])
+    K2 = [X.T @ ((h.geometric_stiffness(prestress_unit) - h.spin_softening) @ X)
+          for h, X in ((model, Phi), (twin, Psi))]
+    K2 = np.block([[0.5 * (K2[0] + K2[0].T), zero], [zero, 0.5 * (K2[1] + K2[1].T)]])
+    G = np.block([[zero, C], [Psi.T @ (B @ Phi), zero]])
+    J = np.block([[zero, -np.eye(m)], [np.eye(m), zero]])
+    n = model.n
+    return ReducedSpin(n, M, K, G, K2, G - 2 * n * M @ J, K2 - n * (n * M + G @ J))

@@ -173,7 +173,14 @@ def band_model(scene: Scene, **overrides: Any):
     if model == "band-1dof":
         raise InputError("cvt.model", model, "is the static equilibrium model and has no time run",
                          "use a dynamic band model (band-4dof, band-6+2n, band-6+2n+8)")
-    return model_for(model, band_params(scene, **overrides))
+    band = model_for(model, band_params(scene, **overrides))
+    if scene.sheave is not None and scene.sheave.flexibility != "rigid":  # issue 20: sheave faces give way
+        import dataclasses
+
+        from cvtfem.machines.sheave import band_faces
+
+        band = dataclasses.replace(band, faces=band_faces(scene))
+    return band
 
 
 def check_ratio_range(scene: Scene, p=None) -> tuple[float, float]:

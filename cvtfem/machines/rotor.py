@@ -295,7 +295,8 @@ def build_model(scene: Scene) -> RotorModel:
     K = assemble(n, [(Kshaft, beam.dofs), (bearings.stiffness(), bearings.dofs), (conn, conn_dofs),
                      *(flexible.stiffness if flexible else ())])
     beta = opts.damping_beta if opts else 0.0
-    C = assemble(n, [(bearings.damping(), bearings.dofs), (beta * Kshaft, beam.dofs)])
+    C = assemble(n, [(bearings.damping(), bearings.dofs), (beta * Kshaft, beam.dofs),
+                     *(flexible.damping if flexible else ())])
     G = assemble(n, [(beam.gyroscopic(), beam.dofs), (disks.gyroscopic()[rigid], disks.dofs[rigid]),
                      (bearings.gyroscopic(), bearings.dofs), *(flexible.gyroscopic if flexible else ())])
     z = np.concatenate([[0.0], np.cumsum(arrays["L"]), np.zeros(len(elastic))])

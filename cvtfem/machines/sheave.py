@@ -52,9 +52,10 @@ class FlexibleSheaves:
 
     Attributes
     ----------
-    mass, stiffness, gyroscopic : list of (blocks (1, m, m), dofs (1, m))
+    mass, stiffness, gyroscopic, damping : list of (blocks (1, m, m), dofs (1, m))
         Families for :func:`cvtfem.assembly.assemble` (kg, kg m, kg m^2; N/m, N m/rad; per unit spin speed;
-        modal coordinates of unit modal mass).
+        modal coordinates of unit modal mass); ``damping`` is ``2 zeta omega_k`` (1/s) on each fixed-interface
+        mode, ``zeta`` the scene's ``sheave.damping_ratio``.
     kinds : int array (n_extra,)
         Node DOF kind (0..5) given to each modal coordinate: ``n = 1`` modes as u1 (``cos``) and u2 (the twin,
         interleaved so that each pair is one orbit), ``n = 0`` modes as u3 (umbrella/axial) and phi (torsion).
@@ -65,6 +66,7 @@ class FlexibleSheaves:
     mass: list
     stiffness: list
     gyroscopic: list
+    damping: list
     kinds: np.ndarray
     disks: tuple[int, ...]
 
@@ -114,7 +116,7 @@ def flexible_sheaves(scene: Scene, nodes: np.ndarray, first_extra: int) -> Flexi
 
     opts = scene.sheave
     n_modes = None if opts.flexibility == "full" else opts.modes
-    mass, stiffness, gyroscopic, kinds = [], [], [], []
+    mass, stiffness, gyroscopic, damping, kinds = [], [], [], [], []
     nxt = first_extra
     for i in sheave_indices(scene):
         d = scene.disk[i]
@@ -141,6 +143,9 @@ def flexible_sheaves(scene: Scene, nodes: np.ndarray, first_extra: int) -> Flexi
             dofs = np.concatenate([6 * nodes[i] + np.array(node_dofs), own])
             mass.append(((S[:, None] * red.M * S)[None], dofs[None]))
             stiffness.append(((S[:, None] * red.K * S)[None], dofs[None]))
+            if opts.damping_ratio > 0.0 and n_own:  # modal damping of the fixed-interface modes (unit modal mass)
+                omega = np.sqrt(np.maximum(np.diag(red.K)[-n_own:], 0.0))
+                damping.append((np.diag(2 * opts.damping_ratio * omega)[None], own[None]))
             pair_dofs[n].append(dofs)
             pair_signs[n].append(S)
         for n in (0, 1):
@@ -149,4 +154,38 @@ def flexible_sheaves(scene: Scene, nodes: np.ndarray, first_extra: int) -> Flexi
             gyroscopic.append(((S[:, None] * gyro[n] * S)[None], np.concatenate(pair_dofs[n])[None]))
         nxt += n_axial + n_torsion + 2 * n_lateral
         kinds += [2] * n_axial + [5] * n_torsion + [0, 1] * n_lateral
-    return FlexibleSheaves(mass, stiffness, gyroscopic, np.array(kinds, dtype=np.int64), tuple(sheave_indices(scene)))
+    return FlexibleSheaves(mass, stiffness, gyroscopic, damping, np.array(kinds, dtype=np.int64),
+                           tuple(sheave_indices(scene)))
+
+
+def cvt_sheave_section(scene: Scene) -> SheaveSection:
+    """The section of a CVT scene's sheaves: bore, hub and rim from ``[sheave]``, the outer radius, face and flank
+    angle from ``cvt.geometry`` (a toroidal face as the arc of ``torus_radius`` through the face's end points)."""
+    opts, g = scene.sheave, scene.cvt.geometry
+    for name in ("bore_diameter", "hub_diameter", "rim_thickness"):
+        if not opts[name] > 0.0:
+            raise InputError(f"sheave.{name}", opts[name], "must be given (> 0) for flexible sheaves in a CVT scene")
+    return SheaveSection(bore_radius=opts.bore_diameter / 2, hub_radius=opts.hub_diameter / 2,
+                         outer_radius=g.sheave_outer_radius, hub_length=opts.hub_length,
+                         rim_thickness=opts.rim_thickness, flank_angle=g.flank_angle, face=g.sheave_profile,
+                         torus_radius=g.torus_radius, E=opts.young_modulus or scene.cvt.young_modulus,
+                         nu=opts.poisson_ratio, rho=opts.density)
+
+
+def band_faces(scene: Scene):  # noqa: ANN201 - tuple of FaceCompliance or None
+    """The face compliance of a band-model CVT scene's sheaves (``[sheave] flexibility = "reduced"``), one per
+    pulley, over the contact radii ``cvt.geometry.r_min..r_max``; None for rigid sheaves (no sheave code runs)."""
+    opts = scene.sheave
+    if opts is None or opts.flexibility == "rigid":
+        return None
+    model = scene.cvt.model
+    if opts.flexibility != "reduced" or model not in ("band-6+2n", "band-6+2n+8"):
+        raise InputError("sheave.flexibility", opts.flexibility,
+                         f"must be 'rigid' for `{model}`: the band-6+2n models run on 'reduced' sheaves "
+                         "(the faces' static compliance under the contact arcs); chain models and 'full' not yet")
+    from cvtfem.elements.sheave_face import face_compliance
+
+    g = scene.cvt.geometry
+    faces = face_compliance(cvt_sheave_section(scene), g.r_min, g.r_max, opts.harmonics,
+                            (opts.cells_radial, opts.cells_axial))
+    return faces, faces

@@ -17,6 +17,11 @@ sheave pair, components along i, j).
   friction forces, so friction only dissipates (``D = -Q^f . q' >= 0``).
 * Band damping: Rayleigh function ``beta c' int eps'^2 ds`` with ``beta = 2 nu / omega_z``; shaft
   damping (6+2n+8): ``2 nu sqrt(c m)`` on each shift and tilt (effects.damping, ratio ``damping_ratio``).
+* Flexible sheaves (``faces``, issue 20): the faces open under the arc's own edge forces, quasi-statically:
+  ``eps = eps_r + w``, ``w = -c' K_f D eps`` (``eps_r`` the strain on rigid faces, ``K_f`` the face compliance
+  between the Gauss nodes, :class:`~cvtfem.elements.sheave_face.FaceCompliance`, ``D`` the arc-length weights),
+  so ``eps = A^-1 eps_r`` with ``A = I + c' K_f D``; the sheaves' strain energy joins the band's,
+  ``V = c' int eps eps_r ds`` (the minimum over ``w``), whose gradient in ``x`` is ``2 c' int E eps ds``.
 """
 from __future__ import annotations
 
@@ -46,11 +51,14 @@ class CompressibleBand:
 
     ``use_numba``: evaluate :meth:`accel` and :meth:`jacobian` with the compiled kernels of
     ``compressible_kernel`` (when numba is installed); :meth:`accel_numpy` is their reference twin.
+    ``faces``: the face compliance of the driving and driven sheaves
+    (:class:`~cvtfem.elements.sheave_face.FaceCompliance`), or None for rigid faces.
     """
 
     p: BandParams
     shaft_compliance: bool = False
     use_numba: bool = True
+    faces: tuple | None = None
     _c: dict = field(init=False, repr=False, default_factory=dict)
 
     def __post_init__(self) -> None:
@@ -130,6 +138,9 @@ class CompressibleBand:
             rows.append(np.stack([-tg[:, None] * cs, -tg[:, None] * sn, lev * sn, -lev * cs], axis=1))
             geo.update(a=a, cs=cs, sn=sn)
         geo["E"] = np.concatenate(rows, axis=1)  # (2, nx, g): d eps / d x_k at the nodes
+        if self.faces is not None:  # A = I + c' K_f D per arc (flexible sheaves)
+            geo["A"] = np.stack([np.eye(len(c["xi"])) + c["c_edge"] * self.faces[k].matrix(r[k], th[k]) * geo["ds"][k]
+                                 for k in range(2)])
         return geo
 
     def band_mass(self, phi, geo=None):
@@ -149,9 +160,16 @@ class CompressibleBand:
         return M
 
     def strain(self, q, geo):
-        """Band-edge strain ``eps`` at the nodes, ``(2, g)`` (1.55) / (1.63)."""
+        """Band-edge strain ``eps`` at the nodes on rigid faces, ``(2, g)`` (1.55) / (1.63)."""
         X = q[self._c["xidx"]]  # (2, nx)
         return np.einsum("kx,kxg->kg", X, geo["E"]) - geo["z0"][:, None]
+
+    def face_opening(self, q, geo=None):
+        """Axial opening ``w = eps - eps_r`` (m, ``(2, g)``) of each sheave face at the arc's Gauss nodes (zero on
+        rigid faces); ``> 0`` where the face gives way under the band."""
+        g = self.arcs(q[0]) if geo is None else geo
+        eps_r = self.strain(q, g)
+        return np.linalg.solve(g["A"], eps_r[..., None])[..., 0] - eps_r if "A" in g else np.zeros_like(eps_r)
 
     def accel(self, q, v, F, M):
         """Accelerations and diagnostics (``N`` (2, g) N/m, ``dissipation``, ``clamp_power`` W, slips)."""
@@ -198,10 +216,16 @@ class CompressibleBand:
         gc = self.arcs(phi + 1j * H)
         g = {k: (val.real if val.dtype.kind == "c" else val) for k, val in gc.items()}
         eps_c = self.strain(q, gc)
+        E_eps = g["E"]  # d eps / d x at the nodes
+        if self.faces is None:
+            Pi_c = c["c_edge"] * np.sum(eps_c ** 2 * gc["ds"])
+        else:  # flexible faces: eps = A^-1 eps_r, V = c' int eps eps_r ds
+            eps_r_c, eps_c = eps_c, np.linalg.solve(gc["A"], eps_c[..., None])[..., 0]
+            Pi_c = c["c_edge"] * np.sum(eps_c * eps_r_c * gc["ds"])
+            E_eps = np.swapaxes(np.linalg.solve(g["A"], np.swapaxes(g["E"], 1, 2)), 1, 2)
         eps, deps = eps_c.real, eps_c.imag / H
         Q = np.zeros(n2)
         # elastic band energy and its generalized forces
-        Pi_c = c["c_edge"] * np.sum(eps_c ** 2 * gc["ds"])
         Q[0] -= Pi_c.imag / H
         xidx = c["xidx"]
         Q[xidx] -= 2 * c["c_edge"] * np.einsum("kxg,kg->kx", g["E"], eps * g["ds"])
@@ -218,10 +242,10 @@ class CompressibleBand:
                     Q[b:b + 4] -= d * v[b:b + 4]
                     dissipation += float(np.sum(d * v[b:b + 4] ** 2))
         if c["beta"] > 0:
-            deps_dt = deps * v[0] + np.einsum("kx,kxg->kg", v[xidx], g["E"])
+            deps_dt = deps * v[0] + np.einsum("kx,kxg->kg", v[xidx], E_eps)
             Qd = np.zeros(n2)
             Qd[0] = -2 * c["beta"] * c["c_edge"] * np.sum(deps_dt * deps * g["ds"])
-            Qd[xidx] = -2 * c["beta"] * c["c_edge"] * np.einsum("kxg,kg->kx", g["E"], deps_dt * g["ds"])
+            Qd[xidx] = -2 * c["beta"] * c["c_edge"] * np.einsum("kxg,kg->kx", E_eps, deps_dt * g["ds"])
             dissipation -= float(Qd @ v)
             Q += Qd
         info = {"N": np.zeros_like(eps), "eps": eps}
@@ -337,7 +361,11 @@ class CompressibleBand:
         of :meth:`energies`."""
         p, n = self.p, self.p.n_ritz
         g = self.arcs(q[0])
-        E = self._c["c_edge"] * np.sum(self.strain(q, g) ** 2 * g["ds"])
+        eps = self.strain(q, g)
+        if self.faces is None:
+            E = self._c["c_edge"] * np.sum(eps ** 2 * g["ds"])
+        else:  # the band's and the sheaves' strain energy, c' int eps eps_r ds
+            E = self._c["c_edge"] * np.sum((eps + self.face_opening(q, g)) * eps * g["ds"])
         if self.shaft_compliance:
             b = 6 + 2 * n
             for k in range(2):
@@ -360,8 +388,13 @@ class CompressibleBand:
         q[0] = phi
         for k in range(2):
             E, ds = g["E"][k], g["ds"][k]
-            K = 2 * c["c_edge"] * (E * ds) @ E.T
-            rhs = 2 * c["c_edge"] * (E @ (g["z0"][k] * ds))
+            if "A" not in g:
+                K = 2 * c["c_edge"] * (E * ds) @ E.T
+                rhs = 2 * c["c_edge"] * (E @ (g["z0"][k] * ds))
+            else:  # flexible faces: V = c' eps_r^T W eps_r, W = D A^-1 = (D^-1 A^T)^-1 = (D^-1 + c' K_f)^-1
+                W = np.linalg.inv(np.diag(1.0 / ds) @ g["A"][k].T)
+                K = 2 * c["c_edge"] * E @ W @ E.T
+                rhs = 2 * c["c_edge"] * (E @ W @ np.full_like(ds, g["z0"][k]))
             rhs[0] -= p.kappa * F[k]
             if self.shaft_compliance:
                 K[1 + n:, 1 + n:] += np.diag([p.c_U[k]] * 2 + [p.c_psi[k]] * 2)

@@ -8,7 +8,9 @@ Without numba (``HAVE_NUMBA`` false) the model uses its numpy methods.
 
 Parameters are packed by :func:`pack`: ``s`` (scalars, index constants ``S_*``), ``sh`` (2, 5) sheave
 faces ``[profile (0 conical, 1 toroidal), gamma, R, y, w]``, ``sf`` (2, 5) shafts
-``[J, m_sheave, Theta, c_U, c_psi]``, ``xidx`` (2, nx) elastic-coordinate indices, and the Ritz shapes.
+``[J, m_sheave, Theta, c_U, c_psi]``, ``xidx`` (2, nx) elastic-coordinate indices, the Ritz shapes, and the
+flexible sheave faces (issue 20): ``fc`` (2, H + 1, d + 1) Chebyshev coefficients of each pulley's face
+compliance ``c_n(r)`` and ``fr`` (2, 2) their radius ranges (``S_FLEX`` = 0: rigid faces, not read).
 Complex powers are written as products: numba's complex ``z ** k`` goes through exp/log, whose
 rounding (~1e-16 |z|^k in the imaginary part) swamps a 1e-30 complex step.
 """
@@ -22,18 +24,55 @@ H = 1e-30  # complex step, as in compressible.py
 LAW_CODES = {"tanh": 0, "smoothed": 1, "linear-saturated": 2}
 # scalar slots of ``s``
 (S_LENGTH, S_L, S_MASS, S_RHO, S_CEDGE, S_C, S_KAPPA, S_BETA, S_F0, S_V0, S_LAW, S_FRICTION, S_SHAFT,
- S_DAMPING, S_GYRO, S_NU) = range(16)
+ S_DAMPING, S_GYRO, S_NU, S_FLEX) = range(17)
 
 
 def pack(model) -> tuple:
     """Kernel arguments of a :class:`CompressibleBand` (arrays only, built once per model)."""
     p, c = model.p, model._c
     s = np.array([p.length, p.L, p.mass, p.rho, c["c_edge"], p.c, p.kappa, c["beta"], p.f0, p.v0,
-                  LAW_CODES[p.law], p.friction, model.shaft_compliance, p.damping, p.gyroscopic, p.damping_ratio],
-                 dtype=float)
+                  LAW_CODES[p.law], p.friction, model.shaft_compliance, p.damping, p.gyroscopic, p.damping_ratio,
+                  model.faces is not None], dtype=float)
     sh = np.array([[0.0 if f.profile == "conical" else 1.0, f.gamma, f.R, f.y, f.w] for f in p.sheaves])
     sf = np.array([[p.J[k], p.m_sheave[k], p.Theta[k], p.c_U[k], p.c_psi[k]] for k in range(2)])
-    return s, sh, sf, np.ascontiguousarray(c["xidx"]), c["xi"], c["wq"], c["F"], c["dF"]
+    if model.faces is None:
+        fc, fr = np.zeros((2, 1, 1)), np.array([[0.0, 1.0], [0.0, 1.0]])
+    else:
+        fc = np.ascontiguousarray(np.stack([f.coef for f in model.faces]))
+        fr = np.array([[f.r_lo, f.r_hi] for f in model.faces])
+    return s, sh, sf, np.ascontiguousarray(c["xidx"]), c["xi"], c["wq"], c["F"], c["dF"], fc, fr
+
+
+@njit(cache=True)
+def _face_system(fck, frk, ce, r, th, ds):
+    """``A = I + c' K_f D`` of one arc (complex, (g, g)) as ``CompressibleBand.arcs``: the face compliance
+    ``c_n(r)`` by Clenshaw's recurrence, ``K_f = C^T diag(c) C + S^T diag(c) S`` symmetrised."""
+    x = (2 * r - (frk[0] + frk[1])) / (frk[1] - frk[0])
+    nh, nd = fck.shape
+    g = th.size
+    C = np.empty((nh, g), np.complex128)
+    S = np.empty((nh, g), np.complex128)
+    cC = np.empty((nh, g), np.complex128)
+    cS = np.empty((nh, g), np.complex128)
+    for n in range(nh):
+        b1, b2 = 0j, 0j
+        for k in range(nd - 1, 0, -1):
+            b1, b2 = 2 * x * b1 - b2 + fck[n, k], b1
+        c = x * b1 - b2 + fck[n, 0]
+        for j in range(g):
+            if n < 2:  # cos n theta, sin n theta: directly for n = 0, 1, then by the Chebyshev recurrence
+                C[n, j], S[n, j] = np.cos(n * th[j]), np.sin(n * th[j])
+            else:
+                C[n, j] = 2 * C[1, j] * C[n - 1, j] - C[n - 2, j]
+                S[n, j] = 2 * C[1, j] * S[n - 1, j] - S[n - 2, j]
+            cC[n, j], cS[n, j] = c * C[n, j], c * S[n, j]
+    K = C.T.copy() @ cC + S.T.copy() @ cS
+    A = np.empty((g, g), np.complex128)
+    for i in range(g):
+        for j in range(g):
+            A[i, j] = ce * 0.5 * (K[i, j] + K[j, i]) * ds[j]
+        A[i, i] += 1.0
+    return A
 
 
 @njit(cache=True)
@@ -143,7 +182,7 @@ def _gain(x, law):
 
 
 @njit(cache=True)
-def accel_kernel(q, v, F, Mt, s, sh, sf, xidx, xi, wq, Fs, dF):
+def accel_kernel(q, v, F, Mt, s, sh, sf, xidx, xi, wq, Fs, dF, fc, frng):
     """Accelerations ``a`` (n2,), normal force ``N`` (2, g) N/m, strain ``eps`` (2, g), circumferential slip
     at the arc middles and largest slip per arc (2,) m/s, dissipation and clamping power (W); the numpy
     ``CompressibleBand.accel`` statement by statement."""
@@ -158,13 +197,36 @@ def accel_kernel(q, v, F, Mt, s, sh, sf, xidx, xi, wq, Fs, dF):
     eps = np.empty((2, g))
     deps = np.empty((2, g))
     Pi_im = 0.0
+    flex = s[S_FLEX] != 0.0
+    Ed = E  # d eps / d x at the nodes (flexible faces: A^-1 E^T)
+    if flex:
+        Ed = np.empty((2, nx, g))
     for k in range(2):
-        for j in range(g):
-            e = -z0c[k]
-            for x in range(nx):
-                e += q[xidx[k, x]] * Ec[k, x, j]
-            eps[k, j], deps[k, j] = e.real, e.imag / H
-            Pi_im += (ce * e * e * dsc[k, j]).imag
+        if flex:  # eps = A^-1 eps_r, V = c' int eps eps_r ds (as CompressibleBand.accel_numpy)
+            er = np.empty(g, np.complex128)
+            for j in range(g):
+                e = -z0c[k]
+                for x in range(nx):
+                    e += q[xidx[k, x]] * Ec[k, x, j]
+                er[j] = e
+            A = _face_system(fc[k], frng[k], ce, rc[k], thc[k], dsc[k])
+            rhs = np.empty((g, nx + 1), np.complex128)  # one LU: the strain and (real parts) A^-1 E^T
+            rhs[:, 0] = er
+            rhs[:, 1:] = E[k].T
+            X = np.linalg.solve(A, rhs)
+            for j in range(g):
+                ec = X[j, 0]
+                eps[k, j], deps[k, j] = ec.real, ec.imag / H
+                Pi_im += (ce * ec * er[j] * dsc[k, j]).imag
+                for x in range(nx):
+                    Ed[k, x, j] = X[j, 1 + x].real
+        else:
+            for j in range(g):
+                e = -z0c[k]
+                for x in range(nx):
+                    e += q[xidx[k, x]] * Ec[k, x, j]
+                eps[k, j], deps[k, j] = e.real, e.imag / H
+                Pi_im += (ce * e * e * dsc[k, j]).imag
         for x in range(nx):
             acc = 0.0
             for j in range(g):
@@ -193,13 +255,13 @@ def accel_kernel(q, v, F, Mt, s, sh, sf, xidx, xi, wq, Fs, dF):
             for j in range(g):
                 acc = deps[k, j] * v[0]
                 for x in range(nx):
-                    acc += v[xidx[k, x]] * E[k, x, j]
+                    acc += v[xidx[k, x]] * Ed[k, x, j]
                 dd[j] = acc
                 Qd[0] -= 2 * beta * ce * acc * deps[k, j] * ds[k, j]
             for x in range(nx):
                 acc = 0.0
                 for j in range(g):
-                    acc += E[k, x, j] * dd[j] * ds[k, j]
+                    acc += Ed[k, x, j] * dd[j] * ds[k, j]
                 Qd[xidx[k, x]] = -2 * beta * ce * acc
         for i in range(n2):
             dissipation -= Qd[i] * v[i]
@@ -312,7 +374,7 @@ def _solve(q, v, Q, s, sf, rc, drc, thc, dsc, frc, Fs, phic, shaft):
 
 
 @njit(cache=True)
-def jacobian_kernel(q, v, F, Mt, s, sh, sf, xidx, xi, wq, Fs, dF):
+def jacobian_kernel(q, v, F, Mt, s, sh, sf, xidx, xi, wq, Fs, dF, fc, frng):
     """Forward-difference Jacobian of ``y = [a, dissipation, clamp_power]`` (n2 + 2) with respect to
     ``[q, v, F, M]`` (2 n2 + 4 columns); the rotation angles q[1:4] never enter, their columns are 0.
 
@@ -320,7 +382,7 @@ def jacobian_kernel(q, v, F, Mt, s, sh, sf, xidx, xi, wq, Fs, dF):
     for velocities; ``y`` is affine in F and M, so their columns are exact to rounding.
     """
     n2 = q.size
-    a0, _, _, _, _, d0, c0 = accel_kernel(q, v, F, Mt, s, sh, sf, xidx, xi, wq, Fs, dF)
+    a0, _, _, _, _, d0, c0 = accel_kernel(q, v, F, Mt, s, sh, sf, xidx, xi, wq, Fs, dF, fc, frng)
     Jm = np.zeros((n2 + 2, 2 * n2 + 4))
     for col in range(2 * n2 + 4):
         if 1 <= col <= 3:
@@ -338,7 +400,7 @@ def jacobian_kernel(q, v, F, Mt, s, sh, sf, xidx, xi, wq, Fs, dF):
         else:
             h = 1e-6 * max(1.0, abs(Mt[col - 2 * n2 - 2]))
             Mp[col - 2 * n2 - 2] += h
-        a1, _, _, _, _, d1, c1 = accel_kernel(qp, vp, Fp, Mp, s, sh, sf, xidx, xi, wq, Fs, dF)
+        a1, _, _, _, _, d1, c1 = accel_kernel(qp, vp, Fp, Mp, s, sh, sf, xidx, xi, wq, Fs, dF, fc, frng)
         for i in range(n2):
             Jm[i, col] = (a1[i] - a0[i]) / h
         Jm[n2, col] = (d1 - d0) / h
@@ -347,7 +409,7 @@ def jacobian_kernel(q, v, F, Mt, s, sh, sf, xidx, xi, wq, Fs, dF):
 
 
 @njit(cache=True)
-def energy_kernel(q, v, s, sh, sf, xidx, xi, wq, Fs, dF):
+def energy_kernel(q, v, s, sh, sf, xidx, xi, wq, Fs, dF, fc, frng):
     """Kinetic and elastic energy ``(T, V)``, J, as ``CompressibleBand.kinetic_energy`` and ``elastic_energy``
     (real geometry: the complex kernels at ``phi + 0j``; strain summed as the numpy twin's, ``E^T x - z0``)."""
     n, g = Fs.shape
@@ -382,12 +444,21 @@ def energy_kernel(q, v, s, sh, sf, xidx, xi, wq, Fs, dF):
     E, ds, z0 = Ec.real, dsc.real, z0c.real
     V = 0.0
     for k in range(2):
+        er = np.empty(g)
         for j in range(g):
             e = 0.0
             for x in range(nx):
                 e += q[xidx[k, x]] * E[k, x, j]
             e -= z0[k]
-            V += e * e * ds[k, j]
+            er[j] = e
+        if s[S_FLEX] != 0.0:  # the band's and the sheaves' strain energy, c' int eps eps_r ds
+            A = _face_system(fc[k], frng[k], s[S_CEDGE], rc[k], thc[k], dsc[k]).real
+            ef = np.linalg.solve(np.ascontiguousarray(A), er)
+            for j in range(g):
+                V += ef[j] * er[j] * ds[k, j]
+        else:
+            for j in range(g):
+                V += er[j] * er[j] * ds[k, j]
     V *= s[S_CEDGE]
     if shaft:
         for k in range(2):

@@ -46,6 +46,10 @@ ROTOR = Table("rotor", "Rotor model options (beam theory, switches, damping, ana
     Key("n_modes", "int", "Default number of modes reported.", "-", 12, ge=1),
 ), optional=True)
 
+#: ``[sheave]`` keys a CVT scene gives its sheaves' section with (the outer radius and face are `cvt.geometry`'s).
+CVT_SECTION = (("bore_diameter", "bore diameter"), ("hub_diameter", "hub outer diameter"),
+               ("hub_length", "hub length behind the disc"), ("rim_thickness", "thickness at the outer radius"))
+
 SHEAVE = Table("sheave", "Sheave disks (`[[disk]]` with geometry = 'sheave') as rigid bodies or flexible solids.", (
     Key("flexibility", "str", "Rigid: the disk's mass properties only (no sheave FE code runs); reduced: a "
         "solid model per nodal-diameter harmonic n = 0, 1 on the shaft node, Craig-Bampton reduced; full: the "
@@ -57,6 +61,16 @@ SHEAVE = Table("sheave", "Sheave disks (`[[disk]]` with geometry = 'sheave') as 
     Key("cells_axial", "int", "Section mesh: layers from the back face to the contact face.", "-", 2, ge=1, le=40),
     Key("diameters", "int", "The sheaves' own waves of n = 2..diameters nodal diameters drawn by `cvtfem campbell` "
         "(forward and backward; they do not couple with the shaft).", "-", 4, ge=1, le=40),
+    Key("damping_ratio", "float", "Rotor scenes: modal damping ratio of each fixed-interface mode of a reduced "
+        "or full sheave (C = 2 zeta omega_k on its modal coordinate).", "-", 0.0, ge=0.0, lt=1.0),
+    Key("harmonics", "int", "CVT scenes (band-6+2n models): nodal-diameter harmonics 0..harmonics of the sheave "
+        "face's compliance under the contact arcs.", "-", 24, ge=1, le=200),
+    *(Key(name, "float", f"CVT scenes: {doc} of the sheaves (rotor scenes take their sections from [[disk]]); "
+          "required with flexibility = 'reduced'.", "m", 0.0, ge=0.0) for name, doc in CVT_SECTION),
+    Key("young_modulus", "float", "CVT scenes: Young's modulus of the sheaves (0: `cvt.young_modulus`).", "Pa",
+        0.0, ge=0.0, le=1e13),
+    Key("poisson_ratio", "float", "CVT scenes: Poisson's ratio of the sheaves.", "-", 0.3, gt=-1.0, lt=0.5),
+    Key("density", "float", "CVT scenes: density of the sheaves.", "kg/m^3", 7850.0, ge=1.0, le=1e5),
 ), optional=True)
 
 DISK = TableArray("disk", "Rigid disks / sheaves on shaft nodes.", Table("disk", "A rigid disk or sheave.", (
@@ -166,6 +180,10 @@ def check_rotor(scene: Mapping[str, Any], path: str) -> None:
     if flexibility != "rigid" and not any(d["geometry"] == "sheave" for d in scene["disk"]):
         raise InputError("sheave.flexibility", flexibility, "needs a [[disk]] with geometry = 'sheave' "
                          "(or flexibility = 'rigid')")
+    for name in [n for n, _ in CVT_SECTION] + ["young_modulus"]:
+        if (scene.get("sheave") or {}).get(name, 0.0):
+            raise InputError(f"sheave.{name}", scene["sheave"][name], "must be left out of a rotor scene: its "
+                             "sheaves take their sections from [[disk]] (the key is for CVT scenes)")
     if (scene["disk"] or scene["bearing"]) and not scene["shaft"]:
         raise InputError("shaft", [], "needs at least one entry when disks or bearings are given")
 
