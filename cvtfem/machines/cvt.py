@@ -238,9 +238,10 @@ def chain_refusal(scene: Scene) -> InputError | None:
     if model != "chain-S2" and not eff.pin_bending:
         return InputError("cvt.effects.pin_bending", False, f"must be true for `{model}` (its pins bend); "
                           "without pin bending use `chain-S2`")
-    if eff.shaft_elasticity:
-        return InputError("cvt.effects.shaft_elasticity", True, f"is not available for `{model}` yet: the chain "
-                          "runs on rigid shafts (set it false)")
+    if eff.shaft_elasticity and (model not in ("chain-S2", "chain-S3") or eff.contact != "hertz"):
+        return InputError("cvt.effects.shaft_elasticity", True, f"is not available for `{model}` with contact "
+                          f"'{eff.contact}' yet: elastic shafts run under chain-S2 and chain-S3 with H1 contact "
+                          "('hertz'; set it false for the others)")
     if eff.contact not in ("hertz", "hertz-refined"):
         return InputError("cvt.effects.contact", eff.contact, f"must be 'hertz' or 'hertz-refined' for `{model}`: Hertz "
                           "contact at the pin-axis end or refined (the rigid and impact contacts are not coupled to a "
@@ -278,7 +279,21 @@ def chain_loop(scene: Scene):
     clamping = Clamping(band_params(scene), rg.clamping_safety, rg.clamping_split, rg.min_clamping_force)
     F_appl = clamping.forces(rg.torque, rg.ratio)
     overrides = {} if eff.damping else {"damping_ratio": 0.0}
+    if eff.shaft_elasticity:
+        from cvtfem.machines.chain_cvt_elastic import from_scene as elastic_from_scene
+        return elastic_from_scene(scene, chain_geometry(scene), F_appl, model=model, contact=eff.contact, **overrides)
     return from_scene(scene, chain_geometry(scene), F_appl, model=model, contact=eff.contact, **overrides)
+
+
+def _pulley_layouts(model, outputs, sheave: str) -> list[Layout]:
+    """The two pulleys of a running chain: rigid shafts (2 coordinates) or the elastic structure block."""
+    structure = getattr(model, "structure", None)
+    if structure is None:
+        return [Layout(f"{name} pulley", "rigid-shaft", 2, outputs=outputs(f"{name}."),
+                       note=f"spin angle, {sheave} axial") for name in ("driving", "driven")]
+    return [Layout(f"{name} pulley", "beam-shaft+rigid-sheaves", 6 * len(x) + 1, outputs=outputs(f"{name}."),
+                   note=f"{len(x)} beam nodes x 6 + movable sheave axial") for name, x in zip(("driving", "driven"),
+                                                                                             structure.x)]
 
 
 def _running_chain_layout(scene: Scene) -> tuple[Layout, ...]:
@@ -293,8 +308,7 @@ def _running_chain_layout(scene: Scene) -> tuple[Layout, ...]:
     parts = [Layout("chain", scene.cvt.model, n * per_pin, outputs=outputs("chain.", "contact."),
                     note=f"{n} pins x {per_pin}; Hertz contact at both pin ends with each shaft's sheaves "
                          "(continuous: no discrete state)"),
-             Layout("driving pulley", "rigid-shaft", 2, outputs=outputs("driving."), note=f"spin angle, {sheave} axial"),
-             Layout("driven pulley", "rigid-shaft", 2, outputs=outputs("driven."), note=f"spin angle, {sheave} axial")]
+             *_pulley_layouts(model, outputs, sheave)]
     if scene.cvt.effects.stabilisation:
         parts.append(Layout("stabilisation", "speed-ratio-control", 0, n1=Stabilisation.size,
                             outputs=outputs("control."), note="smoothed speeds, F1 integral, b2 integral"))
