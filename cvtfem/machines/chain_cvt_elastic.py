@@ -162,6 +162,8 @@ class ElasticChainCVT(ChainCVT):
         kin = np.column_stack([X, self.z_ref[k], Xd, np.zeros(len(Z)), Z[:, 18]])
         out = self.contact.local(kin, k, details)
         Y, det = out if details else (out, None)
+        if details:
+            det = dict(det, X=X, tilt=th, side=s)
         F = 0.5 * Y[:, :3]
         F[:, 2] *= s                                               # conjugate to X in the true frame
         Qx = F + _cross(th, F)                                     # (I - theta x)^T F
@@ -475,12 +477,27 @@ class ElasticChainCVT(ChainCVT):
         for kk in range(2):
             sl = slice(nc + s.offset[kk], nc + s.offset[kk] + 6 * len(s.x[kk]))
             v[sl][5::6] = w[kk]
+        self._turn_with_sheaves(q, v)
         x0 = np.concatenate([q, v, self.control.initial_state(*w), np.zeros(4)])
         _, _, _, (_, c) = self._contacts(q, v, details=True)
         report = dict(rep, residual=res, F1=F1, rigid_F1=rep["F1"], model=self, nfev_elastic=sol.nfev,
                       max_penetration=float(c["delta"].max()),
                       tension=float(self._elastic_link_tension(q[:nc]).mean()))
         return x0, report
+
+    def _turn_with_sheaves(self, q, v) -> None:
+        """Set the velocities of the pin ends touching a fixed sheave to those of its material point (no slip): the
+        spin about the sheave's displaced, tilted axis (to first order in the tilt)."""
+        e, k, j, cols = self._mapped_pairs(q)
+        Z = np.concatenate([q, v])[cols]
+        _, det = self.mapped_local(Z, k, j, details=True)
+        on = (j == 0) & (det["delta"] > 0)
+        arm = det["X"][on, :2] - self.contact.centres[k[on]]
+        target = np.column_stack([-arm[:, 1], arm[:, 0], np.zeros(on.sum())]) * Z[on, 18, None]
+        target[:, 2] *= det["side"][on]
+        rate = target + _cross(det["tilt"][on], target)
+        rate[:, 2] *= det["side"][on]
+        v[self._idx[3][e[on]]] = rate
 
     def start(self):
         w1, _, i = self.regime.targets(0.0)
