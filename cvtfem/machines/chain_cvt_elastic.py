@@ -8,7 +8,10 @@ sheaves of a shaft: the end at ``x = (u1, u2, s u3)`` on the sheave on side ``s`
 symmetric chain is implied).  A contact is evaluated in the frame of its sheave: with the sheave's pivot ``o``
 (its node on the undeformed axis), translation ``a`` and small tilt ``theta`` (no spin part), the pin end's
 reference position is ``X = o + (I - theta x)(x - o - a)`` (first order in the tilt) and its velocity the time
-derivative of that map; mirrored to the ``x3 > 0`` side (``x3 -> s x3``) it is the input of the rigid model's
+derivative of that map.  The axial part of ``a`` is measured from the pair's mid-plane (half the difference of
+the two sheaves' axial displacements): the symmetric chain has no axial rigid motion, so its mid-plane follows
+each pulley's, as a real chain centres itself between the sheaves (the bearings then carry no axial force from
+the chain).  Mirrored to the ``x3 > 0`` side (``x3 -> s x3``) the position is the input of the rigid model's
 H1 kernel (:class:`~cvtfem.elements.chain.sheave_contact.SheaveContact`) with the sheave face at the constant
 reference position ``z_ref`` of the quasi-static start.  The kernel's force (per end: half its mirrored
 pair's) acts on every coordinate through the same map (virtual work: ``Q = (dX/dq)^T F``), so the pin end gets
@@ -19,7 +22,7 @@ energy added and its bearing damping dissipating.  The clamping force ``F_k`` ac
 sheave (``zeta_k``) and its node; the torques act on the fixed sheave's node, whose spin rate the loops read.
 
 Jacobian: the chain family's blocks, the structure's ``-K``, ``-(C + Omega G)`` and ``-G v`` on the spin
-rates, per-contact central differences of the mapped kernel (17 inputs, 10 outputs, all contacts at once)
+rates, per-contact central differences of the mapped kernel (19 inputs, 11 outputs, all contacts at once)
 scattered on both sides, and the loops' forward differences, as in ChainCVT.
 """
 from __future__ import annotations
@@ -47,10 +50,6 @@ N_MAPPED_IN = 19
 #: Outputs: forces on those 9 positions and on the spin; the friction power.
 N_MAPPED_OUT = 11
 _STEPS = np.array([1e-9] * 9 + [1e-6] * 9 + [1e-5])
-
-
-def _cross(a, b):
-    return np.cross(a, b)
 
 
 def _tilt(th):
@@ -123,7 +122,7 @@ class ElasticChainCVT(ChainCVT):
     # ----- contacts ----------------------------------------------------------------------------
     def _mapped_pairs(self, q):
         """``(ends, shafts, sheaves, cols)``: each broad-phase candidate with both sheaves (0 fixed, 1 movable)
-        of its shaft and the state columns (m, 17) of its mapped inputs in ``y = [q, v]``."""
+        of its shaft and the state columns (m, 19) of its mapped inputs in ``y = [q, v]``."""
         ends, shafts = self._candidates(q)
         e, k = np.repeat(ends, 2), np.repeat(shafts, 2)
         j = np.tile(np.arange(2), len(ends))
@@ -141,9 +140,10 @@ class ElasticChainCVT(ChainCVT):
         return np.column_stack([cols[:, :9], cols[:, 18] - n2])
 
     def mapped_local(self, Z, k, j, details: bool = False):
-        """Outputs (m, 10) of mapped contacts with inputs ``Z`` (m, 17) on shafts ``k``, sheaves ``j``: generalized
-        forces on the pin-end coordinates (3), the sheave's translation (3) and tilt (2) and spin (1), and the
-        friction power (W); with ``details`` also the kernel's per-contact dict (for one end and one sheave)."""
+        """Outputs (m, 11) of mapped contacts with inputs ``Z`` (m, 19, :data:`N_MAPPED_IN`) on shafts ``k``, sheaves
+        ``j``: generalized forces on the pin-end coordinates (3), the sheave's translation (3) and tilt (2), the other
+        sheave's axial position (1) and the spin (1), and the friction power (W); with ``details`` also the kernel's
+        per-contact dict (for one end and one sheave) with the mapped position ``X`` (kernel frame), tilt, side."""
         s = self._sides[k, j].astype(float)
         o = np.column_stack([self.contact.centres[k], self.structure.sheave_x3[k, j]])
         x = Z[:, :3].copy()
@@ -155,8 +155,8 @@ class ElasticChainCVT(ChainCVT):
         va, vth = Z[:, 12:15].copy(), _tilt(Z[:, 15:17])
         va[:, 2] = 0.5 * (Z[:, 14] - Z[:, 17])
         d, dd = x - o - a, vx - va
-        X = o + d - _cross(th, d)
-        Xd = dd - _cross(th, dd) - _cross(vth, d)
+        X = o + d - np.cross(th, d)
+        Xd = dd - np.cross(th, dd) - np.cross(vth, d)
         X[:, 2] *= s
         Xd[:, 2] *= s
         kin = np.column_stack([X, self.z_ref[k], Xd, np.zeros(len(Z)), Z[:, 18]])
@@ -166,12 +166,12 @@ class ElasticChainCVT(ChainCVT):
             det = dict(det, X=X, tilt=th, side=s)
         F = 0.5 * Y[:, :3]
         F[:, 2] *= s                                               # conjugate to X in the true frame
-        Qx = F + _cross(th, F)                                     # (I - theta x)^T F
+        Qx = F + np.cross(th, F)                                     # (I - theta x)^T F
         Qpin = Qx.copy()
         Qpin[:, 2] *= s
         Qa = -Qx
         Qa[:, 2] *= 0.5
-        res = np.column_stack([Qpin, Qa, -_cross(d, F)[:, :2], -Qa[:, 2], 0.5 * Y[:, 4], 0.5 * Y[:, 5]])
+        res = np.column_stack([Qpin, Qa, -np.cross(d, F)[:, :2], -Qa[:, 2], 0.5 * Y[:, 4], 0.5 * Y[:, 5]])
         return (res, det) if details else res
 
     def _mapped_set(self, q, v, details: bool = False):
@@ -231,7 +231,7 @@ class ElasticChainCVT(ChainCVT):
 
     # ----- Jacobian ----------------------------------------------------------------------------
     def _mapped_jacobian(self, q, v):
-        """``(cols, Jl)``: state columns and local Jacobians (m, 10, 17) of the mapped contacts at ``(q, v)``."""
+        """``(cols, Jl)``: state columns and local Jacobians (m, 11, 19) of the mapped contacts at ``(q, v)``."""
         e, k, j, cols = self._mapped_pairs(q)
         Z = np.concatenate([q, v])[cols]
         Jl = central_local_jacobian(lambda Zp, kk: self.mapped_local(Zp, kk, j), Z, k, _STEPS, N_MAPPED_OUT)
@@ -420,11 +420,11 @@ class ElasticChainCVT(ChainCVT):
         return replace(self, z_ref=x0r[self.rigid()._idx[2]].copy(), rigid_start=(i, w1, x0r, rep))
 
     def _elastic_static(self, x0r, rep, w1, tol):
-        nc, iphi, iz, _ = self._idx
+        """The chain and structure balance from the rigid start ``(x0r, rep)`` (:meth:`static_state`)."""
+        nc, _, iz, _ = self._idx
         s, n2, fam = self.structure, self.n2, self.family
         rig = self.rigid()
-        r_nc, r_iphi, r_iz, _ = rig._idx
-        r_n2 = rig.n2
+        r_iphi, r_n2 = rig._idx[1], rig.n2
         F2 = rep["F2"]
         q = np.zeros(n2)
         q[:nc] = x0r[:nc]
@@ -495,7 +495,7 @@ class ElasticChainCVT(ChainCVT):
         arm = det["X"][on, :2] - self.contact.centres[k[on]]
         target = np.column_stack([-arm[:, 1], arm[:, 0], np.zeros(on.sum())]) * Z[on, 18, None]
         target[:, 2] *= det["side"][on]
-        rate = target + _cross(det["tilt"][on], target)
+        rate = target + np.cross(det["tilt"][on], target)
         rate[:, 2] *= det["side"][on]
         v[self._idx[3][e[on]]] = rate
 

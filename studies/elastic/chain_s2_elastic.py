@@ -55,7 +55,8 @@ def main() -> None:
         wall = time.perf_counter() - t0
         ms = 1e3 * a.until
         print(f"  run {ms:g} ms: status {res.status}, wall {wall:.1f} s = {wall / ms:.1f} s per simulated ms = "
-              f"{60 * ms / wall:.2f} ms per wall minute; {res.stats['nfev']} RHS, {res.stats['njev']} Jacobians, {res.stats['nsteps']} steps")
+              f"{60 * ms / wall:.2f} ms per wall minute; {res.stats['nfev']} RHS, {res.stats['njev']} Jacobians, "
+              f"{res.stats['nsteps']} steps")
         o = m.outputs(res.t[-1], res.y[:, -1])
         print(f"  end: ratio {o['ratio']:.4f}, efficiency {o['efficiency']:.4f}, "
               f"support force driving {np.round(o['driving.support_force'], 1)} N, "
