@@ -103,23 +103,32 @@ def test_structure_block_at_standstill_equals_the_rotor_code(scene, tmp_path):
         np.testing.assert_allclose(mine, ref, rtol=1e-8)
 
 
-def test_j11_without_chain_gives_the_structure_frequencies(static):
+@pytest.mark.parametrize("speeds", [(0.0, 0.0), (400.0, 900.0)])
+def test_j11_without_chain_gives_the_structure_frequencies(static, speeds):
     """The source's J11 (1.358): the Jacobian of the coupled model over the shaft/sheave states with the chain
-    frozen and its contact stiffness zero has the structure block's eigenvalues at standstill (same frequencies
-    and damping to 1e-6), i.e. the Campbell lines with the chain removed."""
+    frozen and its contact stiffness zero has the structure block's eigenvalues (frequencies to 1e-6) at
+    standstill, i.e. the Campbell lines with the chain removed, and with the shafts spinning (rad/s; the
+    sheaves' gyroscopic terms at each shaft's speed, forward and backward whirl split)."""
     model, x0, _ = static
     free = replace(model, contact=replace(model.contact, c=np.zeros(2)))
+    s = model.structure
     x = x0.copy()
     nc, n2 = model.family.size, model.n2
-    x[n2 + nc:2 * n2] = 0.0                                       # standstill
+    x[n2 + nc:2 * n2] = 0.0
+    for k, w in enumerate(speeds):                                # every node of shaft k spins at w
+        nodes = slice(n2 + nc + s.offset[k], n2 + nc + s.offset[k] + 6 * len(s.x[k]))
+        x[nodes][5::6] = w
     rows = np.concatenate([np.arange(nc, n2), n2 + np.arange(nc, n2)])
     J11 = free.jac(0.0, x)[rows][:, rows].toarray()
     lam = np.linalg.eigvals(J11)
     lam = lam[lam.imag > 1.0]                                     # rad/s: drop the free spins and zeta
-    s = model.structure
-    f_ref, _ = _frequencies(s.M, s.K, s.C, s.dof_kind, n=40)
+    G = speeds[0] * s.G[0] + speeds[1] * s.G[1]
+    f_ref, _ = _frequencies(s.M, s.K, s.C, s.dof_kind, speed=1.0, G=G, n=40)
     f = np.sort(lam.imag / (2 * np.pi))[:len(f_ref)]
     np.testing.assert_allclose(f, np.sort(f_ref), rtol=1e-6)
+    if speeds[0]:
+        f_still, _ = _frequencies(s.M, s.K, s.C, s.dof_kind, n=40)
+        assert np.abs(np.sort(f_ref) / np.sort(f_still) - 1).max() > 1e-3   # the gyroscopic split shows
 
 
 def test_contact_map_forces_are_the_hertz_gradient_and_friction_has_the_kernel_power(static):
