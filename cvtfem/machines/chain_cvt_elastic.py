@@ -29,7 +29,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, replace
 from functools import cached_property
-from typing import Any
+from typing import Any, ClassVar
 
 import numpy as np
 import scipy.linalg as sla
@@ -63,8 +63,9 @@ class ElasticChainCVT(ChainCVT):
 
     Attributes (besides ChainCVT's; ``J`` and ``m_sheave`` are the structure's, kept for the loops)
     structure : ShaftStructure
-    z_ref : (2,) m
-        Reference position of each shaft's sheave faces (the rigid model's ``z`` at the quasi-static start).
+    z_ref : (2, 2) m
+        Reference position of each shaft's (fixed, movable) sheave face (the rigid model's at the quasi-static
+        start), counted outwards from the chain mid-plane.
     """
 
     structure: Any = None
@@ -120,24 +121,41 @@ class ElasticChainCVT(ChainCVT):
         return super().output_specs + tuple(new)
 
     # ----- contacts ----------------------------------------------------------------------------
+    #: Share of the kernel's output that one evaluation carries (the S2/S3 kernel loads a mirrored pair: 1/2).
+    kernel_share: ClassVar[float] = 0.5
+    #: Sheaves of a shaft each pin end meets (2: the symmetric chain's end stands for both of its mirror pair).
+    sheaves_per_end: ClassVar[int] = 2
+    #: The sheaves' axial motion counts from the pulley's mid-plane (the symmetric chain has no axial motion).
+    axial_relative: ClassVar[bool] = True
+
     def _mapped_pairs(self, q):
-        """``(ends, shafts, sheaves, cols)``: each broad-phase candidate with both sheaves (0 fixed, 1 movable)
-        of its shaft and the state columns (m, 19) of its mapped inputs in ``y = [q, v]``."""
+        """``(ends, shafts, sheaves, cols, coef)``: each broad-phase candidate with both sheaves (0 fixed,
+        1 movable) of its shaft, the state columns and weights (m, 19, k) of its mapped inputs in ``y = [q, v]``
+        (the contact map of :meth:`ChainCVT._contact_map`)."""
         ends, shafts = self._candidates(q)
         e, k = np.repeat(ends, 2), np.repeat(shafts, 2)
         j = np.tile(np.arange(2), len(ends))
-        return (e, k, j) + (self._mapped_columns(e, k, j),)
+        dof3 = self._idx[3][e]
+        return (e, k, j) + self._mapped_map(dof3[:, :, None], np.ones(dof3.shape + (1,)), k, j)
 
-    def _mapped_columns(self, e, k, j):
-        nc, n2, dof3 = self._idx[0], self.n2, self._idx[3]
+    def _mapped_map(self, end_cols, end_coef, k, j):
+        """The mapped inputs' ``(cols, coef)`` (m, 19, K) from the pin-end position's (m, 3, K) in the mirrored
+        frame of its sheave (``x3 -> s x3``) and the sheave's structure columns."""
+        nc, n2 = self._idx[0], self.n2
         sd = nc + self.structure.sheave_dofs[k, j]                 # (m, 6)
         other = nc + self.structure.sheave_dofs[k, 1 - j, 2]
-        return np.column_stack([dof3[e], sd[:, :5], other, n2 + dof3[e], n2 + sd[:, :5], n2 + other, n2 + sd[:, 5]])
-
-    def _mapped_rows(self, cols):
-        """Rows (in ``q``) of the 10 force outputs of each mapped contact."""
-        n2 = self.n2
-        return np.column_stack([cols[:, :9], cols[:, 18] - n2])
+        own = np.column_stack([sd[:, :5], other])                  # (m, 6)
+        m, K = len(k), end_cols.shape[2]
+        cols = np.zeros((m, N_MAPPED_IN, K), np.int64)
+        coef = np.zeros((m, N_MAPPED_IN, K))
+        for off in (0, 9):
+            cols[:, off:off + 3] = end_cols + (n2 if off else 0)
+            coef[:, off:off + 3] = end_coef
+            cols[:, off + 3:off + 9, 0] = own + (n2 if off else 0)
+            coef[:, off + 3:off + 9, 0] = 1.0
+        cols[:, 18, 0] = n2 + sd[:, 5]
+        coef[:, 18, 0] = 1.0
+        return cols, coef
 
     def mapped_local(self, Z, k, j, details: bool = False):
         """Outputs (m, 11) of mapped contacts with inputs ``Z`` (m, 19, :data:`N_MAPPED_IN`) on shafts ``k``, sheaves
@@ -149,38 +167,43 @@ class ElasticChainCVT(ChainCVT):
         x = Z[:, :3].copy()
         x[:, 2] *= s
         a, th = Z[:, 3:6].copy(), _tilt(Z[:, 6:8])
-        a[:, 2] = 0.5 * (Z[:, 5] - Z[:, 8])                     # axial: relative to the pair's mid-plane
         vx = Z[:, 9:12].copy()
         vx[:, 2] *= s
         va, vth = Z[:, 12:15].copy(), _tilt(Z[:, 15:17])
-        va[:, 2] = 0.5 * (Z[:, 14] - Z[:, 17])
+        if self.axial_relative:                                  # axial: from the pair's mid-plane
+            a[:, 2] = 0.5 * (Z[:, 5] - Z[:, 8])
+            va[:, 2] = 0.5 * (Z[:, 14] - Z[:, 17])
         d, dd = x - o - a, vx - va
         X = o + d - np.cross(th, d)
         Xd = dd - np.cross(th, dd) - np.cross(vth, d)
         X[:, 2] *= s
         Xd[:, 2] *= s
-        kin = np.column_stack([X, self.z_ref[k], Xd, np.zeros(len(Z)), Z[:, 18]])
+        kin = np.column_stack([X, self.z_ref[k, j], Xd, np.zeros(len(Z)), Z[:, 18]])
         out = self.contact.local(kin, k, details)
         Y, det = out if details else (out, None)
         if details:
             det = dict(det, X=X, tilt=th, side=s)
-        F = 0.5 * Y[:, :3]
+        F = self.kernel_share * Y[:, :3]
         F[:, 2] *= s                                               # conjugate to X in the true frame
         Qx = F + np.cross(th, F)                                     # (I - theta x)^T F
         Qpin = Qx.copy()
         Qpin[:, 2] *= s
         Qa = -Qx
-        Qa[:, 2] *= 0.5
-        res = np.column_stack([Qpin, Qa, -np.cross(d, F)[:, :2], -Qa[:, 2], 0.5 * Y[:, 4], 0.5 * Y[:, 5]])
+        Qo = np.zeros(len(Z))
+        if self.axial_relative:
+            Qa[:, 2] *= 0.5
+            Qo = -Qa[:, 2]
+        share = self.kernel_share
+        res = np.column_stack([Qpin, Qa, -np.cross(d, F)[:, :2], Qo, share * Y[:, 4], share * Y[:, 5]])
         return (res, det) if details else res
 
     def _mapped_set(self, q, v, details: bool = False):
-        e, k, j, cols = self._mapped_pairs(q)
-        Z = np.concatenate([q, v])[cols]
-        return e, k, j, cols, Z, self.mapped_local(Z, k, j, details)
+        e, k, j, cols, coef = self._mapped_pairs(q)
+        Z = (coef * np.concatenate([q, v])[cols]).sum(axis=2)
+        return e, k, j, cols, coef, Z, self.mapped_local(Z, k, j, details)
 
     def _contacts(self, q, v, details=False):
-        e, k, j, cols, Z, Y = self._mapped_set(q, v, details)
+        e, k, j, cols, coef, Z, Y = self._mapped_set(q, v, details)
         return e, k, Z, Y
 
     # ----- right-hand side ---------------------------------------------------------------------
@@ -189,8 +212,9 @@ class ElasticChainCVT(ChainCVT):
         s = self.structure
         Q = np.zeros(self.n2)
         Q[:nc] = self.family.forces(q[:nc], v[:nc])
-        e, k, j, cols, Z, Y = self._mapped_set(q, v)
-        Q += np.bincount(self._mapped_rows(cols).ravel(), Y[:, :10].ravel(), self.n2)
+        e, k, j, cols, coef, Z, Y = self._mapped_set(q, v)
+        rows, wr = self._output_rows(cols, coef)
+        Q += np.bincount(rows.ravel(), (wr * Y[:, :-1, None]).ravel(), self.n2)
         qs, vs = q[nc:], v[nc:]
         Q[nc:] -= s.K @ qs + s.damping_matrix(v[iphi]) @ vs
         Q[iphi] += M
@@ -231,19 +255,10 @@ class ElasticChainCVT(ChainCVT):
 
     # ----- Jacobian ----------------------------------------------------------------------------
     def _mapped_jacobian(self, q, v):
-        """``(cols, Jl)``: state columns and local Jacobians (m, 11, 19) of the mapped contacts at ``(q, v)``."""
-        e, k, j, cols = self._mapped_pairs(q)
-        Z = np.concatenate([q, v])[cols]
+        """``(cols, coef, Jl)``: the contact map and the local Jacobians (m, 11, 19) of the mapped contacts."""
+        e, k, j, cols, coef, Z, _ = self._mapped_set(q, v)
         Jl = central_local_jacobian(lambda Zp, kk: self.mapped_local(Zp, kk, j), Z, k, _STEPS, N_MAPPED_OUT)
-        return cols, Jl
-
-    def _force_entries(self, cols, Jl, n_in: int = N_MAPPED_IN):
-        rows = self._mapped_rows(cols)
-        R = np.broadcast_to(rows[:, :, None], (len(cols), 10, n_in))
-        C = np.broadcast_to(cols[:, None, :n_in], R.shape)
-        vals = Jl[:, :10, :n_in]
-        keep = vals != 0
-        return R[keep], C[keep], vals[keep]
+        return cols, coef, Jl
 
     @cached_property
     def _inv_mass(self) -> sp.csr_matrix:
@@ -266,8 +281,8 @@ class ElasticChainCVT(ChainCVT):
         parts = []
         for Mx, off in ((Kc.tocoo(), 0), (Cc.tocoo(), n2)):
             parts.append((Mx.row, Mx.col + off, Mx.data))
-        cols, Jl = self._mapped_jacobian(q, v)
-        parts.append(self._force_entries(cols, Jl))
+        cols, coef, Jl = self._mapped_jacobian(q, v)
+        parts.append(self._contact_entries(cols, coef, Jl))
         for Mx, off in ((-s.K).tocoo(), nc), ((-s.damping_matrix(w)).tocoo(), n2 + nc):
             parts.append((Mx.row + nc, Mx.col + off, Mx.data))
         vs = v[nc:]
@@ -289,7 +304,8 @@ class ElasticChainCVT(ChainCVT):
         Qd = self.family.dissipative_forces(q[:nc], v[:nc])
         Kd = self.family.jacobian(q[:nc], v[:nc], part="dissipative", wrt=(0,))[0]
         dD = np.zeros(N)
-        np.add.at(dD, cols.ravel(), -Jl[:, 10, :].ravel())
+        cw = np.where(cols < 2 * n2, coef, 0.0)
+        np.add.at(dD, np.where(cw != 0, cols, 0).ravel(), -(cw * Jl[:, -1, :, None]).ravel())
         dD[np.arange(nc)] += -(Kd.T @ v[:nc])
         dD[n2 + np.arange(nc)] += -2 * Qd
         dD[n2 + nc:2 * n2] += 2 * (s.C @ vs)
@@ -312,11 +328,8 @@ class ElasticChainCVT(ChainCVT):
         ctrl = 2 * n2 + np.arange(nz)
         P = sp.csr_matrix(self.family.jac_sparsity, dtype=float).tocoo()
         rows, cols = [P.row, P.row], [P.col, P.col + n2]
-        ends, shafts = self._all_pairs()
-        e, k = np.repeat(ends, 2), np.repeat(shafts, 2)
-        j = np.tile(np.arange(2), len(ends))
-        mc = self._mapped_columns(e, k, j)
-        r, c, _ = self._force_entries(mc, np.ones((len(mc), N_MAPPED_OUT, N_MAPPED_IN)))
+        mc, mw = self._all_mapped()
+        r, c, _ = self._contact_entries(mc, mw, np.ones((len(mc), N_MAPPED_OUT, N_MAPPED_IN)))
         rows.append(r)
         cols.append(c)
         S = (abs(self.structure.K) + abs(self.structure.C) + abs(self.structure.G[0]) + abs(self.structure.G[1]))
@@ -341,6 +354,17 @@ class ElasticChainCVT(ChainCVT):
                           shape=(4, N))
         return sp.vstack([top, acc.astype(float), ctrl_rows, W], format="csr").astype(bool)
 
+    def _axial_outputs(self, k, j, c) -> dict[str, np.ndarray]:
+        """Axial force of the pins on one sheave of each shaft (N, pushing it open): the pair's mean."""
+        return {"contact.sheave_axial_force": -np.bincount(k, c["F"][:, 2], 2) / self.sheaves_per_end}
+
+    def _all_mapped(self):
+        """``(cols, coef)`` of every mapped contact the broad phase may return (the structural pattern)."""
+        ends, shafts = self._all_pairs()
+        e, k = np.repeat(ends, 2), np.repeat(shafts, 2)
+        dof3 = self._idx[3][e]
+        return self._mapped_map(dof3[:, :, None], np.ones(dof3.shape + (1,)), k, np.tile(np.arange(2), len(ends)))
+
     # ----- energy and outputs ------------------------------------------------------------------
     def energy(self, x) -> float:
         """Kinetic plus elastic energy: chain, structure (``v M v / 2 + q K q / 2``), Hertz potentials, J."""
@@ -349,7 +373,7 @@ class ElasticChainCVT(ChainCVT):
         _, _, _, (_, info) = self._contacts(q, v, details=True)
         qs, vs = q[nc:], v[nc:]
         return float(self.family.energy(q[:nc], v[:nc]) + 0.5 * vs @ (s.M @ vs) + 0.5 * qs @ (s.K @ qs)
-                     + 0.5 * info["potential"].sum())
+                     + self.kernel_share * info["potential"].sum())
 
     def outputs(self, t: float, x) -> dict[str, Any]:
         """Named outputs; per pin end and shaft the contact values are the means over the two sheaves, the
@@ -357,13 +381,13 @@ class ElasticChainCVT(ChainCVT):
         dx, diag = self.evaluate(t, x, slip=False)
         q, v, _, W = self.split(x)
         nc, n, s = self._idx[0], self.n_ends, self.structure
-        e, k, Z, (Y, c) = self._contacts(q, v, details=True)
+        e, k, j, _, _, _, (Y, c) = self._mapped_set(q, v, details=True)
         on = c["delta"] > 0
         slot = 2 * e + k
 
         def per(values, width=1):
             out = np.zeros((2 * n, width))
-            np.add.at(out, slot, 0.5 * np.reshape(values, (len(slot), width)))
+            np.add.at(out, slot, np.reshape(values, (len(slot), width)) / self.sheaves_per_end)
             return out.ravel()
         P = dx[-4:]
         w, M, F = diag["w"], diag["M"], diag["F"]
@@ -378,7 +402,7 @@ class ElasticChainCVT(ChainCVT):
                     "contact.slip_speed": per(np.where(on, np.linalg.norm(c["slip"], axis=1), 0.0)),
                     "contact.friction_force": per(c["F_fr"], 3),
                     "contact.friction_power": np.bincount(k, Y[:, 10], 2),
-                    "contact.sheave_axial_force": -0.5 * np.bincount(k, c["F"][:, 2], 2),
+                    **self._axial_outputs(k, j, c),
                     "driving.speed": w[0], "driven.speed": w[1], "driving.torque": M[0], "driven.torque": M[1],
                     "driving.clamping_force": F[0], "driven.clamping_force": F[1],
                     "driving.support_force": -bearing[0, :, :2].sum(axis=0),
@@ -409,7 +433,7 @@ class ElasticChainCVT(ChainCVT):
             x0r, rep = rs[2], rs[3]
         else:
             x0r, rep = self.rigid().static_state(ratio, w1, tension, tol)
-        model = replace(self, z_ref=x0r[self.rigid()._idx[2]].copy(), rigid_start=(ratio, w1, x0r, rep))
+        model = replace(self, z_ref=self._face_reference(x0r), rigid_start=(ratio, w1, x0r, rep))
         return model._elastic_static(x0r, rep, w1, tol)
 
     def referenced(self) -> "ElasticChainCVT":
@@ -417,7 +441,12 @@ class ElasticChainCVT(ChainCVT):
         ratio and driving speed at ``t = 0`` (what :meth:`start` starts from)."""
         w1, _, i = self.regime.targets(0.0)
         x0r, rep = self.rigid().static_state(i, w1)
-        return replace(self, z_ref=x0r[self.rigid()._idx[2]].copy(), rigid_start=(i, w1, x0r, rep))
+        return replace(self, z_ref=self._face_reference(x0r), rigid_start=(i, w1, x0r, rep))
+
+    def _face_reference(self, x0r) -> np.ndarray:
+        """``z_ref`` (2, 2) from the rigid start ``x0r``: both faces of a pair at its ``z``."""
+        z = x0r[self.rigid()._idx[2]]
+        return np.column_stack([z, z])
 
     def _elastic_static(self, x0r, rep, w1, tol):
         """The chain and structure balance from the rigid start ``(x0r, rep)`` (:meth:`static_state`)."""
@@ -488,9 +517,7 @@ class ElasticChainCVT(ChainCVT):
     def _turn_with_sheaves(self, q, v) -> None:
         """Set the velocities of the pin ends touching a fixed sheave to those of its material point (no slip): the
         spin about the sheave's displaced, tilted axis (to first order in the tilt)."""
-        e, k, j, cols = self._mapped_pairs(q)
-        Z = np.concatenate([q, v])[cols]
-        _, det = self.mapped_local(Z, k, j, details=True)
+        e, k, j, _, _, Z, (_, det) = self._mapped_set(q, v, details=True)
         on = (j == 0) & (det["delta"] > 0)
         arm = det["X"][on, :2] - self.contact.centres[k[on]]
         target = np.column_stack([-arm[:, 1], arm[:, 0], np.zeros(on.sum())]) * Z[on, 18, None]

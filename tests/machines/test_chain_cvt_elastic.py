@@ -145,9 +145,7 @@ def test_contact_map_forces_are_the_hertz_gradient_and_friction_has_the_kernel_p
     x[tilt] += rng.normal(0.0, 2e-4, tilt.size)
     x[n2:2 * n2] += rng.normal(0.0, 0.05, n2)
     q, v = x[:n2], x[n2:2 * n2]
-    e, k, j, cols = model._mapped_pairs(q)
-    Z = np.concatenate([q, v])[cols]
-    Y, det = model.mapped_local(Z, k, j, details=True)
+    e, k, j, _, _, Z, (Y, det) = model._mapped_set(q, v, details=True)
     on = det["delta"] > 0
     assert on.sum() > 40 and np.unique(j[on]).size == 2
 
@@ -180,8 +178,7 @@ def test_static_state_on_elastic_shafts(static, rigid_start):
         assert 1e-5 < abs(tilt).max() < 1e-2
     assert o["contact.slip_speed"].max() < 5e-3 * model.contact.v0   # pins turn with the tilted sheaves (1st order)
     n2 = model.n2
-    e, k, j, cols = model._mapped_pairs(x0[:n2])
-    Y = model.mapped_local(np.concatenate([x0[:n2], np.zeros(n2)])[cols], k, j)     # friction unloaded
+    e, k, j, _, _, _, Y = model._mapped_set(x0[:n2], np.zeros(n2))                # friction unloaded
     for i, name in enumerate(("driving", "driven")):
         on_sheaves = Y[k == i, 3:5].sum(axis=0)
         assert np.linalg.norm(on_sheaves) > 1e3
