@@ -40,6 +40,7 @@ from cvtfem.assembly.model import StateLayout
 from cvtfem.elements.base import Block
 from cvtfem.elements.chain.sheave_contact import central_local_jacobian
 from cvtfem.errors import NumericalError
+from cvtfem.machines.chain_a_cvt import ChainACVT
 from cvtfem.machines.chain_cvt import ChainCVT
 from cvtfem.machines.shaft_structure import ShaftParameters, ShaftStructure, build_structure
 from cvtfem.outputs import OutputSpec
@@ -536,6 +537,58 @@ class ElasticChainCVT(ChainCVT):
                             f"penetration {1e6 * rep['max_penetration']:.1f} um)", "model": rep["model"]}
 
 
+@dataclass(frozen=True, eq=False)
+class ElasticChainACVT(ElasticChainCVT, ChainACVT):
+    """The whole-pin chain (A1) on elastic shafts: :class:`ElasticChainCVT`'s structure and sheave frames under
+    :class:`~cvtfem.machines.chain_a_cvt.ChainACVT`'s pin ends, each meeting the one sheave on its side of a shaft
+    (its movable or fixed sheave) with the pin end a combination of the pin's coordinates (its contact map).  The
+    chain moves axially, so the sheaves' axial motion counts from the undeformed positions and the locating
+    bearing carries the pulley's net axial force; the fixed faces start at ChainACVT's ``fixed_z``."""
+
+    kernel_share: ClassVar[float] = 1.0
+    sheaves_per_end: ClassVar[int] = 1
+    axial_relative: ClassVar[bool] = False
+
+    def _sheave_of(self, ends, shafts) -> np.ndarray:
+        """Sheave (0 fixed, 1 movable) an end on side ``+-1`` (odd ends: ``x3 > 0``) meets on each shaft."""
+        side = np.where(ends % 2 == 1, 1, -1)
+        return (np.asarray(self.movable_side)[shafts] == side).astype(np.int64)
+
+    def _pairs_map(self, ends, shafts):
+        j = self._sheave_of(ends, shafts)
+        cols, coef = ChainACVT._contact_map(self, ends, shafts)
+        return (ends, shafts, j) + self._mapped_map(cols[:, :3], coef[:, :3], shafts, j)
+
+    def _mapped_pairs(self, q):
+        return self._pairs_map(*self._candidates(q))
+
+    def _all_mapped(self):
+        return self._pairs_map(*self._all_pairs())[3:]
+
+    def rigid(self) -> ChainACVT:
+        return ChainACVT(self.family, self.contact, self.J, self.m_sheave, self.regime, self.F_appl, self.control,
+                         self.movable_side, self.fixed_z)
+
+    def _face_reference(self, x0r) -> np.ndarray:
+        """``z_ref`` (2, 2): the fixed faces at ``fixed_z``, the movable ones at the rigid start's ``z``."""
+        return np.column_stack([self.fixed_z, x0r[self.rigid()._idx[2]]])
+
+    def _axial_outputs(self, k, j, c) -> dict[str, np.ndarray]:
+        F3 = c["F"][:, 2]
+        return {"contact.sheave_axial_force": -np.bincount(k[j == 1], F3[j == 1], 2),
+                "contact.fixed_sheave_axial_force": -np.bincount(k[j == 0], F3[j == 0], 2)}
+
+    def _turn_with_sheaves(self, q, v) -> None:
+        """The pins on each arc turn with the spin about the sheaves' displaced axis (the tilt left out)."""
+        nc, iphi = self._idx[0], self._idx[1]
+        s = self.structure
+        e, k, j, _, _, _, (_, det) = self._mapped_set(q, v, details=True)
+        for kk in range(2):
+            pins = np.unique(self.pin_of(e[(k == kk) & (det["delta"] > 0)]))
+            centre = self.contact.centres[kk] + q[nc + s.sheave_dofs[kk, :, :2]].mean(axis=0)
+            ChainACVT._turn_with_sheave(self, q[:nc], v[:nc], pins, v[iphi[kk]], centre)
+
+
 def shaft_parameters(scene) -> tuple[ShaftParameters, ShaftParameters]:
     """The two shafts of a CVT scene's ``[cvt.driving]``, ``[cvt.driven]`` (movable sheaves on opposite sides)."""
     cvt = scene.cvt
@@ -546,9 +599,11 @@ def shaft_parameters(scene) -> tuple[ShaftParameters, ShaftParameters]:
 
 
 def elastic(rigid: ChainCVT, structure: ShaftStructure) -> ElasticChainCVT:
-    """The rigid transmission ``rigid`` on ``structure`` (``z_ref`` set by :meth:`ElasticChainCVT.static_state`)."""
-    return ElasticChainCVT(rigid.family, rigid.contact, rigid.J, rigid.m_sheave, rigid.regime, rigid.F_appl,
-                           rigid.control, structure, np.zeros(2))
+    """The rigid transmission ``rigid`` (ChainCVT, or ChainACVT: :class:`ElasticChainACVT`) on ``structure`` (``z_ref`` set by :meth:`ElasticChainCVT.static_state`)."""
+    args = (rigid.family, rigid.contact, rigid.J, rigid.m_sheave, rigid.regime, rigid.F_appl, rigid.control)
+    if isinstance(rigid, ChainACVT):
+        return ElasticChainACVT(*args, rigid.movable_side, rigid.fixed_z, structure, np.zeros((2, 2)))
+    return ElasticChainCVT(*args, structure, np.zeros((2, 2)))
 
 
 def from_scene(scene, geom, F_appl, **overrides) -> ElasticChainCVT:

@@ -238,10 +238,9 @@ def chain_refusal(scene: Scene) -> InputError | None:
     if model != "chain-S2" and not eff.pin_bending:
         return InputError("cvt.effects.pin_bending", False, f"must be true for `{model}` (its pins bend); "
                           "without pin bending use `chain-S2`")
-    if eff.shaft_elasticity and (model not in ("chain-S2", "chain-S3") or eff.contact != "hertz"):
-        return InputError("cvt.effects.shaft_elasticity", True, f"is not available for `{model}` with contact "
-                          f"'{eff.contact}' yet: elastic shafts run under chain-S2 and chain-S3 with H1 contact "
-                          "('hertz'; set it false for the others)")
+    if eff.shaft_elasticity and eff.contact != "hertz":
+        return InputError("cvt.effects.shaft_elasticity", True, f"is not available with contact '{eff.contact}' yet: "
+                          "elastic shafts run with H1 contact ('hertz'; set it false for the refined contact)")
     if eff.contact not in ("hertz", "hertz-refined"):
         return InputError("cvt.effects.contact", eff.contact, f"must be 'hertz' or 'hertz-refined' for `{model}`: Hertz "
                           "contact at the pin-axis end or refined (the rigid and impact contacts are not coupled to a "
