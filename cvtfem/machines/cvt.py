@@ -2,8 +2,8 @@
 
 Coordinate counts follow the spec: band models (low-order digest section 4),
 chain models (chain-models-2.md section 0: 2/3/5/10/21 per pin), shafts
-(shafts-sheaves-supports.md: rigid 2 per shaft, elastic 6 per node plus a
-6-DOF movable sheave), controller states (low-order digest section 5.5).
+(shafts-sheaves-supports.md: rigid 2 per shaft, elastic 6 per node plus the
+movable sheave's axial coordinate), controller states (low-order digest section 5.5).
 """
 from __future__ import annotations
 
@@ -57,8 +57,8 @@ def _shaft(name: str, scene: Scene, model: str) -> Layout:
         return Layout(f"{name} pulley", "rigid-shaft", 2, outputs=tuple(outputs), note="spin angle, sheave axial")
     nodes = shaft.shaft_elements + 1
     outputs.append(OutputSpec(f"{name}.support_force", "N", "Radial force in each of the two bearings.", 4))
-    return Layout(f"{name} pulley", "beam-shaft+rigid-sheave", 6 * nodes + 6, outputs=tuple(outputs),
-                  note=f"{nodes} beam nodes x 6 + movable sheave 6")
+    return Layout(f"{name} pulley", "beam-shaft+rigid-sheaves", 6 * nodes + 1, outputs=tuple(outputs),
+                  note=f"{nodes} beam nodes x 6 + movable sheave axial (machines/shaft_structure.py)")
 
 
 def _chain(scene: Scene) -> Layout:
@@ -263,7 +263,8 @@ def chain_loop(scene: Scene):
     at the regime's start: torque, ratio, safety factor, split); the ratio loop corrects ``F1`` from there.
     Only what runs is accepted: ``chain-S2`` (no pin bending), ``chain-S3`` and the whole-pin chain ``chain-A1``
     (pin bending; :mod:`~cvtfem.machines.chain_a_cvt`, a fixed and a movable sheave per shaft), rigid shafts,
-    ``effects.contact = "hertz"`` (all three) or ``"hertz-refined"`` (S2, S3), friction on.  (A3/A4 build through
+    ``effects.contact = "hertz"`` (all three) or ``"hertz-refined"`` (S2, S3), friction on; with
+    ``effects.shaft_elasticity`` the three with H1 on elastic shafts (:mod:`~cvtfem.machines.chain_cvt_elastic`).  (A3/A4 build through
     the same interface, but their quasi-static start does not converge yet: docs/chain.md.)
     """
     from cvtfem.control.clamping import Clamping
