@@ -256,7 +256,7 @@ def test_scene_builds_the_elastic_model_with_its_layout(scene):
 def test_whole_pin_chain_on_elastic_shafts():
     """chain-A1 on the elastic shafts (ElasticChainACVT, variant (b) less the refined contact): the quasi-static
     start balances, each sheave tilts under its own pins, the bearings carry the resultant of the pins' forces on
-    the sheaves, the Jacobian matches central differences on the structure and sampled chain columns, and a 20 us
+    the sheaves, the Jacobian matches central differences on the structure and sampled chain columns, and a 50 us
     Radau run closes the energy balance to 1e-6 of the input work."""
     from cvtfem.machines.chain_cvt_elastic import ElasticChainACVT
 
@@ -280,4 +280,4 @@ def test_whole_pin_chain_on_elastic_shafts():
                            n2 + sheave])
     assert_jacobian_columns(model, x, J, np.unique(cols))
     F1 = model.outputs(0.0, x0)["contact.sheave_axial_force"][0]
-    assert_energy_balance(model.with_clamping([F1, model.F_appl[1]]), x0, 2e-5)
+    assert_energy_balance(model.with_clamping([F1, model.F_appl[1]]), x0, 5e-5)

@@ -1,9 +1,10 @@
-"""Chain-S2 on elastic shafts against rigid shafts: cost of one RHS and one Jacobian, and a short run.
+"""Chains on elastic shafts against rigid shafts: cost of one RHS and one Jacobian, and a short run.
 
-    OPENBLAS_NUM_THREADS=1 nice .venv/bin/python studies/elastic/chain_s2_elastic.py [--until 2e-3] [--calls 200]
+    OPENBLAS_NUM_THREADS=1 nice .venv/bin/python studies/elastic/chain_elastic.py [--until 2e-3] [--calls 200]
+        [--scenes chain-S2,regime-chapter2:chain-A1,regime-chapter2,shafts-elastic]
 
-Scene ``chain-S2,regime-chapter2`` with and without the part ``shafts-elastic`` (ElasticChainCVT: beam FE shafts,
-rigid sheaves, linear bearings).  For each: the states, the RHS median of ``--calls`` calls and the Jacobian
+Scenes (``--scenes``, separated by colons; default ``chain-S2,regime-chapter2`` with and without the part
+``shafts-elastic``: ElasticChainCVT, beam FE shafts, rigid sheaves, linear bearings).  For each: the states, the RHS median of ``--calls`` calls and the Jacobian
 median of ``--jac-calls`` calls at the quasi-static start perturbed to a running state; then a Radau run (the
 scene's tolerances) over ``--until`` s: wall time per simulated ms, simulated ms per wall minute, RHS calls and
 Jacobians, and at the end the sheave tilts, the bearing forces and the support force.  The machine and its load
@@ -37,9 +38,10 @@ def main() -> None:
     ap.add_argument("--until", type=float, default=2e-3)
     ap.add_argument("--calls", type=int, default=200)
     ap.add_argument("--jac-calls", type=int, default=10)
+    ap.add_argument("--scenes", default="chain-S2,regime-chapter2:chain-S2,regime-chapter2,shafts-elastic")
     a = ap.parse_args()
     print(f"machine: {machine()}")
-    for name in ("chain-S2,regime-chapter2", "chain-S2,regime-chapter2,shafts-elastic"):
+    for name in a.scenes.split(":"):
         scene = load_scene(name)
         m = chain_loop(scene)
         x0, info = m.start()
