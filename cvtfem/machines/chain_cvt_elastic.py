@@ -209,11 +209,17 @@ class ElasticChainCVT(ChainCVT):
 
     # ----- right-hand side ---------------------------------------------------------------------
     def _forces(self, q, v, F, M, slip: bool = False):
+        """Generalized forces (N, N m) and the friction power (W); with ``slip`` also the contact-force-weighted
+        mean slip speed on each shaft (m/s, 0 without contact), as ChainCVT's."""
         nc, iphi, iz, _ = self._idx
         s = self.structure
         Q = np.zeros(self.n2)
         Q[:nc] = self.family.forces(q[:nc], v[:nc])
-        e, k, j, cols, coef, Z, Y = self._mapped_set(q, v)
+        e, k, j, cols, coef, Z, Y = self._mapped_set(q, v, details=slip)
+        if slip:
+            Y, det = Y
+            N = np.bincount(k, det["N"], 2)
+            mean_slip = np.bincount(k, det["N"] * np.linalg.norm(det["slip"], axis=1), 2) / np.maximum(N, 1e-300)
         rows, wr = self._output_rows(cols, coef)
         Q += np.bincount(rows.ravel(), (wr * Y[:, :-1, None]).ravel(), self.n2)
         qs, vs = q[nc:], v[nc:]
@@ -223,9 +229,7 @@ class ElasticChainCVT(ChainCVT):
         Q[iz] -= side * F
         Q[self._movable_node_u3] += side * F
         Pf = float(Y[:, 10].sum())
-        if slip:
-            return Q, Pf, np.zeros(2)
-        return Q, Pf
+        return (Q, Pf, mean_slip) if slip else (Q, Pf)
 
     @cached_property
     def _structure_inverse(self) -> np.ndarray:
@@ -243,7 +247,7 @@ class ElasticChainCVT(ChainCVT):
         nc, iphi, iz, _ = self._idx
         w = v[iphi]
         F, M, dz, diag = self._controls(t, w, zc)
-        Q, Pf = self._forces(q, v, F, M)
+        Q, Pf, *mean_slip = self._forces(q, v, F, M, slip)
         vs = v[nc:]
         D = 2 * self.family.rayleigh(q[:nc], v[:nc]) - Pf + float(vs @ (self.structure.C @ vs))
         side = self._sides[:, 1]
@@ -251,7 +255,7 @@ class ElasticChainCVT(ChainCVT):
         dW = np.array([M[0] * w[0], -M[1] * w[1], D, clamp])
         diag = dict(diag, F=F, M=M, w=w, friction_power=Pf, targets=self.regime.targets(t))
         if slip:
-            diag["slip"] = np.zeros(2)
+            diag["slip"] = mean_slip[0]
         return np.concatenate([v, self.solve_mass(Q), dz, dW]), diag
 
     # ----- Jacobian ----------------------------------------------------------------------------

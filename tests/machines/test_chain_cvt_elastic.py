@@ -238,9 +238,9 @@ def test_energy_balance_over_a_short_run(static):
     assert_energy_balance(m, x0, 5e-5)
 
 
-def test_elastic_shafts_under_other_chains_are_refused_by_name():
+def test_elastic_shafts_with_the_refined_contact_are_refused_by_name():
     with pytest.raises(InputError, match=r"cvt\.effects\.shaft_elasticity"):
-        chain_loop(load_scene("chain-A1,shafts-elastic"))
+        chain_loop(load_scene("chain-S3-refined,shafts-elastic"))
 
 
 @pytest.mark.slow
@@ -281,3 +281,15 @@ def test_whole_pin_chain_on_elastic_shafts():
     assert_jacobian_columns(model, x, J, np.unique(cols))
     F1 = model.outputs(0.0, x0)["contact.sheave_axial_force"][0]
     assert_energy_balance(model.with_clamping([F1, model.F_appl[1]]), x0, 5e-5)
+
+
+def test_mean_slip_of_a_running_state(static):
+    """The loops' mean slip per shaft: the contact-force-weighted mean of the slip speeds the outputs report."""
+    model, x0, _ = static
+    x = _perturbed(model, x0, seed=7)
+    slip = model.evaluate(0.0, x)[1]["slip"]
+    e, k, j, _, _, _, (_, det) = model._mapped_set(x[:model.n2], x[model.n2:2 * model.n2], details=True)
+    speeds = np.linalg.norm(det["slip"], axis=1)
+    for i in range(2):
+        w = det["N"][k == i]
+        assert slip[i] == pytest.approx((w * speeds[k == i]).sum() / w.sum(), rel=1e-12) and slip[i] > 1e-3
