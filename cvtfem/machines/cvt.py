@@ -2,8 +2,8 @@
 
 Coordinate counts follow the spec: band models (low-order digest section 4),
 chain models (chain-models-2.md section 0: 2/3/5/10/21 per pin), shafts
-(shafts-sheaves-supports.md: rigid 2 per shaft, elastic 6 per node plus a
-6-DOF movable sheave), controller states (low-order digest section 5.5).
+(shafts-sheaves-supports.md: rigid 2 per shaft, elastic 6 per node plus the
+movable sheave's axial coordinate), controller states (low-order digest section 5.5).
 """
 from __future__ import annotations
 
@@ -57,8 +57,8 @@ def _shaft(name: str, scene: Scene, model: str) -> Layout:
         return Layout(f"{name} pulley", "rigid-shaft", 2, outputs=tuple(outputs), note="spin angle, sheave axial")
     nodes = shaft.shaft_elements + 1
     outputs.append(OutputSpec(f"{name}.support_force", "N", "Radial force in each of the two bearings.", 4))
-    return Layout(f"{name} pulley", "beam-shaft+rigid-sheave", 6 * nodes + 6, outputs=tuple(outputs),
-                  note=f"{nodes} beam nodes x 6 + movable sheave 6")
+    return Layout(f"{name} pulley", "beam-shaft+rigid-sheaves", 6 * nodes + 1, outputs=tuple(outputs),
+                  note=f"{nodes} beam nodes x 6 + movable sheave axial (machines/shaft_structure.py)")
 
 
 def _chain(scene: Scene) -> Layout:
@@ -245,12 +245,12 @@ def chain_refusal(scene: Scene) -> InputError | None:
     if model not in ("chain-S1", "chain-S2") and not eff.pin_bending:
         return InputError("cvt.effects.pin_bending", False, f"must be true for `{model}` (its pins bend); "
                           "without pin bending use `chain-S2`")
-    if eff.shaft_elasticity:
-        return InputError("cvt.effects.shaft_elasticity", True, f"is not available for `{model}` yet: the chain "
-                          "runs on rigid shafts (set it false)")
     if model == "chain-S1" and eff.contact != "rigid":
         return InputError("cvt.effects.contact", eff.contact, "must be 'rigid' for `chain-S1`: its pins have no axial "
                           "coordinate, their ends follow the sheave faces (chain-models-1 2.2)")
+    if eff.shaft_elasticity and eff.contact != "hertz":
+        return InputError("cvt.effects.shaft_elasticity", True, f"is not available with contact '{eff.contact}' yet: "
+                          "elastic shafts run with H1 contact ('hertz'; set it false for the refined or rigid contact)")
     if model != "chain-S1" and eff.contact not in ("hertz", "hertz-refined"):
         return InputError("cvt.effects.contact", eff.contact, f"must be 'hertz' or 'hertz-refined' for `{model}`: Hertz "
                           "contact at the pin-axis end or refined (the rigid contact runs with `chain-S1` only, the impact "
@@ -274,7 +274,8 @@ def chain_loop(scene: Scene):
     Only what runs is accepted: ``chain-S1`` (rigid contact: the pin ends follow the faces), ``chain-S2`` (no pin
     bending), ``chain-S3`` and the whole-pin chain ``chain-A1``
     (pin bending; :mod:`~cvtfem.machines.chain_a_cvt`, a fixed and a movable sheave per shaft), rigid shafts,
-    ``effects.contact = "hertz"`` (all three) or ``"hertz-refined"`` (S2, S3), friction on.  (A3/A4 build through
+    ``effects.contact = "hertz"`` (all three) or ``"hertz-refined"`` (S2, S3), friction on; with
+    ``effects.shaft_elasticity`` the three with H1 on elastic shafts (:mod:`~cvtfem.machines.chain_cvt_elastic`).  (A3/A4 build through
     the same interface, but their quasi-static start does not converge yet: docs/chain.md.)
     """
     from cvtfem.control.clamping import Clamping
@@ -289,7 +290,21 @@ def chain_loop(scene: Scene):
     clamping = Clamping(band_params(scene), rg.clamping_safety, rg.clamping_split, rg.min_clamping_force)
     F_appl = clamping.forces(rg.torque, rg.ratio)
     overrides = {} if eff.damping else {"damping_ratio": 0.0}
+    if eff.shaft_elasticity:
+        from cvtfem.machines.chain_cvt_elastic import from_scene as elastic_from_scene
+        return elastic_from_scene(scene, chain_geometry(scene), F_appl, model=model, contact=eff.contact, **overrides)
     return from_scene(scene, chain_geometry(scene), F_appl, model=model, contact=eff.contact, **overrides)
+
+
+def _pulley_layouts(model, outputs, sheave: str) -> list[Layout]:
+    """The two pulleys of a running chain: rigid shafts (2 coordinates) or the elastic structure block."""
+    structure = getattr(model, "structure", None)
+    if structure is None:
+        return [Layout(f"{name} pulley", "rigid-shaft", 2, outputs=outputs(f"{name}."),
+                       note=f"spin angle, {sheave} axial") for name in ("driving", "driven")]
+    return [Layout(f"{name} pulley", "beam-shaft+rigid-sheaves", 6 * len(x) + 1, outputs=outputs(f"{name}."),
+                   note=f"{len(x)} beam nodes x 6 + movable sheave axial") for name, x in zip(("driving", "driven"),
+                                                                                             structure.x)]
 
 
 def _running_chain_layout(scene: Scene) -> tuple[Layout, ...]:
@@ -306,8 +321,7 @@ def _running_chain_layout(scene: Scene) -> tuple[Layout, ...]:
                                                       if scene.cvt.model == "chain-S1" else
                                                       "Hertz contact at both pin ends with each shaft's sheaves")
                          + " (continuous: no discrete state)"),
-             Layout("driving pulley", "rigid-shaft", 2, outputs=outputs("driving."), note=f"spin angle, {sheave} axial"),
-             Layout("driven pulley", "rigid-shaft", 2, outputs=outputs("driven."), note=f"spin angle, {sheave} axial")]
+             *_pulley_layouts(model, outputs, sheave)]
     if scene.cvt.effects.stabilisation:
         parts.append(Layout("stabilisation", "speed-ratio-control", 0, n1=Stabilisation.size,
                             outputs=outputs("control."), note="smoothed speeds, F1 integral, b2 integral"))

@@ -72,6 +72,8 @@ def _shaft(name: str, doc: str) -> Table:
         Key("shaft_elements", "int", "Beam elements of the elastic shaft model.", "-", ge=1),
         Key("bearing_stiffness", "float", "Radial stiffness of each of the two bearings.", "N/m", gt=0.0),
         Key("bearing_damping", "float", "Radial damping of each bearing.", "N s/m", ge=0.0),
+        Key("sheave_offset", "float", "Axial distance of each sheave's centre of mass from the chain mid-plane "
+            "(elastic shaft models).", "m", 0.025, gt=0.0),
     ))
 
 

@@ -1,0 +1,621 @@
+"""The symmetric chain (S2, S3) on elastic shafts: :class:`ElasticChainCVT`, the transmission of
+:class:`~cvtfem.machines.chain_cvt.ChainCVT` with the rigid shafts of model 1 replaced by the structure block
+of :mod:`~cvtfem.machines.shaft_structure` (beam FE shafts, rigid sheaves, linear bearings; Table 1.1 (b)'s
+structure).
+
+State ``x = [q_chain, q_structure, velocities, control states, W]``.  Each pin end touches each of the two
+sheaves of a shaft: the end at ``x = (u1, u2, s u3)`` on the sheave on side ``s`` (the mirror end of the
+symmetric chain is implied).  A contact is evaluated in the frame of its sheave: with the sheave's pivot ``o``
+(its node on the undeformed axis), translation ``a`` and small tilt ``theta`` (no spin part), the pin end's
+reference position is ``X = o + (I - theta x)(x - o - a)`` (first order in the tilt) and its velocity the time
+derivative of that map.  The axial part of ``a`` is measured from the pair's mid-plane (half the difference of
+the two sheaves' axial displacements): the symmetric chain has no axial rigid motion, so its mid-plane follows
+each pulley's, as a real chain centres itself between the sheaves (the bearings then carry no axial force from
+the chain).  Mirrored to the ``x3 > 0`` side (``x3 -> s x3``) the position is the input of the rigid model's
+H1 kernel (:class:`~cvtfem.elements.chain.sheave_contact.SheaveContact`) with the sheave face at the constant
+reference position ``z_ref`` of the quasi-static start.  The kernel's force (per end: half its mirrored
+pair's) acts on every coordinate through the same map (virtual work: ``Q = (dX/dq)^T F``), so the pin end gets
+the contact force, the sheave's node its reaction and the moment of it about the pivot, the spin ``phi`` the
+friction moment.  The normal force stays the gradient of the Hertz potential of ``X(q)``, and the friction
+power is that of the kernel: the energy balance of ChainCVT holds with the structure's kinetic and elastic
+energy added and its bearing damping dissipating.  The clamping force ``F_k`` acts between the movable
+sheave (``zeta_k``) and its node; the torques act on the fixed sheave's node, whose spin rate the loops read.
+
+Jacobian: the chain family's blocks, the structure's ``-K``, ``-(C + Omega G)`` and ``-G v`` on the spin
+rates, per-contact central differences of the mapped kernel (19 inputs, 11 outputs, all contacts at once)
+scattered on both sides, and the loops' forward differences, as in ChainCVT.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+from functools import cached_property
+from typing import Any, ClassVar
+
+import numpy as np
+import scipy.linalg as sla
+import scipy.sparse as sp
+from scipy.optimize import least_squares
+
+from cvtfem.assembly.model import StateLayout
+from cvtfem.elements.base import Block
+from cvtfem.elements.chain.sheave_contact import central_local_jacobian
+from cvtfem.errors import NumericalError
+from cvtfem.machines.chain_a_cvt import ChainACVT
+from cvtfem.machines.chain_cvt import ChainCVT
+from cvtfem.machines.shaft_structure import ShaftParameters, ShaftStructure, build_structure
+from cvtfem.outputs import OutputSpec
+
+#: Inputs of a mapped contact: pin end (3), sheave translation (3) and tilt (2), the other sheave's axial
+#: position (1), their rates (9), the spin rate.
+N_MAPPED_IN = 19
+#: Outputs: forces on those 9 positions and on the spin; the friction power.
+N_MAPPED_OUT = 11
+_STEPS = np.array([1e-9] * 9 + [1e-6] * 9 + [1e-5])
+
+
+def _tilt(th):
+    """Tilt vectors (m, 3) from their two components."""
+    return np.column_stack([th, np.zeros(len(th))])
+
+
+@dataclass(frozen=True, eq=False)
+class ElasticChainCVT(ChainCVT):
+    """ChainCVT on the elastic shafts of ``structure`` (:class:`~cvtfem.machines.shaft_structure.ShaftStructure`).
+
+    Attributes (besides ChainCVT's; ``J`` and ``m_sheave`` are the structure's, kept for the loops)
+    structure : ShaftStructure
+    z_ref : (2, 2) m
+        Reference position of each shaft's (fixed, movable) sheave face (the rigid model's at the quasi-static
+        start), counted outwards from the chain mid-plane.
+    """
+
+    structure: Any = None
+    z_ref: np.ndarray = None
+    #: ``(ratio, w1, x0, report)`` of the rigid model's quasi-static start that set ``z_ref`` (reused).
+    rigid_start: tuple = None
+
+    # ----- layout ------------------------------------------------------------------------------
+    @cached_property
+    def layout(self) -> StateLayout:
+        return StateLayout(tuple(self.family.blocks) + (Block("structure", self.structure.n, "m, rad"),)
+                           + tuple(self.control.blocks) + (Block("work", 4, "J", order=1),))
+
+    @cached_property
+    def _idx(self):
+        nc, s = self.family.size, self.structure
+        return nc, nc + s.spin_dof, nc + s.sheave_dofs[:, 1, 2], self.family.dof_index[:, :3]
+
+    @cached_property
+    def _sides(self) -> np.ndarray:
+        """Side (sign of ``x3``) of each shaft's (fixed, movable) sheave, (2, 2)."""
+        m = np.array([p.movable_side for p in self.structure.params])
+        return np.column_stack([-m, m])
+
+    @cached_property
+    def _movable_node_u3(self) -> np.ndarray:
+        """State index of ``u3`` of each movable sheave's node (the clamping reaction acts there)."""
+        return self._idx[0] + self.structure.node_of_sheave[:, 1] + 2
+
+    def state_label(self, i: int) -> str:
+        i, n2, nc = int(i), self.n2, self._idx[0]
+        if i >= 2 * n2 or i % n2 < nc:
+            return super().state_label(i)
+        j, s = i % n2, self.structure
+        k = int(j - nc >= s.offset[1])
+        local = j - nc - s.offset[k]
+        name = f"{('driving', 'driven')[k]} shaft, "
+        n_nodes = len(s.x[k])
+        what = "movable sheave zeta" if local == 6 * n_nodes else \
+            f"node {local // 6} {('u1', 'u2', 'u3', 'theta1', 'theta2', 'phi')[local % 6]}"
+        return name + (f"d({what})/dt" if i >= n2 else what)
+
+    @cached_property
+    def output_specs(self) -> tuple[OutputSpec, ...]:
+        new = []
+        for name in ("driving", "driven"):
+            new += [OutputSpec(f"{name}.bearing_force", "N", f"Forces the two bearings of the {name} shaft carry "
+                               "(K_b u + C_b v), x1 x2 x3 per bearing (the left one locates axially).", 6),
+                    OutputSpec(f"{name}.sheave_tilt", "rad", f"Tilts theta1, theta2 of the fixed, then the movable "
+                               f"sheave of the {name} shaft.", 4),
+                    OutputSpec(f"{name}.sheave_shift", "m", f"Translation u1, u2 of the fixed, then the movable "
+                               f"sheave of the {name} shaft.", 4)]
+        return super().output_specs + tuple(new)
+
+    # ----- contacts ----------------------------------------------------------------------------
+    #: Share of the kernel's output that one evaluation carries (the S2/S3 kernel loads a mirrored pair: 1/2).
+    kernel_share: ClassVar[float] = 0.5
+    #: Sheaves of a shaft each pin end meets (2: the symmetric chain's end stands for both of its mirror pair).
+    sheaves_per_end: ClassVar[int] = 2
+    #: The sheaves' axial motion counts from the pulley's mid-plane (the symmetric chain has no axial motion).
+    axial_relative: ClassVar[bool] = True
+
+    def _mapped_pairs(self, q):
+        """``(ends, shafts, sheaves, cols, coef)``: each broad-phase candidate with both sheaves (0 fixed,
+        1 movable) of its shaft, the state columns and weights (m, 19, k) of its mapped inputs in ``y = [q, v]``
+        (the contact map of :meth:`ChainCVT._contact_map`)."""
+        ends, shafts = self._candidates(q)
+        e, k = np.repeat(ends, 2), np.repeat(shafts, 2)
+        j = np.tile(np.arange(2), len(ends))
+        dof3 = self._idx[3][e]
+        return (e, k, j) + self._mapped_map(dof3[:, :, None], np.ones(dof3.shape + (1,)), k, j)
+
+    def _mapped_map(self, end_cols, end_coef, k, j):
+        """The mapped inputs' ``(cols, coef)`` (m, 19, K) from the pin-end position's (m, 3, K) in the mirrored
+        frame of its sheave (``x3 -> s x3``) and the sheave's structure columns."""
+        nc, n2 = self._idx[0], self.n2
+        sd = nc + self.structure.sheave_dofs[k, j]                 # (m, 6)
+        other = nc + self.structure.sheave_dofs[k, 1 - j, 2]
+        own = np.column_stack([sd[:, :5], other])                  # (m, 6)
+        m, K = len(k), end_cols.shape[2]
+        cols = np.zeros((m, N_MAPPED_IN, K), np.int64)
+        coef = np.zeros((m, N_MAPPED_IN, K))
+        for off in (0, 9):
+            cols[:, off:off + 3] = end_cols + (n2 if off else 0)
+            coef[:, off:off + 3] = end_coef
+            cols[:, off + 3:off + 9, 0] = own + (n2 if off else 0)
+            coef[:, off + 3:off + 9, 0] = 1.0
+        cols[:, 18, 0] = n2 + sd[:, 5]
+        coef[:, 18, 0] = 1.0
+        return cols, coef
+
+    def mapped_local(self, Z, k, j, details: bool = False):
+        """Outputs (m, 11) of mapped contacts with inputs ``Z`` (m, 19, :data:`N_MAPPED_IN`) on shafts ``k``, sheaves
+        ``j``: generalized forces on the pin-end coordinates (3), the sheave's translation (3) and tilt (2), the other
+        sheave's axial position (1) and the spin (1), and the friction power (W); with ``details`` also the kernel's
+        per-contact dict (for one end and one sheave) with the mapped position ``X`` (kernel frame), tilt, side."""
+        s = self._sides[k, j].astype(float)
+        o = np.column_stack([self.contact.centres[k], self.structure.sheave_x3[k, j]])
+        x = Z[:, :3].copy()
+        x[:, 2] *= s
+        a, th = Z[:, 3:6].copy(), _tilt(Z[:, 6:8])
+        vx = Z[:, 9:12].copy()
+        vx[:, 2] *= s
+        va, vth = Z[:, 12:15].copy(), _tilt(Z[:, 15:17])
+        if self.axial_relative:                                  # axial: from the pair's mid-plane
+            a[:, 2] = 0.5 * (Z[:, 5] - Z[:, 8])
+            va[:, 2] = 0.5 * (Z[:, 14] - Z[:, 17])
+        d, dd = x - o - a, vx - va
+        X = o + d - np.cross(th, d)
+        Xd = dd - np.cross(th, dd) - np.cross(vth, d)
+        X[:, 2] *= s
+        Xd[:, 2] *= s
+        kin = np.column_stack([X, self.z_ref[k, j], Xd, np.zeros(len(Z)), Z[:, 18]])
+        out = self.contact.local(kin, k, details)
+        Y, det = out if details else (out, None)
+        if details:
+            det = dict(det, X=X, tilt=th, side=s)
+        F = self.kernel_share * Y[:, :3]
+        F[:, 2] *= s                                               # conjugate to X in the true frame
+        Qx = F + np.cross(th, F)                                     # (I - theta x)^T F
+        Qpin = Qx.copy()
+        Qpin[:, 2] *= s
+        Qa = -Qx
+        Qo = np.zeros(len(Z))
+        if self.axial_relative:
+            Qa[:, 2] *= 0.5
+            Qo = -Qa[:, 2]
+        share = self.kernel_share
+        res = np.column_stack([Qpin, Qa, -np.cross(d, F)[:, :2], Qo, share * Y[:, 4], share * Y[:, 5]])
+        return (res, det) if details else res
+
+    def _mapped_set(self, q, v, details: bool = False):
+        e, k, j, cols, coef = self._mapped_pairs(q)
+        Z = (coef * np.concatenate([q, v])[cols]).sum(axis=2)
+        return e, k, j, cols, coef, Z, self.mapped_local(Z, k, j, details)
+
+    def _contacts(self, q, v, details=False):
+        e, k, j, cols, coef, Z, Y = self._mapped_set(q, v, details)
+        return e, k, Z, Y
+
+    # ----- right-hand side ---------------------------------------------------------------------
+    def _forces(self, q, v, F, M, slip: bool = False):
+        """Generalized forces (N, N m) and the friction power (W); with ``slip`` also the contact-force-weighted
+        mean slip speed on each shaft (m/s, 0 without contact), as ChainCVT's."""
+        nc, iphi, iz, _ = self._idx
+        s = self.structure
+        Q = np.zeros(self.n2)
+        Q[:nc] = self.family.forces(q[:nc], v[:nc])
+        e, k, j, cols, coef, Z, Y = self._mapped_set(q, v, details=slip)
+        if slip:
+            Y, det = Y
+            N = np.bincount(k, det["N"], 2)
+            mean_slip = np.bincount(k, det["N"] * np.linalg.norm(det["slip"], axis=1), 2) / np.maximum(N, 1e-300)
+        rows, wr = self._output_rows(cols, coef)
+        Q += np.bincount(rows.ravel(), (wr * Y[:, :-1, None]).ravel(), self.n2)
+        qs, vs = q[nc:], v[nc:]
+        Q[nc:] -= s.K @ qs + s.damping_matrix(v[iphi]) @ vs
+        Q[iphi] += M
+        side = self._sides[:, 1]
+        Q[iz] -= side * F
+        Q[self._movable_node_u3] += side * F
+        Pf = float(Y[:, 10].sum())
+        return (Q, Pf, mean_slip) if slip else (Q, Pf)
+
+    @cached_property
+    def _structure_inverse(self) -> np.ndarray:
+        return sla.inv(self.structure.M.toarray())
+
+    def solve_mass(self, Q):
+        nc = self._idx[0]
+        a = np.empty_like(Q)
+        a[:nc] = self.family.solve_mass(Q[:nc])
+        a[nc:] = self._structure_inverse @ Q[nc:]
+        return a
+
+    def evaluate(self, t: float, x, slip: bool = True):
+        q, v, zc, _ = self.split(x)
+        nc, iphi, iz, _ = self._idx
+        w = v[iphi]
+        F, M, dz, diag = self._controls(t, w, zc)
+        Q, Pf, *mean_slip = self._forces(q, v, F, M, slip)
+        vs = v[nc:]
+        D = 2 * self.family.rayleigh(q[:nc], v[:nc]) - Pf + float(vs @ (self.structure.C @ vs))
+        side = self._sides[:, 1]
+        clamp = -float(np.sum(side * F * (v[iz] - v[self._movable_node_u3])))
+        dW = np.array([M[0] * w[0], -M[1] * w[1], D, clamp])
+        diag = dict(diag, F=F, M=M, w=w, friction_power=Pf, targets=self.regime.targets(t))
+        if slip:
+            diag["slip"] = mean_slip[0]
+        return np.concatenate([v, self.solve_mass(Q), dz, dW]), diag
+
+    # ----- Jacobian ----------------------------------------------------------------------------
+    def _mapped_jacobian(self, q, v):
+        """``(cols, coef, Jl)``: the contact map and the local Jacobians (m, 11, 19) of the mapped contacts."""
+        e, k, j, cols, coef, Z, _ = self._mapped_set(q, v)
+        Jl = central_local_jacobian(lambda Zp, kk: self.mapped_local(Zp, kk, j), Z, k, _STEPS, N_MAPPED_OUT)
+        return cols, coef, Jl
+
+    @cached_property
+    def _inv_mass(self) -> sp.csr_matrix:
+        import scipy.sparse.linalg as spla
+        Mc = sp.csc_matrix(self.family.mass_matrix())
+        return sp.block_diag([sp.csr_matrix(spla.inv(Mc)), sp.csr_matrix(self._structure_inverse)], format="csr")
+
+    def jac(self, t: float, x) -> sp.csr_matrix:
+        q, v, zc, _ = self.split(x)
+        nc, iphi, iz, _ = self._idx
+        s = self.structure
+        n2, nz, N = self.n2, self.control.size, self.size
+        ctrl = 2 * n2 + np.arange(nz)
+        w = v[iphi]
+        F, M, G = self._loop_gradient(t, w, zc)
+        in_cols = np.concatenate([n2 + iphi, ctrl])
+        Kc, Cc = self.family.jacobian(q[:nc], v[:nc])
+        side = self._sides[:, 1]
+        mu3 = self._movable_node_u3
+        parts = []
+        for Mx, off in ((Kc.tocoo(), 0), (Cc.tocoo(), n2)):
+            parts.append((Mx.row, Mx.col + off, Mx.data))
+        cols, coef, Jl = self._mapped_jacobian(q, v)
+        parts.append(self._contact_entries(cols, coef, Jl))
+        for Mx, off in ((-s.K).tocoo(), nc), ((-s.damping_matrix(w)).tocoo(), n2 + nc):
+            parts.append((Mx.row + nc, Mx.col + off, Mx.data))
+        vs = v[nc:]
+        for kk in range(2):
+            gv = -(s.G[kk] @ vs)
+            nzr = np.flatnonzero(gv)
+            parts.append((nc + nzr, np.full(len(nzr), n2 + iphi[kk]), gv[nzr]))
+        for kk in range(2):
+            parts.append((np.full(len(in_cols), iz[kk]), in_cols, -side[kk] * G[kk]))
+            parts.append((np.full(len(in_cols), mu3[kk]), in_cols, side[kk] * G[kk]))
+        parts.append((np.full(len(in_cols), iphi[1]), in_cols, G[2]))
+        r, c, d = (np.concatenate([np.ravel(p[i]) for p in parts]) for i in range(3))
+        dQ = sp.csr_matrix((d, (r, c)), shape=(n2, N))
+        acc = self._inv_mass @ dQ
+        Wr = sp.lil_matrix((4, N))
+        Wr[0, n2 + iphi[0]] = M[0]
+        Wr[1, in_cols] = -w[1] * G[2]
+        Wr[1, n2 + iphi[1]] += -M[1]
+        Qd = self.family.dissipative_forces(q[:nc], v[:nc])
+        Kd = self.family.jacobian(q[:nc], v[:nc], part="dissipative", wrt=(0,))[0]
+        dD = np.zeros(N)
+        cw = np.where(cols < 2 * n2, coef, 0.0)
+        np.add.at(dD, np.where(cw != 0, cols, 0).ravel(), -(cw * Jl[:, -1, :, None]).ravel())
+        dD[np.arange(nc)] += -(Kd.T @ v[:nc])
+        dD[n2 + np.arange(nc)] += -2 * Qd
+        dD[n2 + nc:2 * n2] += 2 * (s.C @ vs)
+        Wr[2, :] = dD
+        Wr[3, n2 + iz] = -side * F
+        Wr[3, n2 + mu3] = side * F
+        rel = v[iz] - v[mu3]
+        Wr[3, in_cols] = -((side * rel) @ G[:2])
+        ctrl_rows = sp.csr_matrix((G[3:].ravel(), (np.repeat(np.arange(nz), 2 + nz), np.tile(in_cols, nz))),
+                                  shape=(nz, N))
+        top = sp.csr_matrix((np.ones(n2), (np.arange(n2), n2 + np.arange(n2))), shape=(n2, N))
+        return sp.vstack([top, acc, ctrl_rows, Wr.tocsr()], format="csr")
+
+    @cached_property
+    def jac_sparsity(self) -> sp.csr_matrix:
+        """Structural pattern: the chain stencil, every pin with both sheaves of every shaft, the structure
+        (dense per shaft through its inverse mass), the loops, dense work-rate rows."""
+        nc, iphi, iz, _ = self._idx
+        n2, nz, N = self.n2, self.control.size, self.size
+        ctrl = 2 * n2 + np.arange(nz)
+        P = sp.csr_matrix(self.family.jac_sparsity, dtype=float).tocoo()
+        rows, cols = [P.row, P.row], [P.col, P.col + n2]
+        mc, mw = self._all_mapped()
+        r, c, _ = self._contact_entries(mc, mw, np.ones((len(mc), N_MAPPED_OUT, N_MAPPED_IN)))
+        rows.append(r)
+        cols.append(c)
+        S = (abs(self.structure.K) + abs(self.structure.C) + abs(self.structure.G[0]) + abs(self.structure.G[1]))
+        S = S.tocoo()
+        rows += [S.row + nc, S.row + nc]
+        cols += [S.col + nc, S.col + n2 + nc]
+        ns = self.structure.n
+        rows.append(np.repeat(nc + np.arange(ns), 2))
+        cols.append(np.tile(n2 + iphi, ns))
+        in_cols = np.concatenate([n2 + iphi, ctrl])
+        tgt = np.concatenate([iz, self._movable_node_u3, iphi])
+        rows.append(np.repeat(tgt, len(in_cols)))
+        cols.append(np.tile(in_cols, len(tgt)))
+        dQ = sp.csr_matrix((np.ones(sum(len(x) for x in rows)), (np.concatenate(rows), np.concatenate(cols))),
+                           shape=(n2, N))
+        acc = (abs(self._inv_mass) @ dQ) != 0
+        top = sp.csr_matrix((np.ones(n2), (np.arange(n2), n2 + np.arange(n2))), shape=(n2, N))
+        ctrl_rows = sp.csr_matrix((np.ones(nz * len(in_cols)), (np.repeat(np.arange(nz), len(in_cols)),
+                                                                  np.tile(in_cols, nz))), shape=(nz, N))
+        dense = np.arange(2 * n2 + nz)
+        W = sp.csr_matrix((np.ones(4 * len(dense)), (np.repeat(np.arange(4), len(dense)), np.tile(dense, 4))),
+                          shape=(4, N))
+        return sp.vstack([top, acc.astype(float), ctrl_rows, W], format="csr").astype(bool)
+
+    def _axial_outputs(self, k, j, c) -> dict[str, np.ndarray]:
+        """Axial force of the pins on one sheave of each shaft (N, pushing it open): the pair's mean."""
+        return {"contact.sheave_axial_force": -np.bincount(k, c["F"][:, 2], 2) / self.sheaves_per_end}
+
+    def _all_mapped(self):
+        """``(cols, coef)`` of every mapped contact the broad phase may return (the structural pattern)."""
+        ends, shafts = self._all_pairs()
+        e, k = np.repeat(ends, 2), np.repeat(shafts, 2)
+        dof3 = self._idx[3][e]
+        return self._mapped_map(dof3[:, :, None], np.ones(dof3.shape + (1,)), k, np.tile(np.arange(2), len(ends)))
+
+    # ----- energy and outputs ------------------------------------------------------------------
+    def energy(self, x) -> float:
+        """Kinetic plus elastic energy: chain, structure (``v M v / 2 + q K q / 2``), Hertz potentials, J."""
+        q, v, _, _ = self.split(x)
+        nc, s = self._idx[0], self.structure
+        _, _, _, (_, info) = self._contacts(q, v, details=True)
+        qs, vs = q[nc:], v[nc:]
+        return float(self.family.energy(q[:nc], v[:nc]) + 0.5 * vs @ (s.M @ vs) + 0.5 * qs @ (s.K @ qs)
+                     + self.kernel_share * info["potential"].sum())
+
+    def outputs(self, t: float, x) -> dict[str, Any]:
+        """Named outputs; per pin end and shaft the contact values are the means over the two sheaves, the
+        support force is the bearings' reaction on the shaft in the chain plane."""
+        dx, diag = self.evaluate(t, x, slip=False)
+        q, v, _, W = self.split(x)
+        nc, n, s = self._idx[0], self.n_ends, self.structure
+        e, k, j, _, _, _, (Y, c) = self._mapped_set(q, v, details=True)
+        on = c["delta"] > 0
+        slot = 2 * e + k
+
+        def per(values, width=1):
+            out = np.zeros((2 * n, width))
+            np.add.at(out, slot, np.reshape(values, (len(slot), width)) / self.sheaves_per_end)
+            return out.ravel()
+        P = dx[-4:]
+        w, M, F = diag["w"], diag["M"], diag["F"]
+        qs, vs = q[nc:], v[nc:]
+        bearing = s.bearing_forces(qs, vs)
+        tilt = qs[s.sheave_dofs[:, :, 3:5]].reshape(2, 4)
+        shift = qs[s.sheave_dofs[:, :, 0:2]].reshape(2, 4)
+        out = dict(self.family.outputs(q[:nc], v[:nc]))
+        out.update({"chain.coordinates": q[:nc], "chain.span_tension": self.span_tensions(q, v, e, c["delta"]),
+                    "contact.normal_force": per(c["N"]), "contact.penetration": per(c["delta"]),
+                    "contact.radius": per(np.where(on, c["radius"], 0.0)),
+                    "contact.slip_speed": per(np.where(on, np.linalg.norm(c["slip"], axis=1), 0.0)),
+                    "contact.friction_force": per(c["F_fr"], 3),
+                    "contact.friction_power": np.bincount(k, Y[:, 10], 2),
+                    **self._axial_outputs(k, j, c),
+                    "driving.speed": w[0], "driven.speed": w[1], "driving.torque": M[0], "driven.torque": M[1],
+                    "driving.clamping_force": F[0], "driven.clamping_force": F[1],
+                    "driving.support_force": -bearing[0, :, :2].sum(axis=0),
+                    "driven.support_force": -bearing[1, :, :2].sum(axis=0),
+                    "ratio": w[0] / w[1] if w[1] else np.nan, "efficiency": P[1] / P[0] if P[0] else 0.0,
+                    "power": P, "work": W, "energy": self.energy(x),
+                    "control.ratio_estimate": diag["ratio_estimate"], "control.resistance": diag["resistance"]})
+        for i, name in enumerate(("driving", "driven")):
+            out[f"{name}.bearing_force"] = bearing[i].ravel()
+            out[f"{name}.sheave_tilt"] = tilt[i]
+            out[f"{name}.sheave_shift"] = shift[i]
+        return {o.name: out[o.name] for o in self.output_specs}
+
+    # ----- initial state -----------------------------------------------------------------------
+    def rigid(self) -> ChainCVT:
+        """The same chain, contact, loops and regime on the rigid shafts of model 1 (its ``J``, sheave mass)."""
+        return ChainCVT(self.family, self.contact, self.J, self.m_sheave, self.regime, self.F_appl, self.control)
+
+    def static_state(self, ratio: float, w1: float, tension: float | None = None, tol: float = 1e-10):
+        """Quasi-static start on the elastic shafts: the rigid model's (:meth:`ChainCVT.static_state`, which
+        also sets the faces' reference positions ``z_ref``), then the chain and the structure solved together
+        (scipy ``least_squares``) for the balance of chain, Hertz, bearing and shaft forces with the driven
+        clamping force and the chain's centrifugal forces; the spins and the driving movable sheave held (its
+        clamping force is the reaction, ``report["F1"]``).  Returns ``(x0, report)`` as ChainCVT's, and
+        ``report["model"]``: the model with ``z_ref`` set (use it for the run)."""
+        rs = self.rigid_start
+        if rs is not None and tension is None and (rs[0], rs[1]) == (ratio, w1):
+            x0r, rep = rs[2], rs[3]
+        else:
+            x0r, rep = self.rigid().static_state(ratio, w1, tension, tol)
+        model = replace(self, z_ref=self._face_reference(x0r), rigid_start=(ratio, w1, x0r, rep))
+        return model._elastic_static(x0r, rep, w1, tol)
+
+    def referenced(self) -> "ElasticChainCVT":
+        """The model with the faces' reference positions ``z_ref`` of the rigid quasi-static start at the regime's
+        ratio and driving speed at ``t = 0`` (what :meth:`start` starts from)."""
+        w1, _, i = self.regime.targets(0.0)
+        x0r, rep = self.rigid().static_state(i, w1)
+        return replace(self, z_ref=self._face_reference(x0r), rigid_start=(i, w1, x0r, rep))
+
+    def _face_reference(self, x0r) -> np.ndarray:
+        """``z_ref`` (2, 2) from the rigid start ``x0r``: both faces of a pair at its ``z``."""
+        z = x0r[self.rigid()._idx[2]]
+        return np.column_stack([z, z])
+
+    def _elastic_static(self, x0r, rep, w1, tol):
+        """The chain and structure balance from the rigid start ``(x0r, rep)`` (:meth:`static_state`)."""
+        nc, _, iz, _ = self._idx
+        s, n2, fam = self.structure, self.n2, self.family
+        rig = self.rigid()
+        r_iphi, r_n2 = rig._idx[1], rig.n2
+        F2 = rep["F2"]
+        q = np.zeros(n2)
+        q[:nc] = x0r[:nc]
+        pl = rep["placement"]
+        speed = w1 * pl.r[0]
+        a = np.zeros(nc)
+        au = self.pin_positions(a)
+        for kk in range(2):
+            sel = pl.piece == kk
+            au[sel] = -speed ** 2 / pl.r[kk] * (pl.u[sel] - self.contact.centres[kk]) / pl.r[kk]
+        Q_cf = -(fam.mass_matrix() @ a)
+        spins = nc + np.flatnonzero(s.dof_kind == 5)
+        held = np.concatenate([spins, [iz[0]]])
+        free = np.setdiff1d(np.arange(n2), held)
+        vel = np.zeros(n2)
+        F_stat = np.array([0.0, F2])
+        mu3 = self._movable_node_u3
+
+        def forces(y):
+            qq = q.copy()
+            qq[free] = y
+            Q, _ = self._forces(qq, vel, F_stat, np.zeros(2))
+            Q[:nc] += Q_cf
+            Q[mu3[0]] += Q[iz[0]]                       # the held sheave's clamping reaction on its node
+            return Q
+
+        def jacobian(y):
+            qq = q.copy()
+            qq[free] = y
+            x = np.concatenate([qq, vel, self.control.initial_state(0.0, 0.0), np.zeros(4)])
+            K = self.jac(0.0, x)[n2:2 * n2, :n2]
+            Ms = sp.block_diag([sp.csr_matrix(fam.mass_matrix()), self.structure.M], format="csr")
+            dQ = (Ms @ K).toarray()
+            dQ[mu3[0]] += dQ[iz[0]]
+            return dQ[free][:, free] / F2
+        sol = least_squares(lambda y: forces(y)[free] / F2, q[free], jac=jacobian, method="lm", xtol=tol,
+                            ftol=tol, gtol=tol, x_scale=1e-5, max_nfev=200)
+        q[free] = sol.x
+        Q = forces(sol.x)
+        res = float(np.abs(Q[free]).max() / F2)
+        if not res <= 1e-6:
+            raise NumericalError(f"the quasi-static solve on elastic shafts ended with a residual of {res:.3g} of the "
+                                 f"clamping force after {sol.nfev} evaluations ({sol.message})",
+                                 component="ElasticChainCVT.static_state")
+        side = self._sides[:, 1]
+        F1 = float(Q[iz[0]] / side[0])
+        v = np.zeros(n2)
+        v[:nc] = x0r[r_n2:r_n2 + nc]
+        w = x0r[r_n2 + r_iphi]
+        for kk in range(2):
+            sl = slice(nc + s.offset[kk], nc + s.offset[kk] + 6 * len(s.x[kk]))
+            v[sl][5::6] = w[kk]
+        self._turn_with_sheaves(q, v)
+        x0 = np.concatenate([q, v, self.control.initial_state(*w), np.zeros(4)])
+        _, _, _, (_, c) = self._contacts(q, v, details=True)
+        report = dict(rep, residual=res, F1=F1, rigid_F1=rep["F1"], model=self, nfev_elastic=sol.nfev,
+                      max_penetration=float(c["delta"].max()),
+                      tension=float(self._elastic_link_tension(q[:nc]).mean()))
+        return x0, report
+
+    def _turn_with_sheaves(self, q, v) -> None:
+        """Set the velocities of the pin ends touching a fixed sheave to those of its material point (no slip): the
+        spin about the sheave's displaced, tilted axis (to first order in the tilt)."""
+        e, k, j, _, _, Z, (_, det) = self._mapped_set(q, v, details=True)
+        on = (j == 0) & (det["delta"] > 0)
+        arm = det["X"][on, :2] - self.contact.centres[k[on]]
+        target = np.column_stack([-arm[:, 1], arm[:, 0], np.zeros(on.sum())]) * Z[on, 18, None]
+        target[:, 2] *= det["side"][on]
+        rate = target + np.cross(det["tilt"][on], target)
+        rate[:, 2] *= det["side"][on]
+        v[self._idx[3][e[on]]] = rate
+
+    def start(self):
+        w1, _, i = self.regime.targets(0.0)
+        x0, rep = self.static_state(i, w1)
+        if not np.array_equal(rep["model"].z_ref, self.z_ref):
+            raise NumericalError("the model's face reference positions are not those of its start: build it with "
+                                 "`referenced()`", component="ElasticChainCVT.start")
+        return x0, {"kind": f"quasi-static on elastic shafts (residual {rep['residual']:.1e} of F2, largest "
+                            f"penetration {1e6 * rep['max_penetration']:.1f} um)", "model": rep["model"]}
+
+
+@dataclass(frozen=True, eq=False)
+class ElasticChainACVT(ElasticChainCVT, ChainACVT):
+    """The whole-pin chain (A1) on elastic shafts: :class:`ElasticChainCVT`'s structure and sheave frames under
+    :class:`~cvtfem.machines.chain_a_cvt.ChainACVT`'s pin ends, each meeting the one sheave on its side of a shaft
+    (its movable or fixed sheave) with the pin end a combination of the pin's coordinates (its contact map).  The
+    chain moves axially, so the sheaves' axial motion counts from the undeformed positions and the locating
+    bearing carries the pulley's net axial force; the fixed faces start at ChainACVT's ``fixed_z``."""
+
+    kernel_share: ClassVar[float] = 1.0
+    sheaves_per_end: ClassVar[int] = 1
+    axial_relative: ClassVar[bool] = False
+
+    def _sheave_of(self, ends, shafts) -> np.ndarray:
+        """Sheave (0 fixed, 1 movable) an end on side ``+-1`` (odd ends: ``x3 > 0``) meets on each shaft."""
+        side = np.where(ends % 2 == 1, 1, -1)
+        return (np.asarray(self.movable_side)[shafts] == side).astype(np.int64)
+
+    def _pairs_map(self, ends, shafts):
+        j = self._sheave_of(ends, shafts)
+        cols, coef = ChainACVT._contact_map(self, ends, shafts)
+        return (ends, shafts, j) + self._mapped_map(cols[:, :3], coef[:, :3], shafts, j)
+
+    def _mapped_pairs(self, q):
+        return self._pairs_map(*self._candidates(q))
+
+    def _all_mapped(self):
+        return self._pairs_map(*self._all_pairs())[3:]
+
+    def rigid(self) -> ChainACVT:
+        return ChainACVT(self.family, self.contact, self.J, self.m_sheave, self.regime, self.F_appl, self.control,
+                         self.movable_side, self.fixed_z)
+
+    def _face_reference(self, x0r) -> np.ndarray:
+        """``z_ref`` (2, 2): the fixed faces at ``fixed_z``, the movable ones at the rigid start's ``z``."""
+        return np.column_stack([self.fixed_z, x0r[self.rigid()._idx[2]]])
+
+    def _axial_outputs(self, k, j, c) -> dict[str, np.ndarray]:
+        F3 = c["F"][:, 2]
+        return {"contact.sheave_axial_force": -np.bincount(k[j == 1], F3[j == 1], 2),
+                "contact.fixed_sheave_axial_force": -np.bincount(k[j == 0], F3[j == 0], 2)}
+
+    def _turn_with_sheaves(self, q, v) -> None:
+        """The pins on each arc turn with the spin about the sheaves' displaced axis (the tilt left out)."""
+        nc, iphi = self._idx[0], self._idx[1]
+        s = self.structure
+        e, k, j, _, _, _, (_, det) = self._mapped_set(q, v, details=True)
+        for kk in range(2):
+            pins = np.unique(self.pin_of(e[(k == kk) & (det["delta"] > 0)]))
+            centre = self.contact.centres[kk] + q[nc + s.sheave_dofs[kk, :, :2]].mean(axis=0)
+            ChainACVT._turn_with_sheave(self, q[:nc], v[:nc], pins, v[iphi[kk]], centre)
+
+
+def shaft_parameters(scene) -> tuple[ShaftParameters, ShaftParameters]:
+    """The two shafts of a CVT scene's ``[cvt.driving]``, ``[cvt.driven]`` (movable sheaves on opposite sides)."""
+    cvt = scene.cvt
+    return tuple(ShaftParameters(s.shaft_length, s.shaft_diameter, s.shaft_elements, s.sheave_offset, s.inertia,
+                                 s.sheave_mass, s.sheave_transverse_inertia, s.bearing_stiffness, s.bearing_damping,
+                                 side)
+                 for s, side in ((cvt.driving, 1), (cvt.driven, -1)))
+
+
+def elastic(rigid: ChainCVT, structure: ShaftStructure) -> ElasticChainCVT:
+    """The rigid transmission ``rigid`` (ChainCVT, or ChainACVT: :class:`ElasticChainACVT`) on ``structure`` (``z_ref`` set by :meth:`ElasticChainCVT.static_state`)."""
+    args = (rigid.family, rigid.contact, rigid.J, rigid.m_sheave, rigid.regime, rigid.F_appl, rigid.control)
+    if isinstance(rigid, ChainACVT):
+        return ElasticChainACVT(*args, rigid.movable_side, rigid.fixed_z, structure, np.zeros((2, 2)))
+    return ElasticChainCVT(*args, structure, np.zeros((2, 2)))
+
+
+def from_scene(scene, geom, F_appl, **overrides) -> ElasticChainCVT:
+    """:func:`cvtfem.machines.chain_cvt.from_scene` on the scene's elastic shafts (its ``effects.gyroscopic``,
+    ``effects.damping``)."""
+    from cvtfem.machines.chain_cvt import from_scene as rigid_from_scene
+
+    eff = scene.cvt.effects
+    structure = build_structure(shaft_parameters(scene), scene.cvt.young_modulus, gyroscopic=eff.gyroscopic,
+                                damping=eff.damping)
+    return elastic(rigid_from_scene(scene, geom, F_appl, **overrides), structure).referenced()
