@@ -32,8 +32,12 @@ from cvtfem.blas import arpack_start
 from cvtfem.errors import InputError, NumericalError
 from cvtfem.modal.whirl import circularize, classify, mac
 
-#: Models up to this many DOF are solved densely by ``method="auto"``.
-DENSE_LIMIT = 600
+#: ``method="auto"`` solves a block densely when it has at most ``DENSE_PER_MODE (n_modes + 5)`` DOF, else by
+#: sparse shift-invert: dense costs ~m^3 whatever the modes asked, sparse ~m (n_modes + 5). Measured crossover
+#: (studies/rotor/bench_backend.py, one solve of a damped gyroscopic shaft): 44 lateral DOF about even, 84 DOF
+#: sparse 1.6-2x faster for 6-12 modes, dense still 1.4x faster for 24 modes; 4 puts the switch at 44, 68 and
+#: 116 DOF for 6, 12 and 24 modes. (Before: dense up to 600 DOF, 10-50x slower on 160-600 DOF blocks.)
+DENSE_PER_MODE = 4
 #: Dense: eigenvalues with Im below this fraction of the block's largest |lambda| count as non-oscillatory
 #: (a rigid-body Jordan pair is perturbed by about sqrt(eps) |lambda|_max).
 ZERO_RTOL = 1e-6
@@ -123,7 +127,8 @@ class ModalProblem:
     dof_kind : int array (n,)
         Node-DOF kind 0..5 of every DOF (``u1 u2 u3 theta1 theta2 phi``).
     method : {"auto", "dense", "sparse", "slepc"}
-        "auto" picks dense for blocks up to :data:`DENSE_LIMIT` DOF, sparse above.
+        "auto" picks dense for blocks up to ``DENSE_PER_MODE (n_modes + 5)`` DOF (:data:`DENSE_PER_MODE`),
+        sparse above; :attr:`method` then tells the backends the last solve used.
     damped : bool
         False drops C (undamped analysis; G is kept).
     blas_threads : int or None
@@ -165,9 +170,8 @@ class ModalProblem:
             pattern = pattern + abs(sp.csr_matrix(speed_terms.pattern))
         n_blocks, label = connected_components(pattern, directed=False)
         self.blocks = [np.flatnonzero(label == b) for b in range(n_blocks)]
-        #: backend of each block ("auto": dense up to DENSE_LIMIT DOF, else sparse)
-        self.block_methods = [("dense" if len(d) <= DENSE_LIMIT else "sparse") if method == "auto" else method
-                              for d in self.blocks]
+        #: backend of each block ("auto": chosen per solve by :meth:`backend`)
+        self.block_methods = [method] * n_blocks
         self.method = "+".join(sorted(set(self.block_methods)))
         touched = (np.zeros(self.n, bool) if speed_terms is None
                    else np.asarray(abs(sp.csr_matrix(speed_terms.pattern)).sum(axis=1)).ravel() > 0)
@@ -208,6 +212,8 @@ class ModalProblem:
         if n_modes < 1:
             raise InputError("n_modes", n_modes, "must be >= 1")
         limit = self._blas.limit(limits=self.blas_threads, user_api="blas") if self._blas else nullcontext()
+        if "auto" in self.block_methods:
+            self.method = "+".join(sorted({self.backend(b, n_modes) for b in range(len(self.blocks))}))
         with limit:
             modes = self._solve(speed, n_modes, sigma, min_modes)
             planar = (np.abs(modes.whirl_ratio) < PLANAR) & np.isin(modes.whirl, ("forward", "backward"))
@@ -252,7 +258,12 @@ class ModalProblem:
         Blocks too small for a Krylov space of the requested size (``n_modes + 5``
         DOF or fewer) are solved densely by every backend.
         """
-        return "dense" if len(self.blocks[b]) <= n_modes + 5 else self.block_methods[b]
+        m = len(self.blocks[b])
+        if m <= n_modes + 5:
+            return "dense"
+        if self.block_methods[b] == "auto":
+            return "dense" if m <= DENSE_PER_MODE * (n_modes + 5) else "sparse"
+        return self.block_methods[b]
 
     def _solve_block(self, b: int, speed: float, n_modes: int,
                      sigma: float | None) -> tuple[np.ndarray, np.ndarray]:
