@@ -130,9 +130,11 @@ def test_compressor_modes_with_speed_dependent_supports(compressor):
         modes = problem.solve(entry["speed"], 14)
         for wd, ld, whirl in zip(entry["wd"], entry["log_dec"], entry["whirl"]):
             i = np.argmin(np.abs(modes.wd - wd))
-            assert modes.wd[i] == pytest.approx(wd, rel=1e-8), (entry["speed"], wd)
-            if whirl != "None":
-                assert modes.log_dec[i] == pytest.approx(ld, rel=1e-6, abs=1e-8), (entry["speed"], wd)
+            if whirl != "None":  # lateral: measured 3.2e-10 (wd), 2.7e-9 (log dec)
+                assert modes.wd[i] == pytest.approx(wd, rel=1e-8), (entry["speed"], wd)
+                assert modes.log_dec[i] == pytest.approx(ld, rel=1e-7, abs=1e-10), (entry["speed"], wd)
+            else:  # ROSS's axial and torsional modes: 8e-9 (dense and sparse alike; cause not traced)
+                assert modes.wd[i] == pytest.approx(wd, rel=1e-7), (entry["speed"], wd)
 
 
 def test_compressor_constant_coefficients_differ():
