@@ -3,6 +3,7 @@ import json
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 DATA = Path(__file__).resolve().parent / "data" / "ross"
 
@@ -19,6 +20,8 @@ def test_rotormaps_matches_ross_and_writes_figures(cli, tmp_path):
     assert np.allclose(d["static_rigid_u2_m"], ref["static"]["disp_y"], rtol=1e-9, atol=1e-15)
     assert np.allclose(np.array(d["critical_wn_rad_s"]).T, ref["ucs"]["wn"], rtol=1e-8)
     assert np.allclose(d["modes"]["wd_rad_s"], ref["modal_500"]["wd"][:4], rtol=1e-8)
+    # the constant kxx = 1 MN/m crosses mode 1 where ROSS's map does (1e6 is on its grid: exact there)
+    assert d["crossings"][0]["speed_rad_s"] == pytest.approx(ref["ucs"]["intersection_speed"][0], rel=1e-8)
     # on the (softer) bearings the shaft sags more than on rigid supports, by the bearing compression
     weight = -min(d["static_bearings_u2_m"][0], d["static_bearings_u2_m"][-1])
     assert weight > 0 and min(d["static_bearings_u2_m"]) < min(d["static_rigid_u2_m"])

@@ -92,6 +92,14 @@ def run(args: argparse.Namespace) -> int:
         kxx = np.array([model.tables.coefficients(x)[i, 0] for x in s])
         curves.append((f"kxx(speed) of the support at node {supports[0]}", kxx, s))
         crossings = critical_crossings(frequencies, lambda x: model.tables.coefficients(x)[i, 0], s, args.n_modes)
+    else:  # a constant support stiffness: a vertical line, crossed at the map's frequencies there
+        b = model.bearings
+        at = np.flatnonzero(b.nodes == supports[0])
+        kk = float(b.kxx[at].max()) if len(at) else 0.0
+        if kk > 0:
+            w = frequencies(kk)
+            curves.append((f"kxx of the support at node {supports[0]}", np.full(2, kk), (w[0] / 2, 2 * w[-1])))
+            crossings = [(j, float(w[j]), kk) for j in range(args.n_modes)]
     problem = ModalProblem(model.M, model.K, model.C, model.G, model.dof_kind, speed_terms=model.speed_terms)
     modes = problem.solve(speed, args.n_modes)
     title = scene.title or str(scene.source)
@@ -102,7 +110,7 @@ def run(args: argparse.Namespace) -> int:
     for j in range(args.n_modes):
         print(f"    mode {j + 1}: {wn[0, j] * 30 / np.pi:10.5g} .. {wn[-1, j] * 30 / np.pi:10.5g}")
     for j, s, kk in crossings:
-        print(f"  mode {j + 1} crosses the support's kxx(speed) at {s * 30 / np.pi:.5g} rpm, k = {kk:.4g} N/m")
+        print(f"  mode {j + 1} crosses the support's kxx at {s * 30 / np.pi:.5g} rpm, k = {kk:.4g} N/m")
     print(f"  modes at {speed * 30 / np.pi:.5g} rpm (Hz / log dec / whirl): " + ", ".join(
         f"{w / (2 * np.pi):.4g} / {d:.3g} / {h}" for w, d, h in zip(modes.wd, modes.log_dec, modes.whirl)))
     if args.json:
