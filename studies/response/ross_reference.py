@@ -92,6 +92,9 @@ def main():
     cdata = {"ross_version": rs.__version__, "modal": [modal(comp, w, 12) for w in (418.879, 600.0, 837.758,
                                                                                     1047.198, 1151.917, 1300.0)],
              "static": static(comp), "ucs": ucs(comp, (6, 10), 9)}
+    c_speeds = np.linspace(400.0, 1300.0, 19)
+    cdata["unbalance"] = {"node": 26, "me": 1e-4, "phase": 0.5, "speeds": c_speeds.tolist(),
+                          "response": unbalance(comp, 26, 1e-4, 0.5, c_speeds, (20, 26, 35))}
     (OUT / "compressor.json").write_text(json.dumps(cdata, indent=1))
 
 

@@ -158,3 +158,20 @@ def test_compressor_static_and_critical_speed_map(compressor):
     assert np.allclose(u[1:6 * compressor.n_shaft_nodes:6], ref["static"]["disp_y"], rtol=1e-8, atol=1e-14)
     wn = critical_speed_map(compressor.M, K_free, compressor.dof_kind, bearings, ref["ucs"]["stiffness"], 4)
     assert np.allclose(wn.T, ref["ucs"]["wn"], rtol=1e-8)
+
+
+def test_compressor_unbalance_with_speed_dependent_supports(compressor):
+    """1e-4 kg m at 0.5 rad on node 26, 400..1300 rad/s (through the first forward critical speed, beyond the
+    bearing tables at the top): x and y at nodes 20, 26 and 35, the supports interpolated at each speed."""
+    ref = _ref("compressor")["unbalance"]
+    probes = (20, 26, 35)
+    speeds = np.array(ref["speeds"])
+    out = displacement(np.array([[6 * p, 6 * p + 1] for p in probes]).ravel(), compressor.n_dof)
+    mine = unbalance_response(compressor.M, compressor.K, compressor.C, compressor.G,
+                              compressor.unbalance_load(ref["node"], ref["me"], ref["phase"]), out, speeds,
+                              speed_terms=compressor.speed_terms)
+    for j, p in enumerate(probes):
+        for k, c in enumerate("xy"):
+            R, X = _complex(ref["response"][str(p)], c), mine[:, 2 * j + k]
+            assert np.max(np.abs(np.abs(X) / np.abs(R) - 1)) < 1e-4, (p, c)
+            assert np.max(np.abs(np.angle(X / R))) < 1e-4, (p, c)
