@@ -18,7 +18,8 @@ from cvtfem.errors import CvtfemError
 
 #: Command modules in ``cvtfem.commands``, in the order ``--help`` lists them.
 COMMANDS = ("scenes", "describe", "docs", "show", "run", "modes", "campbell", "response", "spectrum", "render", "sheave",
-            "periodic", "sweep", "report", "study", "bench", "demo", "spectrogram", "history", "revolution")
+            "periodic", "sweep", "report", "study", "bench", "demo", "spectrogram", "history", "revolution",
+            "rotormaps")
 
 
 class _Parser(argparse.ArgumentParser):

@@ -154,7 +154,7 @@ def scene_response(scene: Scene, unbalances: list[Unbalance], speeds: np.ndarray
     n = model.n_dof
     load = sum(model.unbalance_load(u.node, u.me, u.phase) for u in unbalances)
     out = displacement([6 * node, 6 * node + 1], n, ("u1", "u2"))
-    xy = unbalance_response(model.M, model.K, model.C, model.G, load, out, speeds)
+    xy = unbalance_response(model.M, model.K, model.C, model.G, load, out, speeds, speed_terms=model.speed_terms)
     major, minor = orbit(xy[:, 0], xy[:, 1])
     if not orders:
         return Response(speeds, node, xy[:, 0], xy[:, 1], major, minor)
@@ -170,7 +170,7 @@ def scene_response(scene: Scene, unbalances: list[Unbalance], speeds: np.ndarray
     for i, s in enumerate(speeds):  # |(u1, u2)| per unit force; one modal basis for the sweep
         amp[i] = np.linalg.norm(basis.frf(out, k * s, s)[..., 0], axis=1)
         grid[i] = np.linalg.norm(basis.frf(out, freqs, s)[..., 0], axis=1)
-    problem = ModalProblem(model.M, model.K, model.C, model.G, model.dof_kind)
+    problem = ModalProblem(model.M, model.K, model.C, model.G, model.dof_kind, speed_terms=model.speed_terms)
     diagram = campbell(problem, speeds, n_modes, shaft_orders(tuple(orders)))
     return Response(speeds, node, xy[:, 0], xy[:, 1], major, minor, tuple(orders), fnode, amp, freqs, grid,
                     diagram)

@@ -78,7 +78,8 @@ def run(args: argparse.Namespace) -> int:
         raise InputError("--fmax", args.fmax, "must be a frequency in Hz with 0 < fmax < 1e9")
     scene, model = load_rotor(args.scene)
     n_modes = args.n_modes or (scene.rotor.n_modes if scene.rotor else 12)
-    problem = ModalProblem(model.M, model.K, model.C, model.G, model.dof_kind, args.method)
+    problem = ModalProblem(model.M, model.K, model.C, model.G, model.dof_kind, args.method,
+                           speed_terms=model.speed_terms)
     result = campbell(problem, speeds, n_modes, _orders(args))
     print(f"{scene.title or scene.source}: {len(speeds)} speeds x {n_modes} modes, backend {problem.method}")
     print("critical speeds (mode crossing an excitation line):")

@@ -45,7 +45,7 @@ def run(args: argparse.Namespace) -> int:
     if n_modes < 1:
         raise InputError("--n-modes", n_modes, "must be >= 1")
     problem = ModalProblem(model.M, model.K, model.C, model.G, model.dof_kind, args.method,
-                           damped=not args.undamped)
+                           damped=not args.undamped, speed_terms=model.speed_terms)
     modes = problem.solve(speed, n_modes)
     print(f"{scene.title or scene.source}: {model.n_dof} DOF, speed {speed:.6g} rad/s "
           f"({speed * 30 / np.pi:.6g} rpm), backend {problem.method}")

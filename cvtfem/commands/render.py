@@ -61,7 +61,8 @@ def run(args: argparse.Namespace) -> int:
     if args.mode < 0:
         raise InputError("--mode", args.mode, "must be >= 0")
     speed = parse_speed(args.speed) if args.speed else (scene.rotor.speed if scene.rotor else 0.0)
-    modes = ModalProblem(model.M, model.K, model.C, model.G, model.dof_kind).solve(speed, args.mode + 1)
+    modes = ModalProblem(model.M, model.K, model.C, model.G, model.dof_kind,
+                         speed_terms=model.speed_terms).solve(speed, args.mode + 1)
     k = args.mode
     print(f"mode {k}: wd = {modes.wd[k]:.6g} rad/s, {modes.whirl[k]}")
     if args.png:

@@ -168,3 +168,54 @@ class BearingFamily:
         G = np.zeros((len(self.nodes), 6, 6))
         G[:, 3, 4], G[:, 4, 3] = self.Ip, -self.Ip
         return G
+
+
+#: Lateral coefficients a bearing may tabulate over the spin speed, in the column order of :class:`SpeedTables`.
+SPEED_COEFFICIENTS = ("kxx", "kxy", "kyx", "kyy", "cxx", "cxy", "cyx", "cyy")
+
+
+def interpolate_over_speed(speeds: np.ndarray, values: np.ndarray, speed: float) -> np.ndarray:
+    """Coefficient table ``values (s, ...)`` over ``speeds (s,)`` (rad/s) at ``speed``, as ROSS 3.1 does.
+
+    One point: constant; two: linear; more: PCHIP (shape-preserving, no overshoot between points). Outside the
+    table the coefficients continue linearly with the end slopes (ROSS 3.1 ``BearingCoefficient``).
+    """
+    from scipy.interpolate import PchipInterpolator, interp1d
+
+    speeds, values = np.asarray(speeds, float), np.asarray(values, float)
+    if len(speeds) == 1:
+        return values[0].copy()
+    if len(speeds) == 2:
+        return interp1d(speeds, values, axis=0, fill_value="extrapolate")(speed)
+    p = PchipInterpolator(speeds, values, axis=0, extrapolate=True)
+    clipped = float(np.clip(speed, speeds[0], speeds[-1]))
+    slope = p.derivative()(clipped)
+    return p(clipped) + (speed - clipped) * slope
+
+
+@dataclass(frozen=True)
+class SpeedTables:
+    """Lateral bearing (or seal) coefficients tabulated over the spin speed.
+
+    Parameters
+    ----------
+    nodes : int array (b,)
+        Node of each tabulated bearing.
+    speeds : tuple of arrays
+        Per bearing its strictly increasing table speeds, rad/s.
+    values : tuple of arrays
+        Per bearing ``(s, 8)``: the columns :data:`SPEED_COEFFICIENTS` (N/m, N s/m) at its speeds.
+    """
+
+    nodes: np.ndarray
+    speeds: tuple
+    values: tuple
+
+    def coefficients(self, speed: float) -> np.ndarray:
+        """``(b, 8)`` coefficients at ``speed`` (rad/s), interpolated per bearing."""
+        return np.array([interpolate_over_speed(s, v, speed) for s, v in zip(self.speeds, self.values)])
+
+    def blocks(self, speed: float) -> tuple[np.ndarray, np.ndarray]:
+        """``(b, 2, 2)`` lateral stiffness and damping blocks at ``speed`` (rad/s)."""
+        c = self.coefficients(speed).reshape(-1, 2, 2, 2)
+        return c[:, 0], c[:, 1]

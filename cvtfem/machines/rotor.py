@@ -8,7 +8,7 @@ model runs at the spin speed ``Omega = speed`` (rad/s).
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from functools import cached_property
 
 import numpy as np
@@ -19,7 +19,7 @@ from cvtfem.assembly import assemble
 from cvtfem.assembly.model import Linearization, ModelBase, StateLayout
 from cvtfem.elements.base import Block, Layout
 from cvtfem.elements.beam import BeamFamily, BeamOptions
-from cvtfem.elements.bearing import BearingFamily, RadialLaw
+from cvtfem.elements.bearing import SPEED_COEFFICIENTS, BearingFamily, RadialLaw, SpeedTables
 from cvtfem.elements.disk import DiskFamily, connection_stiffness, disc_profile, sheave_profile
 from cvtfem.errors import InputError
 from cvtfem.outputs import OutputSpec
@@ -57,6 +57,8 @@ class RotorModel(ModelBase):
     extra_kinds : tuple of int
         Node DOF kind of each DOF after the nodes' (the modal coordinates of flexible sheaves,
         :func:`cvtfem.machines.sheave.flexible_sheaves`).
+    tables : SpeedTables or None
+        Bearing coefficients over speed; K and C hold them at ``speed``, :attr:`speed_terms` the rest.
     """
 
     M: sp.csr_matrix
@@ -71,6 +73,12 @@ class RotorModel(ModelBase):
     speed: float = 0.0
     seats: tuple = ()
     extra_kinds: tuple = ()
+    tables: SpeedTables | None = None
+
+    @property
+    def speed_terms(self) -> SpeedTerms | None:
+        """What K and C gain away from the model's speed (speed-dependent bearings), or None."""
+        return None if self.tables is None else SpeedTerms(self.n_dof, self.tables, self.speed)
 
     @property
     def n_dof(self) -> int:
@@ -96,6 +104,20 @@ class RotorModel(ModelBase):
         cols = np.repeat(b.dofs, 2, axis=0).ravel()
         return tuple(sp.csr_matrix((X[:, :2, :].ravel(), (rows, cols)), shape=(2 * len(b.nodes), n))
                      for X in (b.stiffness(), b.damping()))
+
+    def support_stiffness(self) -> sp.csr_matrix:
+        """``(n, n)`` stiffness of all bearings (and tabulated ones at the model's speed), N/m, N m/rad."""
+        K = assemble(self.n_dof, [(self.bearings.stiffness(), self.bearings.dofs)])
+        if self.tables is not None:
+            K = K + _lateral(self.n_dof, self.tables.nodes, self.tables.blocks(self.speed)[0])
+        return K.tocsr()
+
+    def support_dofs(self, nodes) -> np.ndarray:
+        """``(s, 2)`` DOFs ``(u1, u2)`` of the shaft nodes ``nodes``."""
+        nodes = np.atleast_1d(np.asarray(nodes, int))
+        if np.any((nodes < 0) | (nodes >= self.n_shaft_nodes)):
+            raise InputError("support nodes", nodes.tolist(), f"must be shaft nodes 0..{self.n_shaft_nodes - 1}")
+        return nodes[:, None] * 6 + np.arange(2)
 
     def unbalance_load(self, node: int, me: float, phase: float) -> np.ndarray:
         """Complex force amplitude per unit ``Omega^2`` of an unbalance ``me`` (kg m) at angle ``phase`` (rad).
@@ -196,7 +218,7 @@ def _shaft_arrays(scene: Scene) -> dict[str, np.ndarray]:
         raise InputError("shaft[].repeat", n, f"must add up to at most {MAX_ELEMENTS} shaft elements "
                          f"({6 * (n + 1):.3g} DOF asked for)")
     rows = [s for s in scene.shaft for _ in range(s.repeat)]
-    return {"L": np.array([s.length for s in rows]),
+    return {"L": np.array([s.length for s in rows]), "parallel": np.array([s.parallel for s in rows], bool),
             "Do": np.array([s.outer_diameter for s in rows]),
             "Di": np.array([s.inner_diameter for s in rows]),
             "E": np.array([mats[s.material].E for s in rows]),
@@ -233,6 +255,7 @@ def _bearings(scene: Scene) -> BearingFamily:
         e = {k: b[k] for k in ("kxx", "kxy", "kyx", "kyy", "cxx", "cxy", "cyx", "cyy", "kzz", "czz",
                                "ktt", "ctt", "kphi", "cphi", "Id", "Ip")}
         e["m"] = b.mass
+        e.update({c: 0.0 for c in SPEED_COEFFICIENTS if b[f"{c}_table"]})  # the table replaces the constant
         if b.law != "linear":
             law = RadialLaw(u=b.table_u, f=b.table_f) if b.law == "table" else RadialLaw(coeffs=b.coeffs)
             Kt = law.tangent(np.array(b.u0))
@@ -241,6 +264,53 @@ def _bearings(scene: Scene) -> BearingFamily:
                      cxy=e["cxy"] + Dt[0, 1], cyx=e["cyx"] + Dt[1, 0], cyy=e["cyy"] + Dt[1, 1])
         entries.append(e)
     return BearingFamily.from_dicts(np.array([b.node for b in scene.bearing], dtype=np.int64), entries)
+
+
+def _speed_tables(scene: Scene) -> SpeedTables | None:
+    """The bearings' coefficient tables over speed (None without any); a coefficient without a table keeps its
+    constant value (in the family's K and C, so the tables hold 0 for it)."""
+    rows = [b for b in scene.bearing if b.speeds]
+    if not rows:
+        return None
+    values = tuple(np.column_stack([np.asarray(b[f"{c}_table"], float) if b[f"{c}_table"]
+                                    else np.zeros(len(b.speeds)) for c in SPEED_COEFFICIENTS]) for b in rows)
+    return SpeedTables(np.array([b.node for b in rows], dtype=np.int64),
+                       tuple(np.asarray(b.speeds, float) for b in rows), values)
+
+
+def _lateral(n: int, nodes: np.ndarray, blocks: np.ndarray) -> sp.csr_matrix:
+    """``(b, 2, 2)`` lateral blocks on the (u1, u2) DOFs of ``nodes``, as an ``(n, n)`` matrix."""
+    dofs = nodes[:, None] * 6 + np.arange(2)
+    return assemble(n, [(blocks, dofs)])
+
+
+@dataclass(frozen=True)
+class SpeedTerms:
+    """Speed-dependent part of a rotor's K and C: ``(K(speed) - K(speed0), C(speed) - C(speed0))``.
+
+    The model's own K and C hold the tabulated coefficients at ``speed0`` (``[rotor] speed``); solvers that follow
+    the speed (``ModalProblem``, ``unbalance_response``) add these differences. ``pattern``: where they can be non-zero.
+    """
+
+    n: int
+    tables: SpeedTables = field(repr=False)
+    speed0: float = 0.0
+
+    @cached_property
+    def pattern(self) -> sp.csr_matrix:
+        return _lateral(self.n, self.tables.nodes, np.ones((len(self.tables.nodes), 2, 2)))
+
+    @cached_property
+    def _base(self) -> tuple[np.ndarray, np.ndarray]:
+        return self.tables.blocks(self.speed0)
+
+    @property
+    def damped(self) -> bool:
+        return bool(np.any([v[:, 4:] for v in self.tables.values]))
+
+    def __call__(self, speed: float) -> tuple[sp.csr_matrix, sp.csr_matrix]:
+        k, c = self.tables.blocks(speed)
+        return _lateral(self.n, self.tables.nodes, k - self._base[0]), _lateral(self.n, self.tables.nodes, c - self._base[1])
 
 
 def build_model(scene: Scene) -> RotorModel:
@@ -258,15 +328,17 @@ def build_model(scene: Scene) -> RotorModel:
     opts = scene.rotor
     theory = opts.theory if opts else "timoshenko"
     arrays = _shaft_arrays(scene)
+    parallel = arrays.pop("parallel")
     n_el = len(arrays["L"])
+    left = np.cumsum(~parallel) - 1  # a sleeve lies on the nodes of the element before it
     kappa = None
     if opts and opts.shear_coefficient > 0:
         kappa = np.full(n_el, opts.shear_coefficient)
-    beam = BeamFamily(nodes=np.stack([np.arange(n_el), np.arange(1, n_el + 1)], axis=1), kappa=kappa,
+    beam = BeamFamily(nodes=np.stack([left, left + 1], axis=1), kappa=kappa,
                       options=BeamOptions(shear=theory == "timoshenko",
                                           rotary_inertia=opts.rotary_inertia if opts else True,
                                           gyroscopic=opts.gyroscopic if opts else True), **arrays)
-    n_shaft = n_el + 1
+    n_shaft = int(left[-1]) + 2
     elastic = [i for i, d in enumerate(scene.disk) if d.connection == "elastic"]
     disk_nodes = np.array([d.node for d in scene.disk], dtype=np.int64)
     disk_nodes[elastic] = n_shaft + np.arange(len(elastic))
@@ -299,16 +371,21 @@ def build_model(scene: Scene) -> RotorModel:
                      *(flexible.damping if flexible else ())])
     G = assemble(n, [(beam.gyroscopic(), beam.dofs), (disks.gyroscopic()[rigid], disks.dofs[rigid]),
                      (bearings.gyroscopic(), bearings.dofs), *(flexible.gyroscopic if flexible else ())])
-    z = np.concatenate([[0.0], np.cumsum(arrays["L"]), np.zeros(len(elastic))])
+    z = np.concatenate([[0.0], np.cumsum(arrays["L"][~parallel]), np.zeros(len(elastic))])
     z[n_shaft:] = z[[scene.disk[i].node for i in elastic]]
-    return RotorModel(M, K, C, G, z, beam, disks, bearings, profiles, opts.speed if opts else 0.0,
-                      tuple(d.node for d in scene.disk), tuple(flexible.kinds) if flexible else ())
+    speed = opts.speed if opts else 0.0
+    tables = _speed_tables(scene)
+    if tables is not None:  # M, K, C hold the tabulated coefficients at the model's speed
+        Kb, Cb = (_lateral(n, tables.nodes, X) for X in tables.blocks(speed))
+        K, C = (K + Kb).tocsr(), (C + Cb).tocsr()
+    return RotorModel(M, K, C, G, z, beam, disks, bearings, profiles, speed,
+                      tuple(d.node for d in scene.disk), tuple(flexible.kinds) if flexible else (),
+                      tables)
 
 
 def layout(scene: Scene) -> tuple[Layout, ...]:
     """Components of a rotor model: the beam carries all nodal DOFs."""
-    n_elements = sum(s.repeat for s in scene.shaft)
-    nodes = n_elements + 1
+    nodes = sum(s.repeat for s in scene.shaft if not s.parallel) + 1
     theory = scene.rotor.theory if scene.rotor else "timoshenko"
     shaft, bearings = _output_specs(nodes, len(scene.bearing))
     parts = [Layout("shaft", f"{theory}-beam", 6 * nodes, outputs=shaft, note=f"{nodes} nodes x 6")]

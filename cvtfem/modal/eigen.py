@@ -32,8 +32,12 @@ from cvtfem.blas import arpack_start
 from cvtfem.errors import InputError, NumericalError
 from cvtfem.modal.whirl import circularize, classify, mac
 
-#: Models up to this many DOF are solved densely by ``method="auto"``.
-DENSE_LIMIT = 600
+#: ``method="auto"`` solves a block densely when it has at most ``DENSE_PER_MODE (n_modes + 5)`` DOF, else by
+#: sparse shift-invert: dense costs ~m^3 whatever the modes asked, sparse ~m (n_modes + 5). Measured crossover
+#: (studies/rotor/bench_backend.py, one solve of a damped gyroscopic shaft): 44 lateral DOF about even, 84 DOF
+#: sparse 1.6-2x faster for 6-12 modes, dense still 1.4x faster for 24 modes; 4 puts the switch at 44, 68 and
+#: 116 DOF for 6, 12 and 24 modes. (Before: dense up to 600 DOF, 10-50x slower on 160-600 DOF blocks.)
+DENSE_PER_MODE = 4
 #: Dense: eigenvalues with Im below this fraction of the block's largest |lambda| count as non-oscillatory
 #: (a rigid-body Jordan pair is perturbed by about sqrt(eps) |lambda|_max).
 ZERO_RTOL = 1e-6
@@ -123,7 +127,8 @@ class ModalProblem:
     dof_kind : int array (n,)
         Node-DOF kind 0..5 of every DOF (``u1 u2 u3 theta1 theta2 phi``).
     method : {"auto", "dense", "sparse", "slepc"}
-        "auto" picks dense for blocks up to :data:`DENSE_LIMIT` DOF, sparse above.
+        "auto" picks dense for blocks up to ``DENSE_PER_MODE (n_modes + 5)`` DOF (:data:`DENSE_PER_MODE`),
+        sparse above; :attr:`method` then tells the backends the last solve used.
     damped : bool
         False drops C (undamped analysis; G is kept).
     blas_threads : int or None
@@ -131,10 +136,14 @@ class ModalProblem:
         the library default.  1 by default: these blocks are small, and on a
         shared 2-core machine multi-threaded OpenBLAS was measured 10-25x slower
         (96 x 96 ``geev``: 0.43 s with 2 threads under load vs 0.018 s with 1).
+    speed_terms : callable or None
+        Speed-dependent supports: ``speed_terms(speed) -> (dK, dC)`` (sparse (n, n)) added to K and C at each
+        speed, with ``speed_terms.pattern`` (sparse) where they may be non-zero and ``speed_terms.damped``
+        (e.g. :attr:`cvtfem.machines.rotor.RotorModel.speed_terms`). Blocks they touch are re-solved per speed.
     """
 
     def __init__(self, M, K, C, G, dof_kind: np.ndarray, method: str = "auto", damped: bool = True,
-                 blas_threads: int | None = 1) -> None:
+                 blas_threads: int | None = 1, speed_terms=None) -> None:
         if method not in ("auto", "dense", "sparse", "slepc"):
             raise InputError("method", method, "must be 'auto', 'dense', 'sparse' or 'slepc'")
         self.M, self.K, self.G = (sp.csr_matrix(x) for x in (M, K, G))
@@ -154,23 +163,41 @@ class ModalProblem:
                              "must pair every lateral DOF: as many u1 as u2 and theta1 as theta2",
                              "planar or axial models: use kinds 2 (u3) or 5 (phi)")
         self.mdiag = self.M.diagonal()
+        self.speed_terms = speed_terms
+        self.damped = damped
         pattern = abs(self.M) + abs(self.K) + abs(self.C) + abs(self.G)
+        if speed_terms is not None:
+            pattern = pattern + abs(sp.csr_matrix(speed_terms.pattern))
         n_blocks, label = connected_components(pattern, directed=False)
         self.blocks = [np.flatnonzero(label == b) for b in range(n_blocks)]
-        #: backend of each block ("auto": dense up to DENSE_LIMIT DOF, else sparse)
-        self.block_methods = [("dense" if len(d) <= DENSE_LIMIT else "sparse") if method == "auto" else method
-                              for d in self.blocks]
+        #: backend of each block ("auto": chosen per solve by :meth:`backend`)
+        self.block_methods = [method] * n_blocks
         self.method = "+".join(sorted(set(self.block_methods)))
-        self._gyro = [self.G[d].nnz > 0 for d in self.blocks]
+        touched = (np.zeros(self.n, bool) if speed_terms is None
+                   else np.asarray(abs(sp.csr_matrix(speed_terms.pattern)).sum(axis=1)).ravel() > 0)
+        #: per block: whether it depends on the speed through the supports (solved at every speed)
+        self._supports = [bool(touched[d].any()) for d in self.blocks]
+        self._gyro = [self.G[d].nnz > 0 or t for d, t in zip(self.blocks, self._supports)]
         self._blas = _blas_controller() if blas_threads is not None else None
         self.blas_threads = blas_threads
         self._dense: dict[int, tuple[np.ndarray, np.ndarray, np.ndarray | None]] = {}
+        self._cho: dict[int, tuple] = {}
         self._cache: dict[tuple[int, int], tuple[np.ndarray, np.ndarray]] = {}
         self._definite: dict[int, bool] = {}
 
-    def _sub(self, b: int) -> list[sp.csr_matrix]:
+    def _sub(self, b: int, speed: float | None = None) -> list[sp.csr_matrix]:
+        """Block ``b``'s M, K, C, G; with ``speed``, K and C include the speed-dependent supports there."""
         dofs = self.blocks[b]
-        return [X[dofs][:, dofs] for X in (self.M, self.K, self.C, self.G)]
+        M, K, C, G = (X[dofs][:, dofs] for X in (self.M, self.K, self.C, self.G))
+        if speed is not None and self._supports[b]:
+            dK, dC = self._terms(speed)
+            K = (K + dK[dofs][:, dofs]).tocsr()
+            C = (C + dC[dofs][:, dofs]).tocsr() if self.damped else C
+        return [M, K, C, G]
+
+    def _terms(self, speed: float) -> tuple[sp.csr_matrix, sp.csr_matrix]:
+        dK, dC = self.speed_terms(speed)
+        return sp.csr_matrix(dK), sp.csr_matrix(dC)
 
     def solve(self, speed: float, n_modes: int, sigma: float | None = None, min_modes: int | None = None) -> Modes:
         """Lowest ``n_modes`` oscillatory modes at ``speed`` (rad/s).
@@ -185,6 +212,8 @@ class ModalProblem:
         if n_modes < 1:
             raise InputError("n_modes", n_modes, "must be >= 1")
         limit = self._blas.limit(limits=self.blas_threads, user_api="blas") if self._blas else nullcontext()
+        if "auto" in self.block_methods:
+            self.method = "+".join(sorted({self.backend(b, n_modes) for b in range(len(self.blocks))}))
         with limit:
             modes = self._solve(speed, n_modes, sigma, min_modes)
             planar = (np.abs(modes.whirl_ratio) < PLANAR) & np.isin(modes.whirl, ("forward", "backward"))
@@ -229,7 +258,12 @@ class ModalProblem:
         Blocks too small for a Krylov space of the requested size (``n_modes + 5``
         DOF or fewer) are solved densely by every backend.
         """
-        return "dense" if len(self.blocks[b]) <= n_modes + 5 else self.block_methods[b]
+        m = len(self.blocks[b])
+        if m <= n_modes + 5:
+            return "dense"
+        if self.block_methods[b] == "auto":
+            return "dense" if m <= DENSE_PER_MODE * (n_modes + 5) else "sparse"
+        return self.block_methods[b]
 
     def _solve_block(self, b: int, speed: float, n_modes: int,
                      sigma: float | None) -> tuple[np.ndarray, np.ndarray]:
@@ -248,7 +282,7 @@ class ModalProblem:
         else:
             from cvtfem.modal.slepc_backend import solve_gep, solve_pep
 
-            M, K, C, G = self._sub(b)
+            M, K, C, G = self._sub(b, speed)
             s = -SIGMA if sigma is None else sigma
             if C.nnz == 0 and (G.nnz == 0 or speed == 0):
                 lam, Z = solve_gep(M, K, n_modes, s)
@@ -289,7 +323,14 @@ class ModalProblem:
                                      component="modal.dense") from None
             self._dense[b] = (sla.cho_solve(cho, K), sla.cho_solve(cho, C),
                               sla.cho_solve(cho, G) if np.any(G) else None)
+            self._cho[b] = cho
         MK, MC, MG = self._dense[b]
+        if self._supports[b]:
+            dofs = self.blocks[b]
+            dK, dC = (X[dofs][:, dofs].toarray() for X in self._terms(speed))
+            cho = self._cho[b]
+            MK = MK + sla.cho_solve(cho, dK)
+            MC = MC + sla.cho_solve(cho, dC) if self.damped else MC
         if not all(np.all(np.isfinite(X)) for X in (MK, MC) + (() if MG is None else (MG,))):
             raise NumericalError("M^-1 K (or C, G) overflows: stiffness or damping far too large for the masses "
                                  "(ratios beyond double precision)", component="modal.dense")
@@ -303,7 +344,7 @@ class ModalProblem:
 
     def _solve_sparse(self, b: int, speed: float, n_modes: int,
                       sigma: float | None) -> tuple[np.ndarray, np.ndarray]:
-        M, K, C, G = self._sub(b)
+        M, K, C, G = self._sub(b, speed)
         n = M.shape[0]
         s = -SIGMA if sigma is None else float(sigma)
         if C.nnz == 0 and (G.nnz == 0 or speed == 0):
@@ -347,7 +388,8 @@ class ModalProblem:
     def _finish(self, speed: float, lam: np.ndarray, X: np.ndarray, n_modes: int, min_modes: int) -> Modes:
         if not np.all(np.isfinite(lam)):
             raise NumericalError("non-finite eigenvalues", component="modal")
-        if self.C.nnz == 0:  # conservative gyroscopic system: the spectrum is imaginary, drop round-off
+        if self.C.nnz == 0 and not (self.damped and getattr(self.speed_terms, "damped", False)):
+            # conservative gyroscopic system: the spectrum is imaginary, drop round-off
             lam = lam.copy()
             lam.real[np.abs(lam.real) < ROUNDOFF * np.abs(lam)] = 0.0
         order = np.argsort(lam.imag)[:n_modes + 2]

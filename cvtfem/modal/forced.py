@@ -407,7 +407,7 @@ def frf_modal(M, K, C, G, inputs, outputs: OutputMap, omegas, speed: float = 0.0
     return ModalBasis(M, K, C, G, inputs, n_modes, residual, modes, method, basis_speeds).frf(outputs, omegas, speed)
 
 
-def unbalance_response(M, K, C, G, load, outputs: OutputMap, speeds) -> np.ndarray:
+def unbalance_response(M, K, C, G, load, outputs: OutputMap, speeds, speed_terms=None) -> np.ndarray:
     """Steady response to a synchronous load ``Omega^2 load e^{i Omega t}`` at each spin speed Omega.
 
     Parameters
@@ -416,16 +416,40 @@ def unbalance_response(M, K, C, G, load, outputs: OutputMap, speeds) -> np.ndarr
         Force amplitude per unit ``Omega^2`` (e.g. ``me e^{i phase} (e1 - i e2)`` at a disk: forward).
     speeds : array (s,), rad/s
         The spin speed is also the excitation frequency; G and C are those at each speed.
+    speed_terms : callable or None
+        Speed-dependent supports, ``speed_terms(Omega) -> (dK, dC)`` added to K and C (see
+        :class:`cvtfem.modal.eigen.ModalProblem`).
 
     Returns
     -------
     complex array (s, p): output amplitudes.
     """
-    Z, F, D, V = _direct(M, K, C, G, load, outputs)
     s = _omegas(speeds)
+    if speed_terms is not None:
+        return _unbalance_tabulated(M, K, C, G, load, outputs, s, speed_terms)
+    Z, F, D, V = _direct(M, K, C, G, load, outputs)
     out = np.zeros((len(s), D.shape[0]), dtype=complex)
     for i, w in enumerate(s):
         X = Z.solve(w, w, w * w * F)[:, 0]
+        out[i] = D @ X + 1j * w * (V @ X)
+    return out
+
+
+def _unbalance_tabulated(M, K, C, G, load, outputs: OutputMap, speeds: np.ndarray, speed_terms) -> np.ndarray:
+    """:func:`unbalance_response` with K and C of speed-dependent supports: one sparse LU per speed."""
+    M, K, C, G = _check(M, K, C, G)
+    F = _inputs(load, M.shape[0])
+    dofs = reached(M, K + abs(sp.csr_matrix(speed_terms.pattern)), C, G, F)
+    D, V = outputs.D[:, dofs], outputs.V[:, dofs]
+    out = np.zeros((len(speeds), D.shape[0]), dtype=complex)
+    for i, w in enumerate(speeds):
+        dK, dC = speed_terms(w)
+        Z = (K + dK - w * w * M + 1j * w * (C + dC + w * G))[dofs][:, dofs].tocsc()
+        try:
+            X = spla.splu(Z).solve(w * w * F[dofs])[:, 0]
+        except RuntimeError as err:
+            raise NumericalError(f"dynamic stiffness singular at speed {w:g} rad/s ({err})",
+                                 component="modal.forced") from None
         out[i] = D @ X + 1j * w * (V @ X)
     return out
 

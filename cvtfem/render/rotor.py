@@ -147,7 +147,7 @@ def _draw_mode(p, model: RotorModel, modes: Modes, k: int, phase: float, scale: 
         p.add_mesh(mesh, color="firebrick" if kind == "shaft" else _COLORS[kind], smooth_shading=True)
     # whirl orbits of the nodes over one period
     ph = np.linspace(0, 2 * np.pi, 65)
-    nodes = np.arange(len(model.beam.L) + 1)
+    nodes = np.arange(model.n_shaft_nodes)
     for n in nodes:
         u = scale * np.real(np.outer(np.exp(1j * ph), shape[6 * n:6 * n + 2]))
         orbit = _to_view(np.full(len(ph), model.z[n]), u[:, 0], u[:, 1])
@@ -198,7 +198,7 @@ def write_mode_vtu(model: RotorModel, modes: Modes, path: str | Path) -> Path:
     """
     import meshio
 
-    n_nodes = len(model.beam.L) + 1
+    n_nodes = model.n_shaft_nodes
     pts = _to_view(model.z[:n_nodes], np.zeros(n_nodes), np.zeros(n_nodes))
     cells = [("line", np.stack([np.arange(n_nodes - 1), np.arange(1, n_nodes)], axis=1))]
     data = {}

@@ -30,6 +30,8 @@ SHAFT = TableArray("shaft", "Shaft elements in order along the axis.", Table("sh
     Key("material", "str", "Name of a `[[material]]`.", ""),
     Key("repeat", "int", "Number of identical consecutive elements this entry stands for.", "-", 1, ge=1,
         le=MAX_ELEMENTS),
+    Key("parallel", "bool", "A sleeve: this element lies on the two nodes of the element before it (same "
+        "length) and adds its mass and stiffness there instead of starting a new node.", "", False),
 ), checks=(lambda t, p: _check_section(t, p),)))
 
 ROTOR = Table("rotor", "Rotor model options (beam theory, switches, damping, analysis defaults).", (
@@ -122,6 +124,13 @@ BEARING = TableArray("bearing", "Bearings (supports to ground) on shaft nodes.",
         length=2),
     Key("beta", "float", "Radial damping beta f_r'(0) e e^T of a nonlinear law (added to cxx..).", "s", 0.0,
         ge=0.0),
+    Key("speeds", "float[]", "Spin speeds of the coefficient tables `kxx_table` .. `cyy_table` (strictly "
+        "increasing); interpolated as ROSS 3.1 does: PCHIP, linear for two points, linear extrapolation with the "
+        "end slopes.", "rad/s", ()),
+    *(Key(f"k{ij}_table", "float[]", f"Lateral stiffness {ij} at each of `speeds` (replaces `k{ij}`).", "N/m", ())
+      for ij in ("xx", "xy", "yx", "yy")),
+    *(Key(f"c{ij}_table", "float[]", f"Lateral damping {ij} at each of `speeds` (replaces `c{ij}`).", "N s/m", ())
+      for ij in ("xx", "xy", "yx", "yy")),
 ), checks=(lambda t, p: _check_bearing(t, p),)))
 
 
@@ -151,6 +160,17 @@ def _check_disk(table: Mapping[str, Any], path: str) -> None:
 
 
 def _check_bearing(table: Mapping[str, Any], path: str) -> None:
+    tables = [f"{c}{ij}_table" for c in "kc" for ij in ("xx", "xy", "yx", "yy")]
+    speeds = table["speeds"]
+    if any(b <= a for a, b in zip(speeds, speeds[1:])):
+        raise InputError(f"{path}.speeds", speeds, "must be strictly increasing")
+    for key in tables:
+        if table[key] and len(table[key]) != len(speeds):
+            raise InputError(f"{path}.{key}", table[key], f"must have one value per `speeds` entry ({len(speeds)})")
+    if speeds and not any(table[k] for k in tables):
+        raise InputError(f"{path}.speeds", speeds, "needs at least one coefficient table (`kxx_table` ..)")
+    if speeds and table["law"] != "linear":
+        raise InputError(f"{path}.speeds", speeds, "works with law = 'linear' only")
     if table["law"] == "table" and (len(table["table_u"]) < 2 or len(table["table_u"]) != len(table["table_f"])):
         raise InputError(f"{path}.table_u", table["table_u"], "needs >= 2 values and as many `table_f` values")
     if table["law"] == "polynomial" and not table["coeffs"]:
@@ -170,7 +190,11 @@ def check_rotor(scene: Mapping[str, Any], path: str) -> None:
         if disk["geometry"] and disk["material"] not in names:
             raise InputError(f"disk[{i}].material", disk["material"], "must name a `[[material]]`",
                              f"defined: {', '.join(map(repr, names)) or 'none'}")
-    n_nodes = sum(s["repeat"] for s in scene["shaft"]) + 1
+    for i, shaft in enumerate(scene["shaft"]):
+        if shaft["parallel"] and (i == 0 or shaft["repeat"] != 1 or scene["shaft"][i - 1]["length"] != shaft["length"]):
+            raise InputError(f"shaft[{i}].parallel", True, "needs repeat = 1 and an element before it of the same "
+                             "`length` (a sleeve lies on that element's nodes)")
+    n_nodes = sum(s["repeat"] for s in scene["shaft"] if not s["parallel"]) + 1
     for table in ("disk", "bearing"):
         for i, entry in enumerate(scene[table]):
             if entry["node"] >= n_nodes:
