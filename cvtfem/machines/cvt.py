@@ -245,9 +245,9 @@ def chain_refusal(scene: Scene) -> InputError | None:
         return InputError("cvt.effects.contact", eff.contact, f"must be 'hertz' or 'hertz-refined' for `{model}`: Hertz "
                           "contact at the pin-axis end or refined (the rigid and impact contacts are not coupled to a "
                           "running chain yet)")
-    if eff.contact == "hertz-refined" and model not in ("chain-S2", "chain-S3"):
+    if eff.contact == "hertz-refined" and model not in ("chain-S2", "chain-S3", "chain-A1"):
         return InputError("cvt.effects.contact", eff.contact, f"must be 'hertz' for `{model}`: the refined contact "
-                          "runs with the symmetric chains chain-S2 and chain-S3 only so far")
+                          "runs with chain-S2, chain-S3 and chain-A1 only so far")
     if not eff.friction:
         return InputError("cvt.effects.friction", False, "must be true for a chain transmission: the chain "
                           "transmits torque only by pin-sheave friction")
