@@ -40,7 +40,7 @@ PLATE_HEIGHT = 8e-3
 #: Poisson's ratio of the steel plates (torsion stiffness ``G = E / (2 (1 + nu))``).
 POISSON = 0.3
 #: The whole-pin models that run on the sheaves.
-A_MODELS = {"chain-A1": None, "chain-A3": "A3", "chain-A4": "A4"}
+A_MODELS = {"chain-A1": None, "chain-A2": None, "chain-A3": "A3", "chain-A4": "A4"}
 
 
 def whole_pin_family(model: str, geom, damping, E: float, plate_height: float = PLATE_HEIGHT,
@@ -204,7 +204,7 @@ class ChainACVT(ChainCVT):
         H2 (:meth:`_refined_positions`) reads the end slope and the neighbours too."""
         _, iphi, iz, _ = self._idx
         n2, m = self.n2, len(ends)
-        d = self.family.dof_index[ends // 2]
+        d = self.family.dof_index[self.pin_of(ends)]
         side = np.where(ends % 2 == 1, 1.0, -1.0)
         one = np.ones(m)
         movable = np.asarray(self.movable_side)[shafts] == side
@@ -233,7 +233,7 @@ class ChainACVT(ChainCVT):
         ``s (2/l u_1 + u_2)`` (far, ``s = -1``) or ``s (2/l u_1 + u_3)`` (near), over ``END_SLOPE_FACTOR``
         (chain-models-2 §2.2)."""
         fam = self.family
-        pins = ends // 2
+        pins = self.pin_of(ends)
         dm, dn = fam.dof_index[(pins - 1) % fam.n], fam.dof_index[fam.ip1[pins]]
         one = np.ones(len(ends))
         bend = np.where(side > 0, d[:, 6:8].T, d[:, 4:6].T).T          # u_3 (near) or u_2 (far)
@@ -291,6 +291,9 @@ class ChainACVT(ChainCVT):
     def from_parameters(cls, geom, *, contact: str = "hertz", face_radius: float = 0.02, **kw) -> "ChainACVT":
         """:meth:`ChainCVT.from_parameters`; ``contact = "hertz-refined"`` puts H2 at both ends of every pin
         (:class:`RefinedSheaveContact` with the end slopes, crown radius ``face_radius``, m): variant (a)."""
+        if kw.get("model") == "chain-A2" and cls is ChainACVT:
+            from cvtfem.machines.chain_a2_cvt import ChainA2CVT    # builds on this module
+            return ChainA2CVT.from_parameters(geom, contact=contact, face_radius=face_radius, **kw)
         if contact not in ("hertz", "hertz-refined"):
             raise InputError("cvt.effects.contact", contact, "must be 'hertz' or 'hertz-refined' for a whole-pin chain")
         model = super().from_parameters(geom, contact="hertz", face_radius=face_radius, **kw)

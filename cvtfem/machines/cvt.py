@@ -157,7 +157,7 @@ def chain_geometry(scene: Scene):
 
 
 #: Discrete-chain models that run as a transmission (the others exist as element families only).
-RUNNING_CHAINS = ("chain-S2", "chain-S3", "chain-A1")
+RUNNING_CHAINS = ("chain-S2", "chain-S3", "chain-A1", "chain-A2")
 
 
 def band_model(scene: Scene, **overrides: Any):
@@ -245,9 +245,12 @@ def chain_refusal(scene: Scene) -> InputError | None:
         return InputError("cvt.effects.contact", eff.contact, f"must be 'hertz' or 'hertz-refined' for `{model}`: Hertz "
                           "contact at the pin-axis end or refined (the rigid and impact contacts are not coupled to a "
                           "running chain yet)")
-    if eff.contact == "hertz-refined" and model not in ("chain-S2", "chain-S3", "chain-A1"):
+    if eff.contact == "hertz-refined" and model not in ("chain-S2", "chain-S3", "chain-A1", "chain-A2"):
         return InputError("cvt.effects.contact", eff.contact, f"must be 'hertz' for `{model}`: the refined contact "
-                          "runs with chain-S2, chain-S3 and chain-A1 only so far")
+                          "runs with chain-S2, chain-S3, chain-A1 and chain-A2 only so far")
+    if model == "chain-A2" and eff.contact != "hertz-refined":
+        return InputError("cvt.effects.contact", eff.contact, "must be 'hertz-refined' for `chain-A2`: its coupled "
+                          "pin halves touch the sheaves with their biconvex end faces (Table 1.1 (v))")
     if not eff.friction:
         return InputError("cvt.effects.friction", False, "must be true for a chain transmission: the chain "
                           "transmits torque only by pin-sheave friction")
@@ -261,9 +264,10 @@ def chain_loop(scene: Scene):
 
     The prescribed clamping forces are those the band models get (:class:`~cvtfem.control.clamping.Clamping`
     at the regime's start: torque, ratio, safety factor, split); the ratio loop corrects ``F1`` from there.
-    Only what runs is accepted: ``chain-S2`` (no pin bending), ``chain-S3`` and the whole-pin chain ``chain-A1``
-    (pin bending; :mod:`~cvtfem.machines.chain_a_cvt`, a fixed and a movable sheave per shaft), rigid shafts,
-    ``effects.contact = "hertz"`` (all three) or ``"hertz-refined"`` (S2, S3), friction on.  (A3/A4 build through
+    Only what runs is accepted: ``chain-S2`` (no pin bending), ``chain-S3`` and the whole-pin chains ``chain-A1``
+    and ``chain-A2`` (pin bending; :mod:`~cvtfem.machines.chain_a_cvt`, a fixed and a movable sheave per shaft;
+    A2's coupled halves :mod:`~cvtfem.machines.chain_a2_cvt`), rigid shafts, ``effects.contact = "hertz"``
+    (S2, S3, A1) or ``"hertz-refined"`` (all four; variant (a) is A1 with it), friction on.  (A3/A4 build through
     the same interface, but their quasi-static start does not converge yet: docs/chain.md.)
     """
     from cvtfem.control.clamping import Clamping
@@ -281,6 +285,13 @@ def chain_loop(scene: Scene):
     return from_scene(scene, chain_geometry(scene), F_appl, model=model, contact=eff.contact, **overrides)
 
 
+def _contact_note(scene: Scene) -> str:
+    """Which contact the running chain's pin ends have, for `describe`."""
+    refined = scene.cvt.effects.contact == "hertz-refined"
+    where = "both ends of both pin halves" if scene.cvt.model == "chain-A2" else "both pin ends"
+    return f"{'refined (H2)' if refined else 'Hertz (H1)'} contact at {where}"
+
+
 def _running_chain_layout(scene: Scene) -> tuple[Layout, ...]:
     """Components of :func:`chain_loop`'s model with the outputs it writes, grouped by name prefix."""
     model = chain_loop(scene)
@@ -291,7 +302,7 @@ def _running_chain_layout(scene: Scene) -> tuple[Layout, ...]:
         return tuple(o for o in model.output_specs if o.name.startswith(prefixes))
 
     parts = [Layout("chain", scene.cvt.model, n * per_pin, outputs=outputs("chain.", "contact."),
-                    note=f"{n} pins x {per_pin}; Hertz contact at both pin ends with each shaft's sheaves "
+                    note=f"{n} pins x {per_pin}; {_contact_note(scene)} with each shaft's sheaves "
                          "(continuous: no discrete state)"),
              Layout("driving pulley", "rigid-shaft", 2, outputs=outputs("driving."), note=f"spin angle, {sheave} axial"),
              Layout("driven pulley", "rigid-shaft", 2, outputs=outputs("driven."), note=f"spin angle, {sheave} axial")]
