@@ -48,9 +48,9 @@ class ChainA2CVT(ChainACVT):
     def _constants(self) -> np.ndarray:
         return np.append(super()._constants, 1.0)
 
-    def _contact_map(self, ends, shafts):
+    def _build_contact_map(self, ends, shafts):
         """A1's H2 map with the half sign (constant 1 times the sign) before the spin rate."""
-        cols, coef = super()._contact_map(ends, shafts)
+        cols, coef = super()._build_contact_map(ends, shafts)
         sign_col = np.full((len(ends), 1, 2), 2 * self.n2 + 3)
         sign = np.zeros((len(ends), 1, 2))
         sign[:, 0, 0] = self.half_of(ends)

@@ -198,7 +198,17 @@ class ChainACVT(ChainCVT):
     def _constants(self) -> np.ndarray:
         return np.array([*self.fixed_z, 0.0])
 
+    @cached_property
+    def _map_table(self):
+        """The contact map of every ``(end, shaft)`` pair, row ``2 end + shaft`` (built once)."""
+        return self._build_contact_map(*self._all_pairs())
+
     def _contact_map(self, ends, shafts):
+        cols, coef = self._map_table
+        k = 2 * ends + shafts
+        return cols[k], coef[k]
+
+    def _build_contact_map(self, ends, shafts):
         """Inputs in the mirrored frame of each end: ``x_perp = u_0 + s u_1``, ``x3 = s w_0 + w_1`` with ``s``
         the end's side; the sheave on that side is the movable one (``z_k``) or the fixed one (a constant).
         H2 (:meth:`_refined_positions`) reads the end slope and the neighbours too."""

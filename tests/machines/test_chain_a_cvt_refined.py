@@ -156,3 +156,29 @@ def test_energy_balance_over_a_short_run(model, static):
     x0, rep = static
     m = model.with_clamping([rep["F1"], F_APPL[1]])
     assert_energy_balance(m, x0, 2e-5)
+
+
+def _in_plane_resultant(model, x):
+    """Sum over the pins of the contacts' generalized forces on the in-plane translation (u_0 of A1, u of S2/S3)."""
+    q, v = x[:model.n2], x[model.n2:2 * model.n2]
+    Q, _ = _contact_forces(model, q, v)
+    idx = model.family.dof_index
+    return np.array([Q[idx[:, 0]].sum(), Q[idx[:, 1]].sum()])
+
+
+def test_support_forces_are_the_resultant_of_the_contact_forces(model, static, scene):
+    """The outputs' support forces (both shafts) sum to the resultant of the contact forces on the pins' in-plane
+    translations, for A1 with H2 and for S2 with H2 (the H2 kernel's first outputs are the spin couple on the
+    rear neighbour: reading them as the end force was wrong by the whole force)."""
+    x = _perturbed(model, static[0], seed=4)
+    o = model.outputs(0.0, x)
+    total = o["driving.support_force"] + o["driven.support_force"]
+    R = _in_plane_resultant(model, x)
+    assert np.linalg.norm(R) > 1e3
+    np.testing.assert_allclose(total, R, rtol=1e-9, atol=1e-9 * np.linalg.norm(R))
+    s2 = from_scene(scene, reference_geometry(), F_APPL, model="chain-S2", contact="hertz-refined")
+    x2 = s2.static_state(RATIO, scene.cvt.regime.input_speed)[0]
+    x2[s2.n2:s2.n2 + s2.family.size] += np.random.default_rng(6).normal(0.0, 0.05, s2.family.size)
+    o2 = s2.outputs(0.0, x2)
+    np.testing.assert_allclose(o2["driving.support_force"] + o2["driven.support_force"], _in_plane_resultant(s2, x2),
+                               rtol=1e-9, atol=1e-6)
