@@ -182,3 +182,32 @@ def test_support_forces_are_the_resultant_of_the_contact_forces(model, static, s
     o2 = s2.outputs(0.0, x2)
     np.testing.assert_allclose(o2["driving.support_force"] + o2["driven.support_force"], _in_plane_resultant(s2, x2),
                                rtol=1e-9, atol=1e-6)
+
+
+@pytest.mark.slow
+def test_cvtfem_run_variant_a_balances_energy_and_axial_forces(cli, tmp_path):
+    """`cvtfem run` of variant (a) at the stationary regime (chain-A1's solver settings) over 0.2 ms from its
+    quasi-static start: the work integrals close the energy balance to 1e-5 of the input work, every output is
+    finite, and over the second 0.1 ms the pins' axial forces on each movable sheave balance its clamping force
+    on average to 1 %."""
+    import json
+
+    import h5py
+
+    scene = tmp_path / "variant-a.toml"
+    scene.write_text('preset = ["variant-a", "regime-stationary", "chain-random"]\n[solver]\nrtol = 1e-3\n'
+                     'atol = 1e-6\n[output]\nstep = 1e-5\n[cvt.friction]\nlaw = "tanh"\n')
+    h5, js = tmp_path / "a.h5", tmp_path / "s.json"
+    r = cli("run", str(scene), "--until", "2e-4", "--results", str(h5), "--summary-json", str(js), timeout=900)
+    assert r.returncode == 0, r.stderr
+    assert json.loads(js.read_text())["n_coordinates"] == 844
+    with h5py.File(h5) as f:
+        s = f["series"]
+        for name in s:
+            assert np.isfinite(s[name][:]).all(), name
+        t, W, E = s["time"][:], s["work"][-1], s["energy"][:]
+        late = t >= 1e-4
+        axial = s["contact.sheave_axial_force"][late].mean(axis=0)
+        F = np.array([s["driving.clamping_force"][late].mean(), s["driven.clamping_force"][late].mean()])
+    assert W[0] > 1.0 and abs(W[0] - W[1] - W[2] + W[3] - (E[-1] - E[0])) < 1e-5 * W[0]
+    np.testing.assert_allclose(axial, F, rtol=1e-2)
