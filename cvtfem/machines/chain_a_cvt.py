@@ -15,9 +15,9 @@ which is the contact map of ChainCVT with two columns per input.  The chain fami
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from functools import cached_property
-from typing import ClassVar
+from typing import Any, ClassVar
 
 import numpy as np
 import scipy.sparse as sp
@@ -64,7 +64,8 @@ def whole_pin_family(model: str, geom, damping, E: float, plate_height: float = 
                 closed=geom.closed, use_numba=use_numba)
     if A_MODELS[model] is None:
         return WholePinFamily(ChainA1(**args), geom)
-    return WholePinFamily(ChainPerPlate(model=A_MODELS[model], plate_thickness=h, **args), geom)
+    return WholePinFamily(ChainPerPlate(model=A_MODELS[model], plate_thickness=h, **args), geom,
+                          homogenised=ChainA1(**args))
 
 
 class WholePinFamily:
@@ -76,8 +77,9 @@ class WholePinFamily:
 
     name = "chain"
 
-    def __init__(self, chain, geom):
+    def __init__(self, chain, geom, homogenised=None):
         self.chain, self.geom = chain, geom
+        self.homogenised = homogenised                # A3/A4: A1 of the same plates (the start's first step)
         self._a1 = getattr(chain, "base", chain)        # the ChainA1 layout of A3/A4
         self.n, self.size = chain.n_pins, chain.n2
         self.dof_index = chain.dof_index
@@ -161,10 +163,14 @@ class ChainACVT(ChainCVT):
     fixed_z : (2,) m
         Position of each fixed sheave, counted outwards from ``x3 = 0`` as ``z`` (set by ``from_parameters``
         from the wedge estimate at the regime's ratio).
+    start_chain : (n2_chain,) or None
+        Chain coordinates the quasi-static solve starts from (None: the pins placed on the band path); A3/A4
+        set it to the balance of A1 with the same plates (:meth:`_static`).
     """
 
     movable_side: tuple = (1, -1)
     fixed_z: tuple = (0.0, 0.0)
+    start_chain: Any = field(default=None, repr=False)
 
     sheaves_per_z: ClassVar[float] = 1.0
 
@@ -277,7 +283,19 @@ class ChainACVT(ChainCVT):
     def _elastic_link_tension(self, q_chain):
         return self.family.outputs(q_chain, None)["chain.link_tension"]
 
+    def _static(self, ratio, w1, F2, tol):
+        """ChainCVT's quasi-static solve; a per-plate chain (A3, A4) first solves A1 of the same plates (the
+        homogenised layer, ``family.homogenised``) and continues from that balance: from the placement guess the plate
+        states make Levenberg–Marquardt stall (A3 at 1.1e-2 of F2), from A1's balance A3 converges."""
+        a1 = self.family.homogenised
+        if a1 is None or self.start_chain is not None:
+            return super()._static(ratio, w1, F2, tol)
+        x1, _ = replace(self, family=WholePinFamily(a1, self.family.geom))._static(ratio, w1, F2, tol)
+        return replace(self, start_chain=x1[:self.family.size])._static(ratio, w1, F2, tol)
+
     def _placed(self, pl, u3):
+        if self.start_chain is not None:
+            return np.array(self.start_chain, float)
         u = np.zeros((4, self.family.n, 2))
         u[0] = pl.u
         return self.family.join(u, np.stack([np.zeros(self.family.n), u3]))

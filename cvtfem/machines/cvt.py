@@ -268,7 +268,7 @@ def chain_loop(scene: Scene):
     and ``chain-A2`` (pin bending; :mod:`~cvtfem.machines.chain_a_cvt`, a fixed and a movable sheave per shaft;
     A2's coupled halves :mod:`~cvtfem.machines.chain_a2_cvt`), rigid shafts, ``effects.contact = "hertz"``
     (S2, S3, A1) or ``"hertz-refined"`` (all four; variant (a) is A1 with it), friction on.  (A3/A4 build through
-    the same interface, but their quasi-static start does not converge yet: docs/chain.md.)
+    the same interface; A3's start converges from A1's balance, A4's does not yet: docs/chain.md.)
     """
     from cvtfem.control.clamping import Clamping
     from cvtfem.machines.chain_cvt import from_scene
