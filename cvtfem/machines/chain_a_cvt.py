@@ -7,16 +7,17 @@ sheave's position ``z_k`` (counted outwards from the chain, m) is the coordinate
 the pair's, its virtual work ``-F_k dz_k`` with ``F_k`` the clamping force; the fixed sheave stays where
 the wedge estimate puts it at the regime's ratio (aligned pulleys: the chain runs centred at ``x3 = 0``).
 The default places the driving pulley's movable sheave at ``x3 > 0`` and the driven one's at ``x3 < 0``,
-as in chain CVTs.  Every pin end touches the sheave on its side of each shaft (H1,
-:class:`~cvtfem.elements.chain.end_contact.EndContact`); the ends are linear in the pin coordinates
-(``u_0 -+ u_1``, ``w_0 -+ w_1``, chain-models-2 §2.1), which is the contact map of ChainCVT with two
-columns per input.  The chain family is wrapped in :class:`WholePinFamily`, the interface ChainCVT drives.
+as in chain CVTs.  Every pin end touches the sheave on its side of each shaft
+(:class:`~cvtfem.elements.chain.end_contact.EndContact`, H1 or the refined H2 of variant (a)); the ends,
+their slopes and (H2) the neighbours' chords are linear in the pin coordinates (chain-models-2 §2.1-2.2),
+which is the contact map of ChainCVT with two columns per input.  The chain family is wrapped in
+:class:`WholePinFamily`, the interface ChainCVT drives.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from functools import cached_property
-from typing import ClassVar
+from typing import Any, ClassVar
 
 import numpy as np
 import scipy.sparse as sp
@@ -25,6 +26,8 @@ import scipy.sparse.linalg as spla
 from cvtfem.elements.chain.asymmetric import ChainA1
 from cvtfem.elements.chain.end_contact import EndContact
 from cvtfem.elements.chain.per_plate import ChainPerPlate
+from cvtfem.elements.chain.sheave_contact_refined import RefinedSheaveContact
+from cvtfem.elements.chain.symmetric import END_SLOPE_FACTOR
 from cvtfem.errors import InputError
 from cvtfem.machines.chain import FreeChainA
 from cvtfem.machines.chain_cvt import ChainCVT
@@ -37,7 +40,7 @@ PLATE_HEIGHT = 8e-3
 #: Poisson's ratio of the steel plates (torsion stiffness ``G = E / (2 (1 + nu))``).
 POISSON = 0.3
 #: The whole-pin models that run on the sheaves.
-A_MODELS = {"chain-A1": None, "chain-A3": "A3", "chain-A4": "A4"}
+A_MODELS = {"chain-A1": None, "chain-A2": None, "chain-A3": "A3", "chain-A4": "A4"}
 
 
 def whole_pin_family(model: str, geom, damping, E: float, plate_height: float = PLATE_HEIGHT,
@@ -61,7 +64,8 @@ def whole_pin_family(model: str, geom, damping, E: float, plate_height: float = 
                 closed=geom.closed, use_numba=use_numba)
     if A_MODELS[model] is None:
         return WholePinFamily(ChainA1(**args), geom)
-    return WholePinFamily(ChainPerPlate(model=A_MODELS[model], plate_thickness=h, **args), geom)
+    return WholePinFamily(ChainPerPlate(model=A_MODELS[model], plate_thickness=h, **args), geom,
+                          homogenised=ChainA1(**args))
 
 
 class WholePinFamily:
@@ -73,8 +77,9 @@ class WholePinFamily:
 
     name = "chain"
 
-    def __init__(self, chain, geom):
+    def __init__(self, chain, geom, homogenised=None):
         self.chain, self.geom = chain, geom
+        self.homogenised = homogenised                # A3/A4: A1 of the same plates (the start's first step)
         self._a1 = getattr(chain, "base", chain)        # the ChainA1 layout of A3/A4
         self.n, self.size = chain.n_pins, chain.n2
         self.dof_index = chain.dof_index
@@ -158,10 +163,14 @@ class ChainACVT(ChainCVT):
     fixed_z : (2,) m
         Position of each fixed sheave, counted outwards from ``x3 = 0`` as ``z`` (set by ``from_parameters``
         from the wedge estimate at the regime's ratio).
+    start_chain : (n2_chain,) or None
+        Chain coordinates the quasi-static solve starts from (None: the pins placed on the band path); A3/A4
+        set it to the balance of A1 with the same plates (:meth:`_static`).
     """
 
     movable_side: tuple = (1, -1)
     fixed_z: tuple = (0.0, 0.0)
+    start_chain: Any = field(default=None, repr=False)
 
     sheaves_per_z: ClassVar[float] = 1.0
 
@@ -195,28 +204,74 @@ class ChainACVT(ChainCVT):
     def _constants(self) -> np.ndarray:
         return np.array([*self.fixed_z, 0.0])
 
+    @cached_property
+    def _map_table(self):
+        """The contact map of every ``(end, shaft)`` pair, row ``2 end + shaft`` (built once)."""
+        return self._build_contact_map(*self._all_pairs())
+
     def _contact_map(self, ends, shafts):
+        cols, coef = self._map_table
+        k = 2 * ends + shafts
+        return cols[k], coef[k]
+
+    def _build_contact_map(self, ends, shafts):
         """Inputs in the mirrored frame of each end: ``x_perp = u_0 + s u_1``, ``x3 = s w_0 + w_1`` with ``s``
-        the end's side; the sheave on that side is the movable one (``z_k``) or the fixed one (a constant)."""
+        the end's side; the sheave on that side is the movable one (``z_k``) or the fixed one (a constant).
+        H2 (:meth:`_refined_positions`) reads the end slope and the neighbours too."""
         _, iphi, iz, _ = self._idx
         n2, m = self.n2, len(ends)
-        d = self.family.dof_index[ends // 2]
+        d = self.family.dof_index[self.pin_of(ends)]
         side = np.where(ends % 2 == 1, 1.0, -1.0)
         one = np.ones(m)
         movable = np.asarray(self.movable_side)[shafts] == side
         zc = np.where(movable, iz[shafts], 2 * n2 + shafts)             # z_k or the fixed sheave's constant
         zv = np.where(movable, n2 + iz[shafts], 2 * n2 + 2)             # its rate (0 for the fixed one)
-        pos = [(d[:, 0], d[:, 2], one, side), (d[:, 1], d[:, 3], one, side), (d[:, 8], d[:, 9], side, one)]
-        cols = np.empty((m, 9, 2), np.int64)
-        coef = np.zeros((m, 9, 2))
+        if self.contact.refined:
+            pos = self._refined_positions(ends, d, side)
+        else:
+            pos = [(d[:, 0], d[:, 2], one, side), (d[:, 1], d[:, 3], one, side), (d[:, 8], d[:, 9], side, one)]
+        n_pos = len(pos) + 1                                            # and z
+        cols = np.empty((m, 2 * n_pos + 1, 2), np.int64)
+        coef = np.zeros((m, 2 * n_pos + 1, 2))
         for j, (a, b, ca, cb) in enumerate(pos):
             cols[:, j] = np.column_stack([a, b])
-            cols[:, 4 + j] = n2 + cols[:, j]
-            coef[:, j] = coef[:, 4 + j] = np.column_stack([ca, cb])
-        for j, c in ((3, zc), (7, zv), (8, n2 + iphi[shafts])):
+            cols[:, n_pos + j] = n2 + cols[:, j]
+            coef[:, j] = coef[:, n_pos + j] = np.column_stack([ca, cb])
+        for j, c in ((n_pos - 1, zc), (2 * n_pos - 1, zv), (2 * n_pos, n2 + iphi[shafts])):
             cols[:, j] = c[:, None]
             coef[:, j, 0] = 1.0
         return cols, coef
+
+    def _refined_positions(self, ends, d, side):
+        """H2's position inputs as ``(column a, column b, weight a, weight b)``: the pins ``p-1, p, p+1`` at the
+        end's in-plane offset ``s u_1`` of pin ``p`` (their chords are the mean-axis chords, which give the pin
+        spin (1.138)), ``x3 = s w_0 + w_1``, and the end slope in the mirrored frame,
+        ``s (2/l u_1 + u_2)`` (far, ``s = -1``) or ``s (2/l u_1 + u_3)`` (near), over ``END_SLOPE_FACTOR``
+        (chain-models-2 §2.2)."""
+        fam = self.family
+        pins = self.pin_of(ends)
+        dm, dn = fam.dof_index[(pins - 1) % fam.n], fam.dof_index[fam.ip1[pins]]
+        one = np.ones(len(ends))
+        bend = np.where(side > 0, d[:, 6:8].T, d[:, 4:6].T).T          # u_3 (near) or u_2 (far)
+        k = side / END_SLOPE_FACTOR
+        return [(dm[:, 0], d[:, 2], one, side), (dm[:, 1], d[:, 3], one, side),
+                (d[:, 0], d[:, 2], one, side), (d[:, 1], d[:, 3], one, side),
+                (dn[:, 0], d[:, 2], one, side), (dn[:, 1], d[:, 3], one, side),
+                (d[:, 8], d[:, 9], side, one),
+                (d[:, 2], bend[:, 0], 2 / fam.geom.l * k, k), (d[:, 3], bend[:, 1], 2 / fam.geom.l * k, k)]
+
+    def outputs(self, t: float, x):
+        """ChainCVT's outputs; the support forces are the resultant of the contact forces on the pin ends (the
+        H2 kernel's first outputs are the spin couple on the neighbours, not the end force)."""
+        out = super().outputs(t, x)
+        q, v, _, _ = self.split(x)
+        _, shafts, _, (_, c) = self._contacts(q, v, details=True)
+        out["driving.support_force"], out["driven.support_force"] = (
+            np.column_stack([np.bincount(shafts, c["F"][:, j], 2) for j in (0, 1)]))
+        return out
+
+    def _extra_approach(self, k, r):
+        return self.contact.extra_approach(k, r)
 
     def _sheave_outputs(self, ends, shafts, c) -> dict[str, np.ndarray]:
         movable = np.asarray(self.movable_side)[shafts] == np.where(ends % 2 == 1, 1, -1)
@@ -228,7 +283,19 @@ class ChainACVT(ChainCVT):
     def _elastic_link_tension(self, q_chain):
         return self.family.outputs(q_chain, None)["chain.link_tension"]
 
+    def _static(self, ratio, w1, F2, tol):
+        """ChainCVT's quasi-static solve; a per-plate chain (A3, A4) first solves A1 of the same plates (the
+        homogenised layer, ``family.homogenised``) and continues from that balance: from the placement guess the plate
+        states make Levenberg–Marquardt stall (A3 at 1.1e-2 of F2), from A1's balance A3 converges."""
+        a1 = self.family.homogenised
+        if a1 is None or self.start_chain is not None:
+            return super()._static(ratio, w1, F2, tol)
+        x1, _ = replace(self, family=WholePinFamily(a1, self.family.geom))._static(ratio, w1, F2, tol)
+        return replace(self, start_chain=x1[:self.family.size])._static(ratio, w1, F2, tol)
+
     def _placed(self, pl, u3):
+        if self.start_chain is not None:
+            return np.array(self.start_chain, float)
         u = np.zeros((4, self.family.n, 2))
         u[0] = pl.u
         return self.family.join(u, np.stack([np.zeros(self.family.n), u3]))
@@ -247,6 +314,24 @@ class ChainACVT(ChainCVT):
     @classmethod
     def _contact_for(cls, contact):
         return EndContact(contact)
+
+    @classmethod
+    def from_parameters(cls, geom, *, contact: str = "hertz", face_radius: float = 0.02, **kw) -> "ChainACVT":
+        """:meth:`ChainCVT.from_parameters`; ``contact = "hertz-refined"`` puts H2 at both ends of every pin
+        (:class:`RefinedSheaveContact` with the end slopes, crown radius ``face_radius``, m): variant (a)."""
+        if kw.get("model") == "chain-A2" and cls is ChainACVT:
+            from cvtfem.machines.chain_a2_cvt import ChainA2CVT    # builds on this module
+            return ChainA2CVT.from_parameters(geom, contact=contact, face_radius=face_radius, **kw)
+        if contact not in ("hertz", "hertz-refined"):
+            raise InputError("cvt.effects.contact", contact, "must be 'hertz' or 'hertz-refined' for a whole-pin chain")
+        model = super().from_parameters(geom, contact="hertz", face_radius=face_radius, **kw)
+        if contact == "hertz":
+            return model
+        h1 = model.contact.pair
+        fam = model.family
+        h2 = RefinedSheaveContact(h1.centres, h1.faces, h1.c, h1.r_outer, h1.f0, h1.v0, face_radius,
+                                  (np.arange(fam.n) - 1) % fam.n, fam.ip1, slopes=True, law=h1.law, eps=h1.eps)
+        return replace(model, contact=EndContact(h2))._settled()
 
     def _settled(self) -> "ChainACVT":
         """The fixed sheaves where the wedge estimate at the regime's start ratio and ``F_appl[1]`` puts them."""

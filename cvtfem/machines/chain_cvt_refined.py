@@ -39,6 +39,16 @@ class RefinedChainCVT(ChainCVT):
                 upd[on] = x0[self.n2 + iphi[k]] * np.column_stack([-up[on, 1], up[on, 0]])
         return x0, rep
 
+    def outputs(self, t: float, x):
+        """ChainCVT's outputs with the support forces from the end forces of the contacts (both mirrored ends):
+        the kernel's first outputs are the spin couple on the rear neighbour, not the end force."""
+        out = super().outputs(t, x)
+        q, v, _, _ = self.split(x)
+        _, shafts, _, (_, c) = self._contacts(q, v, details=True)
+        out["driving.support_force"], out["driven.support_force"] = (
+            np.column_stack([self.sheaves_per_z * np.bincount(shafts, c["F"][:, j], 2) for j in (0, 1)]))
+        return out
+
     def _extra_approach(self, k, r):
         return float(self.contact.extra_approach(k, r))
 

@@ -157,7 +157,7 @@ def chain_geometry(scene: Scene):
 
 
 #: Discrete-chain models that run as a transmission (the others exist as element families only).
-RUNNING_CHAINS = ("chain-S1", "chain-S2", "chain-S3", "chain-A1")
+RUNNING_CHAINS = ("chain-S1", "chain-S2", "chain-S3", "chain-A1", "chain-A2")
 
 
 def band_model(scene: Scene, **overrides: Any):
@@ -255,9 +255,12 @@ def chain_refusal(scene: Scene) -> InputError | None:
         return InputError("cvt.effects.contact", eff.contact, f"must be 'hertz' or 'hertz-refined' for `{model}`: Hertz "
                           "contact at the pin-axis end or refined (the rigid contact runs with `chain-S1` only, the impact "
                           "contact is not coupled to a running chain yet)")
-    if eff.contact == "hertz-refined" and model not in ("chain-S2", "chain-S3"):
+    if eff.contact == "hertz-refined" and model not in ("chain-S2", "chain-S3", "chain-A1", "chain-A2"):
         return InputError("cvt.effects.contact", eff.contact, f"must be 'hertz' for `{model}`: the refined contact "
-                          "runs with the symmetric chains chain-S2 and chain-S3 only so far")
+                          "runs with chain-S2, chain-S3, chain-A1 and chain-A2 only so far")
+    if model == "chain-A2" and eff.contact != "hertz-refined":
+        return InputError("cvt.effects.contact", eff.contact, "must be 'hertz-refined' for `chain-A2`: its coupled "
+                          "pin halves touch the sheaves with their biconvex end faces (Table 1.1 (v))")
     if not eff.friction:
         return InputError("cvt.effects.friction", False, "must be true for a chain transmission: the chain "
                           "transmits torque only by pin-sheave friction")
@@ -272,11 +275,12 @@ def chain_loop(scene: Scene):
     The prescribed clamping forces are those the band models get (:class:`~cvtfem.control.clamping.Clamping`
     at the regime's start: torque, ratio, safety factor, split); the ratio loop corrects ``F1`` from there.
     Only what runs is accepted: ``chain-S1`` (rigid contact: the pin ends follow the faces), ``chain-S2`` (no pin
-    bending), ``chain-S3`` and the whole-pin chain ``chain-A1``
-    (pin bending; :mod:`~cvtfem.machines.chain_a_cvt`, a fixed and a movable sheave per shaft), rigid shafts,
-    ``effects.contact = "hertz"`` (all three) or ``"hertz-refined"`` (S2, S3), friction on; with
-    ``effects.shaft_elasticity`` the three with H1 on elastic shafts (:mod:`~cvtfem.machines.chain_cvt_elastic`).  (A3/A4 build through
-    the same interface, but their quasi-static start does not converge yet: docs/chain.md.)
+    bending), ``chain-S3`` and the whole-pin chains ``chain-A1`` and ``chain-A2`` (pin bending;
+    :mod:`~cvtfem.machines.chain_a_cvt`, a fixed and a movable sheave per shaft; A2's coupled halves
+    :mod:`~cvtfem.machines.chain_a2_cvt`), rigid shafts, ``effects.contact = "hertz"`` (S2, S3, A1) or
+    ``"hertz-refined"`` (all four; variant (a) is A1 with it), friction on; with ``effects.shaft_elasticity`` S2, S3
+    and A1 with H1 on elastic shafts (:mod:`~cvtfem.machines.chain_cvt_elastic`).  (A3/A4 build through the same
+    interface; A3's start converges from A1's balance, A4's does not yet: docs/chain.md.)
     """
     from cvtfem.control.clamping import Clamping
     from cvtfem.machines.chain_cvt import from_scene
@@ -307,6 +311,15 @@ def _pulley_layouts(model, outputs, sheave: str) -> list[Layout]:
                                                                                              structure.x)]
 
 
+def _contact_note(scene: Scene) -> str:
+    """Which contact the running chain's pin ends have, for `describe`."""
+    if scene.cvt.model == "chain-S1":
+        return "rigid contact: the pin ends follow the faces of"
+    refined = scene.cvt.effects.contact == "hertz-refined"
+    where = "both ends of both pin halves" if scene.cvt.model == "chain-A2" else "both pin ends"
+    return f"{'refined (H2)' if refined else 'Hertz (H1)'} contact at {where} with"
+
+
 def _running_chain_layout(scene: Scene) -> tuple[Layout, ...]:
     """Components of :func:`chain_loop`'s model with the outputs it writes, grouped by name prefix."""
     model = chain_loop(scene)
@@ -317,10 +330,8 @@ def _running_chain_layout(scene: Scene) -> tuple[Layout, ...]:
         return tuple(o for o in model.output_specs if o.name.startswith(prefixes))
 
     parts = [Layout("chain", scene.cvt.model, n * per_pin, outputs=outputs("chain.", "contact."),
-                    note=f"{n} pins x {per_pin}; " + ("rigid contact: the pin ends follow the sheave faces"
-                                                      if scene.cvt.model == "chain-S1" else
-                                                      "Hertz contact at both pin ends with each shaft's sheaves")
-                         + " (continuous: no discrete state)"),
+                    note=f"{n} pins x {per_pin}; {_contact_note(scene)} each shaft's sheaves "
+                         "(continuous: no discrete state)"),
              *_pulley_layouts(model, outputs, sheave)]
     if scene.cvt.effects.stabilisation:
         parts.append(Layout("stabilisation", "speed-ratio-control", 0, n1=Stabilisation.size,

@@ -176,3 +176,18 @@ def test_cvtfem_run_chain_a1_closes_the_energy_balance(cli, tmp_path):
             assert np.isfinite(s[name][:]).all(), name
         W, E = s["work"][-1], s["energy"][:]
     assert W[0] > 1.0 and abs(W[0] - W[1] - W[2] + W[3] - (E[-1] - E[0])) < 1e-5 * W[0]
+
+
+@pytest.mark.slow
+def test_a3_start_continues_from_the_a1_balance(scene, static):
+    """A3's quasi-static start, continued from the A1 balance of its own A1 layout, converges (from the placement
+    guess it stalls at 1.1e-2 of F2): residual, each movable sheave's axial force = its clamping force, and the
+    per-plate chain's tension within 2 % of A1's (the homogenised layer of the same plates)."""
+    a3 = from_scene(scene, reference_geometry(), F_APPL, model="chain-A3")
+    x0, rep = a3.static_state(RATIO, scene.cvt.regime.input_speed)
+    assert rep["residual"] < 1e-8 and rep["nfev"] < 100
+    at_rest = x0.copy()
+    at_rest[a3.n2:2 * a3.n2] = 0.0
+    o = a3.outputs(0.0, at_rest)
+    np.testing.assert_allclose(o["contact.sheave_axial_force"], [rep["F1"], F_APPL[1]], rtol=1e-8)
+    assert rep["tension"] == pytest.approx(static[1]["tension"], rel=2e-2)
