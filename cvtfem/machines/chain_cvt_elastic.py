@@ -119,7 +119,8 @@ class ElasticChainCVT(ChainCVT):
                                f"sheave of the {name} shaft.", 4),
                     OutputSpec(f"{name}.sheave_shift", "m", f"Translation u1, u2 of the fixed, then the movable "
                                f"sheave of the {name} shaft.", 4)]
-        return super().output_specs + tuple(new)
+        rigid_only = ("driving.sheave_position", "driven.sheave_position")   # the rigid model's z: here sheave_shift
+        return tuple(o for o in super().output_specs if o.name not in rigid_only) + tuple(new)
 
     # ----- contacts ----------------------------------------------------------------------------
     #: Share of the kernel's output that one evaluation carries (the S2/S3 kernel loads a mirrored pair: 1/2).
@@ -571,7 +572,7 @@ class ElasticChainACVT(ElasticChainCVT, ChainACVT):
 
     def rigid(self) -> ChainACVT:
         return ChainACVT(self.family, self.contact, self.J, self.m_sheave, self.regime, self.F_appl, self.control,
-                         self.movable_side, self.fixed_z)
+                         self.movable_side, self.fixed_z, self.start_chain)
 
     def _face_reference(self, x0r) -> np.ndarray:
         """``z_ref`` (2, 2): the fixed faces at ``fixed_z``, the movable ones at the rigid start's ``z``."""
@@ -606,8 +607,9 @@ def elastic(rigid: ChainCVT, structure: ShaftStructure) -> ElasticChainCVT:
     """The rigid transmission ``rigid`` (ChainCVT, or ChainACVT: :class:`ElasticChainACVT`) on ``structure`` (``z_ref`` set by :meth:`ElasticChainCVT.static_state`)."""
     args = (rigid.family, rigid.contact, rigid.J, rigid.m_sheave, rigid.regime, rigid.F_appl, rigid.control)
     if isinstance(rigid, ChainACVT):
-        return ElasticChainACVT(*args, rigid.movable_side, rigid.fixed_z, structure, np.zeros((2, 2)))
-    return ElasticChainCVT(*args, structure, np.zeros((2, 2)))
+        return ElasticChainACVT(*args, movable_side=rigid.movable_side, fixed_z=rigid.fixed_z,
+                                start_chain=rigid.start_chain, structure=structure, z_ref=np.zeros((2, 2)))
+    return ElasticChainCVT(*args, structure=structure, z_ref=np.zeros((2, 2)))
 
 
 def from_scene(scene, geom, F_appl, **overrides) -> ElasticChainCVT:
