@@ -16,6 +16,9 @@ splits the ``3n`` system into one real system ``(mu_r/h) I - J`` and one complex
   and refined once through ``F`` when it exceeds the tolerance on the first attempt or after a rejection
   (Shampine's device for very stiff problems).
 * Dense output: the collocation polynomial (order 3 inside the step, exact at its end).
+* Tolerance map of RADAU5: the order-3 estimate is controlled against ``rtol_int = 0.1 rtol^(2/3)``,
+  ``atol_int = atol rtol_int / rtol``, so the order-5 solution's error tracks rtol (without it the error
+  is 1e-3 x rtol at rtol 1e-8 on the limit cycle); ``proportional=False`` controls against rtol itself.
 
 The constants are published figures (the transformation ``T`` and its inverse, the eigenvalues ``mu`` of
 the inverse Radau IIA(5) matrix, the estimate's weights ``e``).
@@ -25,6 +28,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
+from cvtfem.errors import InputError
 from cvtfem.integrate.base import Attempt, Stepper, StepFailure
 from cvtfem.integrate.jacobian import JacobianProvider
 from cvtfem.integrate.linsolve import LU
@@ -59,8 +63,13 @@ class Radau5(Stepper):
     controller = "predictive"   # Gustafsson's, as RADAU5
     STEP_QUANTUM = 1.2          # keep h (and the LUs) unless the controller wants 1.2x or more
 
-    def __init__(self, system, stats=None) -> None:
+    OPTIONS = frozenset({"proportional"})
+
+    def __init__(self, system, stats=None, proportional: bool = True) -> None:
         super().__init__(system, stats)
+        if not isinstance(proportional, (bool, np.bool_)):
+            raise InputError("proportional", proportional, "must be true or false")
+        self.proportional = bool(proportional)
         self.jac = JacobianProvider(self)
         self.J = None
         self._current = False     # J was evaluated at the current step's start
@@ -68,6 +77,10 @@ class Radau5(Stepper):
         self._lu: tuple[float, LU, LU] | None = None
         self._poly = None         # (t0, h, x0, Q) of the last accepted step: Newton's starting guess
         self._retry = True        # refine the error estimate (first attempt, or after a rejection)
+
+    def tolerance_ratio(self, rtol: float) -> float:
+        """``rtol_int / rtol = 0.1 rtol^(-1/3)`` (RADAU5's map, module docstring) or 1."""
+        return 0.1 * rtol ** (-1.0 / 3.0) if self.proportional else 1.0
 
     # --- linear algebra ---------------------------------------------------------------------------
 
