@@ -52,6 +52,8 @@ P = np.array([[13 / 3 + 7 * S6 / 3, -23 / 3 - 22 * S6 / 3, 10 / 3 + 5 * S6],
               [13 / 3 - 7 * S6 / 3, -23 / 3 + 22 * S6 / 3, 10 / 3 - 5 * S6],
               [1 / 3, -8 / 3, 10 / 3]])
 NEWTON_MAXITER = 6
+#: Newton's (rtol, atol) and iteration limit in fixed-step runs (no retry with a smaller step there)
+FIXED_STEP_TOL, FIXED_STEP_MAXITER = (1e-12, 1e-12), 30
 #: a converged solve slower than this (rate) with more than 2 iterations asks for a new Jacobian
 JAC_RATE = 1e-3
 
@@ -119,7 +121,8 @@ class Radau5(Stepper):
         W = TI @ Z
         mr, mc = MU_REAL / h, MU_COMPLEX / h
         norm_old, rate = None, None
-        for k in range(NEWTON_MAXITER):
+        maxiter = NEWTON_MAXITER if self.tolerances else FIXED_STEP_MAXITER
+        for k in range(maxiter):
             F = np.array([self.f(t + ci * h, x + zi) for ci, zi in zip(C, Z)])
             if not np.all(np.isfinite(F)):
                 return None
@@ -129,7 +132,7 @@ class Radau5(Stepper):
             norm = float(np.sqrt(np.mean((dW / scale) ** 2)))
             if norm_old is not None:
                 rate = norm / norm_old
-                if rate >= 1 or rate ** (NEWTON_MAXITER - k) / (1 - rate) * norm > tol:
+                if rate >= 1 or rate ** (maxiter - k) / (1 - rate) * norm > tol:
                     return None
             W += dW
             Z = T @ W
@@ -140,7 +143,7 @@ class Radau5(Stepper):
         return None
 
     def attempt(self, t, x, h):
-        rtol, atol = self.tolerances or (1e-3, 1e-6)
+        rtol, atol = self.tolerances or FIXED_STEP_TOL   # fixed steps: Newton to round-off
         if self.J is None or self._stale:
             self._new_jacobian(t, x)
         f0 = self.f0(t, x)
