@@ -17,9 +17,13 @@ the trapezoidal rule does not damp stiff components (R(-inf) = -1), so a Newton 
 rings on (band-6+2n 1 s, rtol 1e-3, Euler predictor: kappa 0.03 gave 2483 steps, 1e-3 389); fixed-step runs and
 ``newton_stop="source"`` use the source's line search and stopping rule (2.21)-(2.23).
 
-Error estimate (ours): the trapezoidal rule's local error ``-h^3 y'''/12`` with ``y'''``
-from the divided difference of ``F`` over the last two steps; other alpha use
-``|alpha - 1/2| h (F1 - F0)``; both are filtered by the LU of ``I - h alpha J`` (Shampine).
+Error estimate (ours): the trapezoidal rule's local error ``h^3 x'''/12`` with ``x'''`` from the third
+divided difference of the states at the last four points ``t_{n-2} ... t_{n+1}`` (the step before: from the
+divided difference of ``F`` over two steps; the first step: first order). Not from ``F``: the rule is not
+L-stable, so a stiff component's deviation from its slow manifold alternates in sign undamped, and ``F`` of
+the components coupled to it carries that alternation (Robertson: ``1e4 y2`` in ``y1'``), which the rule
+itself cancels in ``(F_n + F_{n+1})/2`` but an estimate from ``F`` does not (h/t fell to 1e-3 on Robertson).
+Other alpha use ``|alpha - 1/2| h (F1 - F0)``; all are filtered by the LU of ``I - h alpha J`` (Shampine).
 
 Tolerance proportionality (adaptive trapezoidal rule, option ``proportional``, default on): with the
 local error held at the tolerance an order-2 method's global error falls only like ``tol^(2/3)``

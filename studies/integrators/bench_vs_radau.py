@@ -8,17 +8,18 @@ interpolated log-log between neighbouring sweep points (``-`` when the sweep doe
 sweep stops at the first error below 1e-8.
 Analytic Jacobians everywhere. Prints a table and the ratio best cvtfem method / Radau.
 
-Run: ``.venv/bin/python studies/integrators/bench_vs_radau.py [--repeats 3] [--methods rodas4,w1-extrapolation]``
+Run: ``.venv/bin/python studies/integrators/bench_vs_radau.py [--repeats 3] [--methods radau5,rodas4:...]``
+(method specs as ``cvtfem study``: ``NAME[:key=value...]``).
 """
 from __future__ import annotations
 
 import argparse
 import dataclasses
-import os
-import platform
 
 import numpy as np
 
+from cvtfem.analysis.timing import machine
+from cvtfem.commands.study import parse_method
 from cvtfem.integrate import solve
 from cvtfem.integrate.study import work_precision
 from cvtfem.problems import hires, robertson, van_der_pol_stiff
@@ -47,20 +48,21 @@ def time_at(rows, target):
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeats", type=int, default=3)
-    ap.add_argument("--methods", default="rodas4,rodas5p")
+    ap.add_argument("--methods", default="radau5,rodas4,rodas5p")
     args = ap.parse_args()
     methods = args.methods.split(",") + ["Radau"]
     problems = {"hires": hires(), "vdp": with_reference(van_der_pol_stiff(1e-6), 1e-12),
                 "robertson": with_reference(robertson(1e5), 1e-20)}
-    print(f"median of {args.repeats} runs; {platform.processor() or platform.machine()}, {os.cpu_count()} cores, "
-          f"Python {platform.python_version()}")
+    print(f"median of {args.repeats} runs; {machine()}")
     print(f"{'problem':10s} {'method':18s} " + " ".join(f"t@{e:.0e}".rjust(10) for e in TARGETS))
     for name, p in problems.items():
         best = {}
         for m in methods:
             rows = []
             for r in RTOLS:   # down to the first error below the smallest target
-                rows += work_precision(p, [(m, m, {"rtol": r, "atol": ATOL[name] * r})], repeats=args.repeats)
+                label, method, opts = parse_method(m)
+                rows += work_precision(p, [(label, method, {**opts, "rtol": r, "atol": ATOL[name] * r})],
+                                       repeats=args.repeats)
                 if rows[-1]["error"] < min(TARGETS):
                     break
             times = [time_at(rows, e) for e in TARGETS]
@@ -73,7 +75,8 @@ def main() -> None:
                     best[("Radau", e)] = t
         ratios = [best[e] / best[("Radau", e)] if e in best and ("Radau", e) in best else None for e in TARGETS]
         print(f"{name:10s} {'best/Radau':18s} " + " ".join(("-" if r is None else f"{r:.2f}x").rjust(10)
-                                                         for r in ratios))
+                                                         for r in ratios), flush=True)
+    print(f"end: {machine()}")
 
 
 if __name__ == "__main__":
