@@ -31,7 +31,8 @@ import scipy.sparse as sp
 from cvtfem.errors import InputError
 from cvtfem.integrate.base import Attempt, Stepper, StepFailure
 from cvtfem.integrate.jacobian import JacobianProvider
-from cvtfem.integrate.linsolve import LU
+from cvtfem.integrate.linsolve import DENSE_MAX, LU
+from cvtfem.integrate.memory import MatrixSlot, opt_scalar, scalar, vector
 
 __all__ = ["Radau5"]
 
@@ -190,3 +191,38 @@ class Radau5(Stepper):
 
     def reset(self) -> None:
         self._poly, self._retry, self._stale = None, True, True
+
+    # --- memory -----------------------------------------------------------------------------------
+
+    def _slot(self) -> MatrixSlot:
+        return MatrixSlot.for_pattern("J", self.system.n, self.system.jac_sparsity)
+
+    def memory_fields(self):
+        """The Jacobian, the step size of its LUs, the flags (J stale / evaluated at this point / refine the next
+        estimate), the last step's collocation polynomial (``t0, h``, ``x0``, ``Q``) and ``F`` here."""
+        n = self.system.n
+        return self._slot().fields() + (("lu_h", 1), ("flags", 3), ("poly_th", 2), ("poly_x0", n),
+                                         ("poly_q", 3 * n)) + super().memory_fields()
+
+    def state(self, t, x):
+        n, poly = self.system.n, self._poly
+        return {**self._slot().pack(self.J), "lu_h": scalar(None if self._lu is None else self._lu[0]),
+                "flags": np.array([self._stale, self._current, self._retry], dtype=float),
+                "poly_th": np.array(poly[:2] if poly else [np.nan, np.nan]),
+                "poly_x0": vector(poly[2] if poly else None, n),
+                "poly_q": vector(poly[3].ravel() if poly else None, 3 * n), **super().state(t, x)}
+
+    def restore(self, state, t, x):
+        """The LUs are recomputed from the saved Jacobian and ``h`` (the same factors for the same matrix)."""
+        J = self._slot().unpack(state)
+        if J is not None:   # in the form JacobianProvider returns
+            self.J = sp.csr_matrix(J) if self.system.n > DENSE_MAX else (J.toarray() if sp.issparse(J) else J)
+        self._stale, self._current, self._retry = (bool(v) for v in state["flags"])
+        self._lu = None
+        lu_h = opt_scalar(state["lu_h"])
+        if lu_h is not None and self.J is not None:
+            self._factors(lu_h)
+        th = state["poly_th"]
+        self._poly = None if np.isnan(th[0]) else (float(th[0]), float(th[1]), np.array(state["poly_x0"]),
+                                                   np.array(state["poly_q"]).reshape(len(x), 3))
+        super().restore(state, t, x)

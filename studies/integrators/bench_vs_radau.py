@@ -49,10 +49,12 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeats", type=int, default=3)
     ap.add_argument("--methods", default="radau5,rodas4,rodas5p")
+    ap.add_argument("--problems", default="hires,vdp,robertson", help="subset of hires,vdp,robertson")
     args = ap.parse_args()
     methods = args.methods.split(",") + ["Radau"]
-    problems = {"hires": hires(), "vdp": with_reference(van_der_pol_stiff(1e-6), 1e-12),
-                "robertson": with_reference(robertson(1e5), 1e-20)}
+    make = {"hires": hires, "vdp": lambda: with_reference(van_der_pol_stiff(1e-6), 1e-12),
+            "robertson": lambda: with_reference(robertson(1e5), 1e-20)}
+    problems = {name: make[name]() for name in args.problems.split(",")}
     print(f"median of {args.repeats} runs; {machine()}")
     print(f"{'problem':10s} {'method':18s} " + " ".join(f"t@{e:.0e}".rjust(10) for e in TARGETS))
     for name, p in problems.items():

@@ -81,3 +81,28 @@ def test_without_the_tolerance_map_far_more_accurate_than_asked():
     err = {prop: np.max(np.abs(solve(**p.solve_kwargs(), method="radau5", rtol=1e-8, atol=1e-8,
                                      proportional=prop).y[:, -1] - ex)) for prop in (True, False)}
     assert err[False] < 1e-2 * 1e-8 < err[True] < 10 * 1e-8
+
+
+@pytest.mark.parametrize("method", ["radau5", "rodas4"])
+def test_memory_restores_bit_for_bit(method):
+    """A run rebuilt from :meth:`Stepping.state` after 40 steps continues bit for bit: radau5's kept Jacobian,
+    LU step size, flags and collocation polynomial, and the predictive controller's memory, are in the state."""
+    p = van_der_pol_stiff(1e-6)
+    x0 = p.y0
+
+    def stepping(t0, x, first_step=None):
+        engine = make_engine(method, as_system(p.fun, x, jac=p.jac), t0, x, 2.0, 1e-6, 1e-6, first_step=first_step)
+        return Stepping(engine, t0, x, 2.0)
+
+    run = stepping(0.0, x0)
+    for _ in range(40):
+        assert run.step()
+    state = run.state()
+    assert {name for name, _ in run.fields()} == set(state)
+    again = stepping(run.t, run.x.copy(), first_step=float(state["h"][0]))
+    again.restore(state)
+    for _ in range(30):
+        run.step(), again.step()
+        assert run.t == again.t and np.array_equal(run.x, again.x)
+    for c in ("nfev", "njev", "nlu", "nreject"):
+        assert run.counts[c] == again.counts[c], c
