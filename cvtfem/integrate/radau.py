@@ -3,7 +3,8 @@
 The collocation method at ``c = (4 - sqrt6)/10, (4 + sqrt6)/10, 1`` (Hairer-Wanner II §IV.8) in the
 stage increments ``Z_i = X_i - x0``; simplified Newton on the transformed unknowns ``W = T^-1 Z``, which
 splits the ``3n`` system into one real system ``(mu_r/h) I - J`` and one complex system
-``(mu_c/h) I - J`` (two LUs per step size and Jacobian). Strategies, as RADAU5:
+``(mu_c/h) I - J`` (two LUs per step size and Jacobian; with second-order structure ``x = [u, v, z]`` both are reduced to
+the ``[v, z]`` block as in the other implicit methods, :mod:`cvtfem.integrate.linsolve`). Strategies, as RADAU5:
 
 * Newton stops on the contraction rate in the error norm (tolerance ``max(10 eps/rtol, min(0.03,
   sqrt(rtol)))``) and gives up when the predicted error after the remaining iterations stays too large;
@@ -31,7 +32,7 @@ import scipy.sparse as sp
 from cvtfem.errors import InputError
 from cvtfem.integrate.base import Attempt, Stepper, StepFailure
 from cvtfem.integrate.jacobian import JacobianProvider
-from cvtfem.integrate.linsolve import DENSE_MAX, LU
+from cvtfem.integrate.linsolve import DENSE_MAX, LU, reduced_matrix
 from cvtfem.integrate.memory import MatrixSlot, opt_scalar, scalar, vector
 
 __all__ = ["Radau5"]
@@ -57,6 +58,11 @@ NEWTON_MAXITER = 6
 FIXED_STEP_TOL, FIXED_STEP_MAXITER = (1e-12, 1e-12), 30
 #: a converged solve slower than this (rate) with more than 2 iterations asks for a new Jacobian
 JAC_RATE = 1e-3
+
+
+def solve(lu: LU, r: np.ndarray) -> np.ndarray:
+    """``k`` with ``((mu/h) I - J) k = r``, from the LU of ``I - gamma J``, ``gamma = h/mu``."""
+    return lu.solve_full(lu.gamma * r)
 
 
 class Radau5(Stepper):
@@ -92,18 +98,13 @@ class Radau5(Stepper):
         self._current, self._stale, self._lu = True, False, None
 
     def _factors(self, h: float) -> tuple[LU, LU]:
-        """LUs of ``(mu_r/h) I - J`` and ``(mu_c/h) I - J``, kept while ``J`` and ``h`` are unchanged."""
+        """LUs of ``I - gamma J`` for ``gamma = h/mu_r`` and ``h/mu_c`` (:func:`solve` turns them into solves with
+        ``(mu/h) I - J``), with the second-order structure eliminated (``n2``); kept while ``J`` and ``h`` are."""
         if self._lu is not None and self._lu[0] == h:
             return self._lu[1], self._lu[2]
-        J, n = self.J, self.system.n
-        if sp.issparse(J):
-            eye = sp.identity(n, format="csc")
-            Mr, Mc = (MU_REAL / h) * eye - J, (MU_COMPLEX / h) * eye - J.astype(complex)
-        else:
-            Mr, Mc = -J, -J.astype(complex)
-            Mr.flat[::n + 1] += MU_REAL / h
-            Mc.flat[::n + 1] += MU_COMPLEX / h
-        lus = LU(self.stats, Mr), LU(self.stats, Mc)
+        J, n2 = self.J, self.system.n2
+        lus = tuple(LU(self.stats, reduced_matrix(J, n2, g), n2, g, J[n2:, :n2])
+                    for g in (h / MU_REAL, h / MU_COMPLEX))
         self._lu = (h, *lus)
         return lus
 
@@ -127,8 +128,8 @@ class Radau5(Stepper):
             F = np.array([self.f(t + ci * h, x + zi) for ci, zi in zip(C, Z)])
             if not np.all(np.isfinite(F)):
                 return None
-            dr = lr.solve_y(F.T @ TI_REAL - mr * W[0])
-            dc = lc.solve_y(F.T @ TI_COMPLEX - mc * (W[1] + 1j * W[2]))
+            dr = solve(lr, F.T @ TI_REAL - mr * W[0])
+            dc = solve(lc, F.T @ TI_COMPLEX - mc * (W[1] + 1j * W[2]))
             dW = np.array([dr, dc.real, dc.imag])
             norm = float(np.sqrt(np.mean((dW / scale) ** 2)))
             if norm_old is not None:
@@ -166,11 +167,11 @@ class Radau5(Stepper):
         err = None
         if self.need_error:
             ZE = E @ Z / h
-            err = lr.solve_y(f0 + ZE)
+            err = solve(lr, f0 + ZE)
             if self._retry:
                 sc = atol + rtol * np.maximum(np.abs(x), np.abs(x1))
                 if np.sqrt(np.mean((err / sc) ** 2)) > 1:
-                    err = lr.solve_y(self.f(t, x + err) + ZE)
+                    err = solve(lr, self.f(t, x + err) + ZE)
         self._retry = True   # the next attempt without accept() follows a rejection
         self._pending = iters > 2 and rate is not None and rate > JAC_RATE
         Q = Z.T @ P
