@@ -10,8 +10,8 @@ the ``[v, z]`` block as in the other implicit methods, :mod:`cvtfem.integrate.li
   sqrt(rtol)))``) and gives up when the predicted error after the remaining iterations stays too large;
   it starts from the previous step's collocation polynomial.
 * The Jacobian is kept across steps and recomputed only after a solve that needed more than 2
-  iterations with a rate above 1e-3, or after a failed solve with an old Jacobian (then the same ``h``
-  is retried); LUs are kept while ``J`` and ``h`` are unchanged (the controller keeps ``h`` unless it
+  iterations with a rate above 1e-3, after a rejected step, or after a failed solve with an old Jacobian
+  (then the same ``h`` is retried); LUs are kept while ``J`` and ``h`` are unchanged (the controller keeps ``h`` unless it
   wants to grow it by 1.2 or more).
 * Error estimate of order 3, filtered by the real LU (``err = ((mu_r/h) I - J)^-1 (F0 + sum e_i Z_i/h)``),
   and refined once through ``F`` when it exceeds the tolerance on the first attempt or after a rejection
@@ -85,7 +85,8 @@ class Radau5(Stepper):
         self._stale = True        # recompute J at the next attempt
         self._lu: tuple[float, LU, LU] | None = None
         self._poly = None         # (t0, h, x0, Q) of the last accepted step: Newton's starting guess
-        self._retry = True        # refine the error estimate (first attempt, or after a rejection)
+        self._retry = True        # first attempt, or after a rejection: refine the estimate, refresh an old J
+        self._pending = False     # the last attempt's Newton solve was slow: new J after accepting it
 
     def tolerance_ratio(self, rtol: float) -> float:
         """``rtol_int / rtol = 0.1 rtol^(-1/3)`` (RADAU5's map, module docstring) or 1."""
@@ -119,7 +120,8 @@ class Radau5(Stepper):
         return (Q @ np.vstack([s, s * s, s ** 3])).T + (x0 - x)
 
     def _newton(self, t, x, h, Z, scale, tol, lr, lc):
-        """Simplified Newton on ``W = T^-1 Z``: ``(Z, F at the stages, iterations, rate)`` or None."""
+        """Simplified Newton on ``W = T^-1 Z``: ``(Z, iterations, last contraction rate or None)``, or None when it
+        diverges or would not converge within the iteration limit."""
         W = TI @ Z
         mr, mc = MU_REAL / h, MU_COMPLEX / h
         norm_old, rate = None, None
@@ -146,7 +148,7 @@ class Radau5(Stepper):
 
     def attempt(self, t, x, h):
         rtol, atol = self.tolerances or FIXED_STEP_TOL   # fixed steps: Newton to round-off
-        if self.J is None or self._stale:
+        if self.J is None or self._stale or (self._retry and not self._current):   # as RADAU5 after a rejection
             self._new_jacobian(t, x)
         f0 = self.f0(t, x)
         scale = atol + rtol * np.abs(x)
