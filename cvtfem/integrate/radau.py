@@ -3,8 +3,9 @@
 The collocation method at ``c = (4 - sqrt6)/10, (4 + sqrt6)/10, 1`` (Hairer-Wanner II §IV.8) in the
 stage increments ``Z_i = X_i - x0``; simplified Newton on the transformed unknowns ``W = T^-1 Z``, which
 splits the ``3n`` system into one real system ``(mu_r/h) I - J`` and one complex system
-``(mu_c/h) I - J`` (two LUs per step size and Jacobian; with second-order structure ``x = [u, v, z]`` both are reduced to
-the ``[v, z]`` block as in the other implicit methods, :mod:`cvtfem.integrate.linsolve`). Strategies, as RADAU5:
+``(mu_c/h) I - J`` (two LUs per step size and Jacobian; with second-order structure ``x = [u, v, z]`` and more than
+``DENSE_MAX`` states both are reduced to the ``[v, z]`` block as in the other implicit methods,
+:mod:`cvtfem.integrate.linsolve`; below, the full dense LU costs less than the reduction's bookkeeping). Strategies, as RADAU5:
 
 * Newton stops on the contraction rate in the error norm (tolerance ``max(10 eps/rtol, min(0.03,
   sqrt(rtol)))``) and gives up when the predicted error after the remaining iterations stays too large;
@@ -25,6 +26,8 @@ The constants are published figures (the transformation ``T`` and its inverse, t
 the inverse Radau IIA(5) matrix, the estimate's weights ``e``).
 """
 from __future__ import annotations
+
+import math
 
 import numpy as np
 import scipy.sparse as sp
@@ -58,6 +61,12 @@ NEWTON_MAXITER = 6
 FIXED_STEP_TOL, FIXED_STEP_MAXITER = (1e-12, 1e-12), 30
 #: a converged solve slower than this (rate) with more than 2 iterations asks for a new Jacobian
 JAC_RATE = 1e-3
+
+
+def rms(a: np.ndarray) -> float:
+    """Root mean square of the entries of ``a``."""
+    a = a.ravel()
+    return math.sqrt(float(a @ a) / a.size)
 
 
 def solve(lu: LU, r: np.ndarray) -> np.ndarray:
@@ -103,7 +112,7 @@ class Radau5(Stepper):
         ``(mu/h) I - J``), with the second-order structure eliminated (``n2``); kept while ``J`` and ``h`` are."""
         if self._lu is not None and self._lu[0] == h:
             return self._lu[1], self._lu[2]
-        J, n2 = self.J, self.system.n2
+        J, n2 = self.J, (self.system.n2 if self.system.n > DENSE_MAX else 0)   # small: the full LU is cheaper
         lus = tuple(LU(self.stats, reduced_matrix(J, n2, g), n2, g, J[n2:, :n2])
                     for g in (h / MU_REAL, h / MU_COMPLEX))
         self._lu = (h, *lus)
@@ -133,7 +142,7 @@ class Radau5(Stepper):
             dr = solve(lr, F.T @ TI_REAL - mr * W[0])
             dc = solve(lc, F.T @ TI_COMPLEX - mc * (W[1] + 1j * W[2]))
             dW = np.array([dr, dc.real, dc.imag])
-            norm = float(np.sqrt(np.mean((dW / scale) ** 2)))
+            norm = rms(dW / scale)
             if norm_old is not None:
                 rate = norm / norm_old
                 if rate >= 1 or rate ** (maxiter - k) / (1 - rate) * norm > tol:
@@ -172,7 +181,7 @@ class Radau5(Stepper):
             err = solve(lr, f0 + ZE)
             if self._retry:
                 sc = atol + rtol * np.maximum(np.abs(x), np.abs(x1))
-                if np.sqrt(np.mean((err / sc) ** 2)) > 1:
+                if rms(err / sc) > 1:
                     err = solve(lr, self.f(t, x + err) + ZE)
         self._retry = True   # the next attempt without accept() follows a rejection
         self._pending = iters > 2 and rate is not None and rate > JAC_RATE
