@@ -3,9 +3,9 @@
 Problems: HIRES (t = 321.8122, published reference), Van der Pol with eps = 1e-6 (t = 2) and Robertson
 (t = 1e5), the last two against scipy Radau at rtol 1e-12. Error: max over components of
 ``|y - y_ref| / |y_ref|`` at the end time. Each method runs a sweep of rtols (atol a fixed fraction of
-rtol, per problem); wall time is the median of ``--repeats`` runs; the time at errors 1e-4/1e-6/1e-8 is
-interpolated log-log between neighbouring sweep points (``-`` when the sweep does not bracket it); a
-sweep stops at the first error below 1e-8.
+rtol, per problem); wall time is the median of ``--repeats`` runs, interleaved between the methods; the
+time at errors 1e-4/1e-6/1e-8 is interpolated log-log between neighbouring sweep points (``-`` when the
+sweep does not bracket it); a sweep stops at the first error below 1e-8.
 Analytic Jacobians everywhere. Prints a table and the ratio best cvtfem method / Radau.
 
 Run: ``.venv/bin/python studies/integrators/bench_vs_radau.py [--repeats 3] [--methods radau5,rodas4:...]``
@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
+import statistics
 
 import numpy as np
 
@@ -45,6 +46,27 @@ def time_at(rows, target):
     return None
 
 
+def sweeps(p, methods, atol_factor, repeats):
+    """``{method: rows}`` along the rtol sweep, each method down to its first error below the smallest target.
+    Interleaved: at each rtol every method still sweeping runs once per round, ``repeats`` rounds, so a change
+    of the machine's load hits all methods alike (the median is over the rounds)."""
+    specs = {m: parse_method(m) for m in methods}
+    rows = {m: [] for m in methods}
+    active = list(methods)
+    for r in RTOLS:
+        runs = {m: [] for m in active}
+        for _ in range(repeats):
+            for m in active:
+                _, method, opts = specs[m]
+                runs[m] += work_precision(p, [(m, method, {**opts, "rtol": r, "atol": atol_factor * r})], repeats=1)
+        for m in active:
+            rows[m].append({**runs[m][-1], "time": statistics.median(row["time"] for row in runs[m])})
+        active = [m for m in active if rows[m][-1]["error"] >= min(TARGETS)]
+        if not active:
+            break
+    return rows
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeats", type=int, default=3)
@@ -58,16 +80,10 @@ def main() -> None:
     print(f"median of {args.repeats} runs; {machine()}")
     print(f"{'problem':10s} {'method':18s} " + " ".join(f"t@{e:.0e}".rjust(10) for e in TARGETS))
     for name, p in problems.items():
+        rows = sweeps(p, methods, ATOL[name], args.repeats)
         best = {}
         for m in methods:
-            rows = []
-            for r in RTOLS:   # down to the first error below the smallest target
-                label, method, opts = parse_method(m)
-                rows += work_precision(p, [(label, method, {**opts, "rtol": r, "atol": ATOL[name] * r})],
-                                       repeats=args.repeats)
-                if rows[-1]["error"] < min(TARGETS):
-                    break
-            times = [time_at(rows, e) for e in TARGETS]
+            times = [time_at(rows[m], e) for e in TARGETS]
             print(f"{name:10s} {m:18s} " + " ".join(("-" if t is None else f"{t:.3f} s").rjust(10) for t in times),
                   flush=True)
             for e, t in zip(TARGETS, times):
