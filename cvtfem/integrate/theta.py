@@ -126,7 +126,7 @@ class Theta(Stepper):
         self._prev = None if prev_h is None else (prev_h, np.array(state["prev_f"]))
         n = self.system.n
         self._hist = [(float(tk), np.array(state["hist_x"][k * n:(k + 1) * n]))
-                      for k, tk in enumerate(state["hist_t"]) if np.isfinite(tk)]
+                      for k, tk in enumerate(state.get("hist_t", ())) if np.isfinite(tk)]   # absent: older checkpoints
         super().restore(state, t, x)
         self.newton.invalidate()
         if state["lu_valid"][0] == 1.0 and self.J is not None and self._gamma is not None:
