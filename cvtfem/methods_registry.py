@@ -26,6 +26,7 @@ _SPECS: dict[str, object] = {
     "w1-extrapolation": "cvtfem.integrate.wmethods:W1Extrapolation",
     "rodas4": "cvtfem.integrate.rosenbrock:Rodas4",
     "rodas5p": "cvtfem.integrate.rosenbrock:Rodas5P",
+    "radau5": "cvtfem.integrate.radau:Radau5",
     "theta": "cvtfem.integrate.theta:Theta",
     "trapezoidal": "cvtfem.integrate.theta:Trapezoidal",
     "implicit-euler": "cvtfem.integrate.theta:ImplicitEuler",

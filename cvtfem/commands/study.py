@@ -75,7 +75,7 @@ def _scene_args(p) -> None:
 
 
 def parse_method(spec: str) -> tuple[str, str, dict]:
-    """``"gbs:stages=2"`` -> ``("gbs:stages=2", "gbs", {"stages": 2})``."""
+    """``"gbs:stages=2"`` -> ``("gbs:stages=2", "gbs", {"stages": 2})``; ``true``/``false`` become booleans."""
     from cvtfem.errors import InputError
 
     import inspect
@@ -97,7 +97,7 @@ def parse_method(spec: str) -> tuple[str, str, dict]:
             except ValueError:
                 continue
         else:
-            opts[key] = val
+            opts[key] = {"true": True, "false": False}.get(val.lower(), val)
     return spec.strip(), name, opts
 
 

@@ -14,12 +14,14 @@ import numpy as np
 
 from cvtfem.errors import InputError
 
-__all__ = ["FixedStep", "SimpleController", "PIController", "PredictiveController", "CONTROLLERS", "make_controller", "error_norm",
+__all__ = ["CONTROLLER_MEMORY", "FixedStep", "SimpleController", "PIController", "PredictiveController", "CONTROLLERS", "make_controller", "error_norm",
            "step_floor"]
 
 SAFETY = 0.9
 MIN_FACTOR = 0.2
 MAX_FACTOR = 5.0
+#: what an error-based controller remembers between steps (a run's memory: checkpoints restore it)
+CONTROLLER_MEMORY = ("rejected", "err_prev", "h_acc", "err_acc")
 #: step-size floor in units of the spacing of doubles at the current time (scipy uses 10)
 FLOOR_ULPS = 16
 
@@ -45,6 +47,13 @@ class FixedStep:
 
     def propose(self, h: float, err_norm: float | None, q: int | None) -> tuple[bool, float]:
         return True, self.h
+
+    def memory(self) -> np.ndarray:
+        """Nothing to remember (NaN in each :data:`CONTROLLER_MEMORY` slot)."""
+        return np.full(len(CONTROLLER_MEMORY), np.nan)
+
+    def restore(self, memory: np.ndarray) -> None:
+        """Nothing to restore."""
 
 
 @dataclass
@@ -81,6 +90,16 @@ class SimpleController:
 
     def accepted(self, err_norm: float) -> None:
         """Hook: an attempt with error ``err_norm`` was accepted."""
+
+    def memory(self) -> np.ndarray:
+        """The :data:`CONTROLLER_MEMORY` values this controller has (NaN for the others)."""
+        return np.array([float(getattr(self, k, np.nan)) for k in CONTROLLER_MEMORY])
+
+    def restore(self, memory: np.ndarray) -> None:
+        """Continue from :meth:`memory` (a checkpoint)."""
+        for k, v in zip(CONTROLLER_MEMORY, memory):
+            if hasattr(self, k) and not np.isnan(v):
+                setattr(self, k, bool(v) if k == "rejected" else float(v))
 
 
 @dataclass

@@ -101,7 +101,7 @@ def solve(fun, t_span, y0, method: str = "dopri45", h: float | None = None, rtol
         Step-size controller of native adaptive runs: ``"i"`` (elementary), ``"pi"`` (proportional-
         integral, smoother step sequences at a stability limit) or ``"predictive"`` (Gustafsson, shrinks
         ``h`` when the error grows from step to step); None: the method's default (``"predictive"``
-        for ``rodas4``, else ``"i"``). All take no growth right after a rejection.
+        for ``rodas4``, ``rodas5p`` and ``radau5``, else ``"i"``). All take no growth right after a rejection.
     **options : method options (``d``, ``alpha``, ``newton``, ``stages``, ``sequence`` ...);
         an option the method ignores warns with :class:`IgnoredOptionWarning`.
     """

@@ -18,7 +18,7 @@ import numpy as np
 
 from cvtfem.errors import InputError, NumericalError
 from cvtfem.integrate.base import Attempt, StepFailure, hermite
-from cvtfem.integrate.controller import FixedStep, error_norm, make_controller, step_floor
+from cvtfem.integrate.controller import CONTROLLER_MEMORY, FixedStep, error_norm, make_controller, step_floor
 from cvtfem.integrate.events import EVENT_SAMPLES, EventLocator
 from cvtfem.integrate.guards import ErrorMonitor, GrowthGuard
 from cvtfem.integrate.methods import METHODS, SCIPY_METHODS, check_options
@@ -186,13 +186,16 @@ class NativeEngine:
         self.stats.counts.update(counts)
 
     def memory_fields(self) -> tuple[tuple[str, int], ...]:
-        return self.stepper.memory_fields()
+        """The method's memory and the step-size controller's."""
+        return self.stepper.memory_fields() + (("controller", len(CONTROLLER_MEMORY)),)
 
     def state(self, t: float, x: np.ndarray) -> dict[str, np.ndarray]:
-        return self.stepper.state(t, x)
+        return {**self.stepper.state(t, x), "controller": self.ctrl.memory()}
 
     def restore(self, state: dict[str, np.ndarray], t: float, x: np.ndarray) -> None:
         self.stepper.restore(state, t, x)
+        if "controller" in state:   # absent in checkpoints written before it was kept
+            self.ctrl.restore(state["controller"])
 
     def report(self) -> dict:
         """Extra stats (the local-error monitor of fixed steps, when active)."""
@@ -411,4 +414,4 @@ def memory_fields(method: str, n: int, n2: int = 0, jac_sparsity=None) -> tuple[
 
         return scipy_fields(method, n, jac_sparsity)
     system = OdeSystem(fun=lambda t, x: x, n=n, n2=n2, jac_sparsity=jac_sparsity)
-    return METHODS[method](system, Stats()).memory_fields()
+    return METHODS[method](system, Stats()).memory_fields() + (("controller", len(CONTROLLER_MEMORY)),)

@@ -17,9 +17,13 @@ the trapezoidal rule does not damp stiff components (R(-inf) = -1), so a Newton 
 rings on (band-6+2n 1 s, rtol 1e-3, Euler predictor: kappa 0.03 gave 2483 steps, 1e-3 389); fixed-step runs and
 ``newton_stop="source"`` use the source's line search and stopping rule (2.21)-(2.23).
 
-Error estimate (ours): the trapezoidal rule's local error ``-h^3 y'''/12`` with ``y'''``
-from the divided difference of ``F`` over the last two steps; other alpha use
-``|alpha - 1/2| h (F1 - F0)``; both are filtered by the LU of ``I - h alpha J`` (Shampine).
+Error estimate (ours): the trapezoidal rule's local error ``h^3 x'''/12`` with ``x'''`` from the third
+divided difference of the states at the last four points ``t_{n-2} ... t_{n+1}`` (the step before: from the
+divided difference of ``F`` over two steps; the first step: first order). Not from ``F``: the rule is not
+L-stable, so a stiff component's deviation from its slow manifold alternates in sign undamped, and ``F`` of
+the components coupled to it carries that alternation (Robertson: ``1e4 y2`` in ``y1'``), which the rule
+itself cancels in ``(F_n + F_{n+1})/2`` but an estimate from ``F`` does not (h/t fell to 1e-3 on Robertson).
+Other alpha use ``|alpha - 1/2| h (F1 - F0)``; all are filtered by the LU of ``I - h alpha J`` (Shampine).
 
 Tolerance proportionality (adaptive trapezoidal rule, option ``proportional``, default on): with the
 local error held at the tolerance an order-2 method's global error falls only like ``tol^(2/3)``
@@ -82,9 +86,11 @@ class Theta(Stepper):
         self.J = None
         self._gamma = None
         self._prev = None   # (h_prev, F at previous step start)
+        self._hist: list[tuple[float, np.ndarray]] = []   # (t, x) at the two previous step starts
 
     def reset(self) -> None:
         self._prev = None
+        self._hist = []
 
     def _slot(self) -> MatrixSlot:
         return MatrixSlot.for_pattern("J", self.system.n, self.system.jac_sparsity)
@@ -94,14 +100,18 @@ class Theta(Stepper):
         (error estimate), the Jacobian, ``F`` at the current point, and the Newton solver's memory
         (Jacobian marked stale, contraction estimate of the last solve)."""
         n = self.system.n
-        return (("gamma", 1), ("lu_valid", 1), ("prev_h", 1), ("prev_f", n)) + self._slot().fields() + \
+        return (("gamma", 1), ("lu_valid", 1), ("prev_h", 1), ("prev_f", n), ("hist_t", 2), ("hist_x", 2 * n)) + \
+            self._slot().fields() + \
             super().memory_fields() + (("newton_stale", 1), ("newton_eta", 1))
 
     def state(self, t, x):
         n, prev = self.system.n, self._prev
         return {"gamma": scalar(self._gamma), "lu_valid": scalar(self.newton.B is not None),
                 "prev_h": scalar(None if prev is None else prev[0]),
-                "prev_f": vector(None if prev is None else prev[1], n), **self._slot().pack(self.J),
+                "prev_f": vector(None if prev is None else prev[1], n),
+                "hist_t": np.array([h[0] for h in self._hist] + [np.nan] * (2 - len(self._hist))),
+                "hist_x": np.concatenate([h[1] for h in self._hist] + [np.full(n, np.nan)] * (2 - len(self._hist))),
+                **self._slot().pack(self.J),
                 **super().state(t, x), "newton_stale": scalar(self.newton.stale),
                 "newton_eta": scalar(self.newton._eta)}
 
@@ -114,6 +124,9 @@ class Theta(Stepper):
         self._gamma = opt_scalar(state["gamma"])
         prev_h = opt_scalar(state["prev_h"])
         self._prev = None if prev_h is None else (prev_h, np.array(state["prev_f"]))
+        n = self.system.n
+        self._hist = [(float(tk), np.array(state["hist_x"][k * n:(k + 1) * n]))
+                      for k, tk in enumerate(state.get("hist_t", ())) if np.isfinite(tk)]   # absent: older checkpoints
         super().restore(state, t, x)
         self.newton.invalidate()
         if state["lu_valid"][0] == 1.0 and self.J is not None and self._gamma is not None:
@@ -123,6 +136,7 @@ class Theta(Stepper):
     def accept(self, att: Attempt) -> None:
         super().accept(att)
         self._prev = (att.h, att.f0)
+        self._hist = (self._hist + [(att.t0, att.x0)])[-2:]
 
     def tolerance_ratio(self, rtol: float) -> float:
         """``rtol_int / rtol``: the trapezoidal rule keeps its global error proportional to rtol
@@ -180,11 +194,17 @@ class Theta(Stepper):
             y1, _ = self.newton.solve(residual, x_pred[n2:], make_matrix, eps, scale, kappa)
             x1 = self._state(y1, t, x, f0, h)
             f1 = self.f(t1, x1)
-        err = self._error(h, f0, f1) if self.need_error else None
+        err = self._error(t, x, h, x1, f0, f1) if self.need_error else None
         return Attempt(t, x, h, x1, err, f0, f1)
 
-    def _error(self, h, f0, f1):
-        if self.alpha == 0.5 and self._prev is not None:
+    def _error(self, t, x, h, x1, f0, f1):
+        if self.alpha == 0.5 and len(self._hist) == 2:   # from the states: see the module docstring
+            ts = [self._hist[0][0], self._hist[1][0], t, t + h]
+            dd = [self._hist[0][1], self._hist[1][1], x, x1]
+            for k in range(1, 4):
+                dd = [(dd[i + 1] - dd[i]) / (ts[i + k] - ts[i]) for i in range(len(dd) - 1)]
+            est = (h ** 3 / 2) * dd[0]   # h^3 x'''/12, x''' = 6 x[t_{n-2}, ..., t_{n+1}]
+        elif self.alpha == 0.5 and self._prev is not None:
             hp, fp = self._prev
             dd = ((f1 - f0) / h - (f0 - fp) / hp) / (h + hp)   # divided difference = x'''/2
             est = (h ** 3 / 6) * dd

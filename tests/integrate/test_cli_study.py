@@ -36,3 +36,11 @@ def test_study_bad_input_exits_2(capsys):
     assert "`--problem`" in capsys.readouterr().err
     assert main(["study", "work", "--problem", "oscillator", "--methods", "rk4", "--rtols", "1e-6"]) == 2
     assert "`method`" in capsys.readouterr().err      # rk4 has no error estimate
+
+
+def test_method_spec_booleans():
+    """``proportional=false`` reaches the method as a boolean (it used to arrive as the string 'false')."""
+    from cvtfem.commands.study import parse_method
+
+    assert parse_method("radau5:proportional=false") == ("radau5:proportional=false", "radau5", {"proportional": False})
+    assert parse_method("sw24:proportional=True:d=0.5")[2] == {"proportional": True, "d": 0.5}

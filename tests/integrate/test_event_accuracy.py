@@ -25,7 +25,7 @@ def oscillator_events(method, rtol):
 @pytest.mark.parametrize("method, rtol", [("dopri45", 1e-6), ("dopri56", 1e-8), ("dopri78", 1e-10),
                                           ("dopri78", 1e-6), ("gbs", 1e-8), ("gbs-smooth", 1e-10),
                                           ("euler-extrapolation", 1e-6), ("w1-extrapolation", 1e-6),
-                                          ("rodas4", 1e-8), ("rodas5p", 1e-10), ("trapezoidal", 1e-4),
+                                          ("rodas4", 1e-8), ("rodas5p", 1e-10), ("radau5", 1e-8), ("trapezoidal", 1e-4),
                                           ("sw24", 1e-4), ("dumka3", 1e-6)])
 def test_zeros_of_cos_within_10_rtol(method, rtol):
     te = oscillator_events(method, rtol)
