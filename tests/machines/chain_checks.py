@@ -33,3 +33,43 @@ def assert_energy_balance(model, x0, t_end: float) -> None:
     W = model.split(x1)[3]
     assert W[0] > 1.0 and W[2] > 0.0
     assert model.energy(x1) - model.energy(x0) == pytest.approx(W[0] - W[1] + W[3] - W[2], abs=1e-6 * W[0])
+
+
+def perturbed(model, x0, seed: int = 0, scale=None):
+    """A running state of a rigid-shaft chain CVT off balance: random chain offsets (2 um, times ``scale`` per chain
+    coordinate) and velocities (0.05 m/s), and random shaft and sheave rates."""
+    rng = np.random.default_rng(seed)
+    x = x0.copy()
+    nc, n2 = model.family.size, model.n2
+    scale = np.ones(nc) if scale is None else scale
+    x[:nc] += rng.normal(0.0, 2e-6, nc) * scale
+    x[n2:n2 + nc] += rng.normal(0.0, 0.05, nc) * scale
+    x[n2 + nc:n2 + nc + 4] += rng.normal(0.0, 0.05, 4)
+    return x
+
+
+def band_reference(scene):
+    """The 6+2n band model of ``scene`` run 1 s into its stationary regime: the clamping forces (2,) N it settles at
+    and its tight and slack span tensions (2,) N (:func:`~cvtfem.machines.chain_cvt.band_span_tensions`)."""
+    from cvtfem.machines import build_model
+    from cvtfem.machines.chain_cvt import band_span_tensions
+
+    band = build_model(scene)
+    rb = solve(band, (0.0, 1.0), band.initial_state(), method="Radau", rtol=1e-6, atol=1e-8, n2=band.n2,
+               jac=band.jac, jac_sparsity=band.jac_sparsity)
+    xb = rb.y[:, -1]
+    ob = band.outputs(1.0, xb)
+    return np.array([ob["driving.clamping_force"], ob["driven.clamping_force"]]), band_span_tensions(band, xb)
+
+
+def stationary_means(model, x0, t_end: float = 10e-3, window: float = 6e-3):
+    """Means over the last ``window`` s of a Radau run (rtol 1e-3) to ``t_end`` sampled every 25 us: span tensions
+    (tight, slack), sheave axial forces and clamping forces (driving, driven), N."""
+    res = solve(model, (0.0, t_end), x0, method="Radau", rtol=1e-3, atol=1e-6, n2=model.n2, jac=model.jac,
+                jac_sparsity=model.jac_sparsity, t_eval=np.linspace(t_end - window, t_end, int(window / 25e-6) + 1))
+    assert res.status == 0
+    outs = [model.outputs(t, y) for t, y in zip(res.t, res.y.T)]
+    T = np.nanmean([o["chain.span_tension"] for o in outs], axis=0)
+    axial = np.mean([o["contact.sheave_axial_force"] for o in outs], axis=0)
+    clamp = np.mean([[o["driving.clamping_force"], o["driven.clamping_force"]] for o in outs], axis=0)
+    return T, axial, clamp

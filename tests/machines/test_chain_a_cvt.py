@@ -11,7 +11,7 @@ from cvtfem.errors import InputError
 from cvtfem.machines.chain_a_cvt import ChainACVT
 from cvtfem.machines.chain_cvt import from_scene
 from cvtfem.scene.loader import load_scene
-from tests.machines.chain_checks import assert_energy_balance, assert_jacobian_columns
+from tests.machines.chain_checks import assert_energy_balance, assert_jacobian_columns, perturbed
 
 RATIO = 2.4
 F_APPL = np.array([30000.0, 35000.0])   # N per sheave, as the S2 tests
@@ -30,17 +30,6 @@ def model(scene):
 @pytest.fixture(scope="module")
 def static(model, scene):
     return model.static_state(RATIO, scene.cvt.regime.input_speed)
-
-
-def _perturbed(model, x0, seed=0):
-    """A running state off balance: random chain offsets and velocities, sheave and shaft rates."""
-    rng = np.random.default_rng(seed)
-    x = x0.copy()
-    nc, n2 = model.family.size, model.n2
-    x[:nc] += rng.normal(0.0, 2e-6, nc)
-    x[n2:n2 + nc] += rng.normal(0.0, 0.05, nc)
-    x[n2 + nc:n2 + nc + 4] += rng.normal(0.0, 0.05, 4)
-    return x
 
 
 def test_model_protocol(model):
@@ -92,7 +81,7 @@ def _contact_forces(model, q, v):
 def test_contact_forces_are_minus_the_gradient_of_the_hertz_potential(model, static):
     """Through the contact map (ends u_0 -+ u_1, w_0 -+ w_1 mirrored, movable or fixed sheave): the generalized
     normal forces on the chain and sheave coordinates equal minus the gradient of the summed Hertz potentials."""
-    q = _perturbed(model, static[0])[:model.n2]
+    q = perturbed(model, static[0])[:model.n2]
     v = np.zeros(model.n2)
     Q, _ = _contact_forces(model, q, v)
 
@@ -115,7 +104,7 @@ def test_contact_forces_are_minus_the_gradient_of_the_hertz_potential(model, sta
 
 
 def test_friction_power_is_the_work_rate_of_the_friction_forces(model, static):
-    x = _perturbed(model, static[0], seed=1)
+    x = perturbed(model, static[0], seed=1)
     q, v = x[:model.n2], x[model.n2:2 * model.n2]
     Q, Pf = _contact_forces(model, q, v)
     frictionless = replace(model, contact=EndContact(replace(model.contact.pair, f0=0.0)))
@@ -125,7 +114,7 @@ def test_friction_power_is_the_work_rate_of_the_friction_forces(model, static):
 
 
 def test_jacobian_against_differences_and_on_its_pattern(model, static):
-    x = _perturbed(model, static[0], seed=2)
+    x = perturbed(model, static[0], seed=2)
     J = model.jac(0.0, x).toarray()
     assert not np.any(J[~model.jac_sparsity.toarray()])
     rng = np.random.default_rng(5)

@@ -9,10 +9,10 @@ from cvtfem.elements.chain.geometry import reference_geometry
 from cvtfem.elements.chain.placement import place_on_path
 from cvtfem.elements.contact.hertz import hertz_potential
 from cvtfem.errors import InputError
-from cvtfem.integrate import solve
-from cvtfem.machines.chain_cvt import ChainCVT, band_span_tensions, from_scene
+from cvtfem.machines.chain_cvt import ChainCVT, from_scene
 from cvtfem.scene.loader import load_scene
-from tests.machines.chain_checks import assert_energy_balance, assert_jacobian_columns
+from tests.machines.chain_checks import (assert_energy_balance, assert_jacobian_columns, band_reference, perturbed,
+                                         stationary_means)
 
 RATIO = 2.4
 F_APPL = np.array([30000.0, 35000.0])   # N per sheave, inputs of the quasi-static tests
@@ -78,20 +78,9 @@ def test_static_state_balances_and_wedge_tension(model, static, scene):
     assert np.all(o["contact.slip_speed"] < 1e-12) and o["contact.friction_power"] == pytest.approx([0, 0], abs=1e-9)
 
 
-def _perturbed(model, x0, seed=0):
-    """A running state off balance: random pin velocities and small position offsets."""
-    rng = np.random.default_rng(seed)
-    x = x0.copy()
-    nc, n2 = model.family.size, model.n2
-    x[:nc] += rng.normal(0.0, 2e-6, nc)
-    x[n2:n2 + nc] += rng.normal(0.0, 0.05, nc)
-    x[n2 + nc:n2 + nc + 4] += rng.normal(0.0, 0.05, 4)
-    return x
-
-
 def test_contact_forces_are_minus_the_hertz_gradient(model, static):
     x0, _ = static
-    q = _perturbed(model, x0)[:model.n2]
+    q = perturbed(model, x0)[:model.n2]
     v = np.zeros(model.n2)                       # no slip: normal forces only
     pins, shafts, X, Y = model._contacts(q, v)
     on = model.contact.local(X, shafts, details=True)[1]["delta"] > 0
@@ -111,7 +100,7 @@ def test_contact_forces_are_minus_the_hertz_gradient(model, static):
 
 
 def test_friction_power_is_the_work_of_the_friction_forces(model, static):
-    x = _perturbed(model, static[0], seed=1)
+    x = perturbed(model, static[0], seed=1)
     q, v = x[:model.n2], x[model.n2:2 * model.n2]
     pins, shafts, X, Y = model._contacts(q, v)
     Y0 = replace(model.contact, f0=0.0).local(X, shafts)
@@ -124,7 +113,7 @@ def test_friction_power_is_the_work_of_the_friction_forces(model, static):
 
 
 def test_jacobian_against_differences_and_on_its_pattern(model, static):
-    x = _perturbed(model, static[0], seed=2)
+    x = perturbed(model, static[0], seed=2)
     J = model.jac(0.0, x).toarray()
     pattern = model.jac_sparsity.toarray()
     assert not np.any(J[~pattern])
@@ -145,25 +134,10 @@ def test_energy_balance_over_a_short_run(model, static):
 def test_stationary_regime_against_the_band_model(scene):
     """Acceptance of issue 13: 3500 rpm, 200 N m, ratio 2.4, the chain from its quasi-static state with the
     band model's stationary clamping forces, 10 ms (means over the last 6 ms, every 25 us)."""
-    from cvtfem.machines import build_model
-
-    band = build_model(scene)
-    rb = solve(band, (0.0, 1.0), band.initial_state(), method="Radau", rtol=1e-6, atol=1e-8, n2=band.n2,
-               jac=band.jac, jac_sparsity=band.jac_sparsity)
-    xb = rb.y[:, -1]
-    ob = band.outputs(1.0, xb)
-    F = np.array([ob["driving.clamping_force"], ob["driven.clamping_force"]])
-    T_band = band_span_tensions(band, xb)
+    F, T_band = band_reference(scene)
     m = from_scene(scene, reference_geometry(), F)
     x0, rep = m.static_state(RATIO, scene.cvt.regime.input_speed)
-    t_end, window = 10e-3, 6e-3
-    res = solve(m, (0.0, t_end), x0, method="Radau", rtol=1e-3, atol=1e-6, n2=m.n2, jac=m.jac,
-                jac_sparsity=m.jac_sparsity, t_eval=np.linspace(t_end - window, t_end, 241))
-    assert res.status == 0
-    outs = [m.outputs(t, y) for t, y in zip(res.t, res.y.T)]
-    T = np.nanmean([o["chain.span_tension"] for o in outs], axis=0)
-    axial = np.mean([o["contact.sheave_axial_force"] for o in outs], axis=0)
-    clamp = np.mean([[o["driving.clamping_force"], o["driven.clamping_force"]] for o in outs], axis=0)
+    T, axial, clamp = stationary_means(m, x0)
     print(f"band: tight {T_band[0]:.0f} N, slack {T_band[1]:.0f} N; chain: tight {T[0]:.0f} N, slack {T[1]:.0f} N; "
           f"axial/clamping {axial / clamp}")
     np.testing.assert_allclose(axial, clamp, rtol=0.01)
@@ -171,7 +145,7 @@ def test_stationary_regime_against_the_band_model(scene):
 
 
 def test_closed_forms_equal_the_contact_primitives(model, static):
-    x = _perturbed(model, static[0], seed=4)
+    x = perturbed(model, static[0], seed=4)
     pins, shafts, X, Y = model._contacts(x[:model.n2], x[model.n2:2 * model.n2])
     Y_ref = model.contact.local(X, shafts, reference=True)
     assert np.all(np.abs(Y - Y_ref) <= 1e-12 * np.abs(Y_ref).max(axis=0))   # per output, of its scale
@@ -184,7 +158,7 @@ def test_s3_chain_on_the_sheaves(scene):
     assert rep["residual"] < 1e-8
     o = m.outputs(0.0, x0)
     np.testing.assert_allclose(o["contact.sheave_axial_force"], [rep["F1"], F_APPL[1]], rtol=1e-8)
-    x = _perturbed(m, x0, seed=6)
+    x = perturbed(m, x0, seed=6)
     J = m.jac(0.0, x)
     assert not np.any(J.toarray()[~m.jac_sparsity.toarray()])
     n2, nc = m.n2, m.family.size
