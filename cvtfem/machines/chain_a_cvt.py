@@ -200,7 +200,7 @@ class ChainACVT(ChainCVT):
         the end's side; the sheave on that side is the movable one (``z_k``) or the fixed one (a constant)."""
         _, iphi, iz, _ = self._idx
         n2, m = self.n2, len(ends)
-        d = self.family.dof_index[ends // 2]
+        d = self._end_dofs(ends)
         side = np.where(ends % 2 == 1, 1.0, -1.0)
         one = np.ones(m)
         movable = np.asarray(self.movable_side)[shafts] == side
@@ -217,6 +217,10 @@ class ChainACVT(ChainCVT):
             cols[:, j] = c[:, None]
             coef[:, j, 0] = 1.0
         return cols, coef
+
+    def _end_dofs(self, ends):
+        """``(m, 10)`` coordinate positions (A1 order) of the pin (or pin half) carrying each end."""
+        return self.family.dof_index[ends // 2]
 
     def _sheave_outputs(self, ends, shafts, c) -> dict[str, np.ndarray]:
         movable = np.asarray(self.movable_side)[shafts] == np.where(ends % 2 == 1, 1, -1)
