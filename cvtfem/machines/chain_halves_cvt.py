@@ -22,7 +22,7 @@ import scipy.sparse.linalg as spla
 from cvtfem.elements.base import Block
 from cvtfem.elements.chain.halves import ChainA5
 from cvtfem.elements.chain.placement import place_on_path
-from cvtfem.errors import InputError
+from cvtfem.errors import InputError, NumericalError
 from cvtfem.machines.chain_a_cvt import PLATE_HEIGHT, PLATE_THICKNESS, POISSON, ChainACVT
 from cvtfem.outputs import OutputSpec
 
@@ -264,6 +264,15 @@ class ChainHalvesCVT(ChainACVT):
         for k in range(2):
             self._turn_with_sheave(q[:nc], v[:nc], np.flatnonzero(pl.piece == k), v[iphi[k]], self.contact.centres[k])
         return np.concatenate([q, v, self.control.initial_state(*v[iphi]), np.zeros(4)])
+
+    def start(self):
+        """``(x0, report)``: the quasi-static state of :meth:`static_state`, or, where its solve stalls (it does at the
+        reference operating point: docs/chain.md), :meth:`placed_state`, off balance, with the stall in ``kind``."""
+        try:
+            return super().start()
+        except NumericalError as err:
+            w1, _, i = self.regime.targets(0.0)
+            return self.placed_state(i, w1), {"kind": f"placed on the sheaves, off balance ({err})"}
 
     def _solve_balance(self, residual, jacobian, y0, tol: float):
         """Damped Newton on the sparse Jacobian (scipy ``splu``): step ``-(J - mu S)^-1 r`` with ``S`` the Jacobian's
