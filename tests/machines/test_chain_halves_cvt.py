@@ -11,7 +11,7 @@ from cvtfem.errors import InputError
 from cvtfem.machines.chain_cvt import from_scene
 from cvtfem.machines.chain_halves_cvt import ChainHalvesCVT, HalvesFamily
 from cvtfem.scene.loader import load_scene
-from tests.machines.chain_checks import assert_energy_balance, assert_jacobian_columns
+from tests.machines.chain_checks import assert_jacobian_columns
 
 RATIO = 2.4
 F_APPL = np.array([30000.0, 35000.0])   # N per sheave, as the S2 and A1 tests
@@ -172,8 +172,17 @@ def test_jacobian_against_differences_and_on_its_pattern(model, placed):
 @pytest.mark.slow
 def test_energy_balance_over_a_short_run(model, placed):
     """From the placed state (off balance: the chain settles on the sheaves), 2 us of Radau: the work integrals,
-    with the chain's internal friction and damping in the dissipated work, close the energy balance."""
-    assert_energy_balance(model, placed, 2e-6)
+    with the chain's internal friction and damping in the dissipated work, close the energy balance to 1e-6 of the
+    input work (``assert_energy_balance`` without its 1 J floor: 2 us put in about 0.15 J)."""
+    from cvtfem.integrate import solve
+
+    res = solve(model, (0.0, 2e-6), placed, method="Radau", rtol=1e-6, atol=1e-9, n2=model.n2, jac=model.jac,
+                jac_sparsity=model.jac_sparsity)
+    assert res.status == 0
+    x1 = res.y[:, -1]
+    W = model.split(x1)[3]
+    assert W[0] > 0.05 and W[2] > 0.01 * W[0]
+    assert model.energy(x1) - model.energy(placed) == pytest.approx(W[0] - W[1] + W[3] - W[2], abs=1e-6 * W[0])
 
 
 def test_scene_path_builds_a5_and_describes_its_outputs_once():
