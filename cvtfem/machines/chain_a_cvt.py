@@ -220,7 +220,7 @@ class ChainACVT(ChainCVT):
         H2 (:meth:`_refined_positions`) reads the end slope and the neighbours too."""
         _, iphi, iz, _ = self._idx
         n2, m = self.n2, len(ends)
-        d = self.family.dof_index[self.pin_of(ends)]
+        d = self._end_dofs(ends)
         side = np.where(ends % 2 == 1, 1.0, -1.0)
         one = np.ones(m)
         movable = np.asarray(self.movable_side)[shafts] == side
@@ -272,6 +272,10 @@ class ChainACVT(ChainCVT):
 
     def _extra_approach(self, k, r):
         return self.contact.extra_approach(k, r)
+
+    def _end_dofs(self, ends):
+        """``(m, 10)`` coordinate positions (A1 order) of the pin (or pin half) carrying each end."""
+        return self.family.dof_index[self.pin_of(ends)]
 
     def _sheave_outputs(self, ends, shafts, c) -> dict[str, np.ndarray]:
         movable = np.asarray(self.movable_side)[shafts] == np.where(ends % 2 == 1, 1, -1)

@@ -466,7 +466,7 @@ class ChainCVT(ModelBase):
         wedge estimate (tension ``T = F2 tan(g2) / theta2*``, per-pin axial forces ``T L / (2 r tan g)``, pin
         compression) and the sheave positions ``z`` (2,) m with the Hertz penetration of those forces."""
         fam, faces = self.family, self.contact.faces
-        pl = place_on_path(fam.geom.L, ratio, self.contact.centres[0, 0])
+        pl = self._placement(ratio)
         if not (pl.r.max() < self.contact.r_outer and pl.r.min() > fam.geom.L.max()):
             raise InputError("ratio", ratio, f"must put both arcs between one pitch and the sheaves' outer radius "
                              f"{self.contact.r_outer:g} m (radii {pl.r[0]:.4g}, {pl.r[1]:.4g} m)")
@@ -481,6 +481,11 @@ class ChainCVT(ModelBase):
         u3k = l / 2 - Nk / (2 * fam.geom.c_pin.mean())
         return pl, u3, np.array([u3k[k] - faces[k].lever(pl.r[k]) - dk[k] + self._extra_approach(k, pl.r[k])
                                  for k in range(2)])
+
+    def _placement(self, ratio: float):
+        """The pins on the band path of ``ratio`` with unstretched links (the hook a chain whose pitch changes with
+        the joint angles overrides)."""
+        return place_on_path(self.family.geom.L, ratio, self.contact.centres[0, 0])
 
     def _extra_approach(self, k: int, r: float) -> float:
         """Penetration of the contact beyond H1's for a pin end at radius ``r`` (m) on shaft ``k`` (0 for H1)."""
@@ -569,8 +574,7 @@ class ChainCVT(ModelBase):
             rows, cols = np.concatenate([Kc.row, r]), np.concatenate([Kc.col, c])
             K = sp.csr_matrix((np.concatenate([Kc.data, d]), (rows, cols)), shape=(n2, n2))
             return (K[free][:, free] / F2).toarray()
-        sol = least_squares(residual, q[free], jac=jacobian, method="lm", xtol=tol, ftol=tol, gtol=tol,
-                            x_scale=1e-5, max_nfev=200)
+        sol = self._solve_balance(residual, jacobian, q[free], tol)
         q[free] = sol.x
         Q = forces(sol.x)
         pins, shafts, _, (_, c) = self._contacts(q, vel, details=True)
@@ -592,6 +596,12 @@ class ChainCVT(ModelBase):
                   "tension": float(self._elastic_link_tension(q[:nc]).mean()), "placement": pl,
                   "nfev": sol.nfev, "status": sol.status}
         return x0, report
+
+    def _solve_balance(self, residual, jacobian, y0, tol: float):
+        """Least squares of the quasi-static balance (scipy Levenberg-Marquardt, dense Jacobian); the result's
+        ``x``, ``nfev``, ``status``, ``message``."""
+        return least_squares(residual, y0, jac=jacobian, method="lm", xtol=tol, ftol=tol, gtol=tol, x_scale=1e-5,
+                             max_nfev=200)
 
     def initial_state(self) -> np.ndarray:
         """The quasi-static state (:meth:`static_state`) at the regime's ratio and driving speed at ``t = 0``."""
@@ -693,6 +703,9 @@ def from_scene(scene, geom, F_appl, model: str = "chain-S2", **overrides) -> Cha
     kw.update(overrides)
     if kw["model"] in FAMILIES:
         return ChainCVT.from_parameters(geom, **kw)
+    if kw["model"].startswith("chain-A5"):
+        from cvtfem.machines.chain_halves_cvt import ChainHalvesCVT   # independent pin halves
+        return ChainHalvesCVT.from_parameters(geom, **kw)
     from cvtfem.machines.chain_a_cvt import ChainACVT   # the whole-pin chains build on this module
     return ChainACVT.from_parameters(geom, **kw)
 

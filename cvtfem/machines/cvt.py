@@ -157,7 +157,7 @@ def chain_geometry(scene: Scene):
 
 
 #: Discrete-chain models that run as a transmission (the others exist as element families only).
-RUNNING_CHAINS = ("chain-S1", "chain-S2", "chain-S3", "chain-A1", "chain-A2")
+RUNNING_CHAINS = ("chain-S1", "chain-S2", "chain-S3", "chain-A1", "chain-A2", "chain-A5", "chain-A5-point")
 
 
 def band_model(scene: Scene, **overrides: Any):

@@ -613,6 +613,16 @@ class ChainA5:
         r = self._evaluate(q, v)
         return r["friction"] - r["grad"] - r["gradv"]
 
+    def forces_and_dissipation(self, q: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, float]:
+        """``(Q, D)``: :meth:`forces` and the power dissipated by its damping and friction parts, ``D = 2 Phi - P_fr``
+        (W, >= 0) in the same pass (:func:`halves_kernel.forces_power` with ``use_numba``)."""
+        if self.backend == "numba":
+            Q, D = HK.forces_power(np.asarray(q, float), np.asarray(v, float), *self._kernel_args)
+            return Q, float(D)
+        r = self._evaluate(q, v)
+        return (r["friction"] - r["grad"] - r["gradv"],
+                2 * float(sum(r["Phi"].values())) - float(np.sum(r["out"]["chain.friction_power"])))
+
     def outputs(self, q: np.ndarray, v: np.ndarray | None = None) -> dict[str, np.ndarray]:
         """Values of :attr:`output_specs` (slips and friction power need ``v``; zero without)."""
         return self._evaluate(q, np.zeros(self.n2) if v is None else v)["out"]

@@ -82,10 +82,11 @@ def _shape(xi, l, H, Hp, Hpp):
 # ---------------------------------------------------------------------------------------------- links
 @njit(cache=True)
 def _link_work():
-    """Scratch arrays of :func:`_link` (``J`` zero: :func:`_virtual_strains` writes only its nonzero columns)."""
+    """Scratch arrays of :func:`_link` (``J`` zero: :func:`_virtual_strains` writes only its nonzero columns); the
+    last accumulates the power of the link damping forces (W)."""
     return (np.zeros(20), np.zeros(20), np.zeros(20), np.zeros((3, 4)), np.zeros((3, 4)), np.zeros((3, 20)),
             np.zeros((3, 3)), np.zeros(3), np.zeros((2, 3)), np.zeros(3), np.zeros(3), np.zeros(10), np.zeros(22),
-            np.zeros(20), np.zeros((3, 22)))
+            np.zeros(20), np.zeros((3, 22)), np.zeros(1))
 
 
 @njit(cache=True)
@@ -164,7 +165,7 @@ def _link(x, xd, e, L, c_twist, plate_w, plate_d, plate_c, plate_c1, plate_c2, p
     their exact velocity derivative (they are linear in ``xd``) to ``Dv`` (22, 22; symmetric, the upper triangle
     overwritten).  Returns the link tension (N).
     """
-    qv, qvd, Qf, Ha, Hb, J, A, V, ev, ed, r, m, Jp, row, AJG = wk
+    qv, qvd, Qf, Ha, Hb, J, A, V, ev, ed, r, m, Jp, row, AJG, pw_ = wk
     l, beta_ext, beta_shear, beta_twist, h_pl = par[0], par[6], par[7], par[8], par[15]
     Le = L[e]
     T = 0.0
@@ -182,6 +183,8 @@ def _link(x, xd, e, L, c_twist, plate_w, plate_d, plate_c, plate_c1, plate_c2, p
         s0 = c1 * z1 + c2 * z2 + beta_shear * (c1 * r[0] + c2 * r[1])
         s1 = c2 * z1 + c1 * z2 + beta_shear * (c2 * r[0] + c1 * r[1])
         s2 = tension + beta_ext * c * r[2]
+        pw_[0] -= pw * (beta_shear * (r[0] * (c1 * r[0] + c2 * r[1]) + r[1] * (c2 * r[0] + c1 * r[1]))
+                        + beta_ext * c * r[2] * r[2])
         g0 = -(A[0, 0] * s0 + A[1, 0] * s1 + A[2, 0] * s2)
         g1 = -(A[0, 1] * s0 + A[1, 1] * s1 + A[2, 1] * s2)
         g2 = -(A[0, 2] * s0 + A[1, 2] * s1 + A[2, 2] * s2)
@@ -215,6 +218,7 @@ def _link(x, xd, e, L, c_twist, plate_w, plate_d, plate_c, plate_c1, plate_c2, p
         for j in range(22):
             phid += Jp[j] * xd[j]
         f = c_twist[e] * (phi + beta_twist * phid)
+        pw_[0] -= beta_twist * c_twist[e] * phid * phid
         for j in range(22):
             loc[j] -= f * Jp[j]
         if want_dv:
@@ -231,10 +235,10 @@ def _link(x, xd, e, L, c_twist, plate_w, plate_d, plate_c, plate_c1, plate_c2, p
 # ---------------------------------------------------------------------------------------------- pins
 @njit(cache=True)
 def _pin_work():
-    """Scratch arrays of :func:`_pin`."""
+    """Scratch arrays of :func:`_pin`; the last accumulates the power of its damping and friction forces (W)."""
     return (np.zeros((2, 2)), np.zeros(2), np.zeros(2), np.zeros((2, 2)), np.zeros((2, 2)), np.zeros(2),
             np.zeros(4), np.zeros(4), np.zeros(4), np.zeros((2, 2)), np.zeros((2, 2)), np.zeros(2), np.zeros(2),
-            np.zeros((2, 2)), np.zeros((2, 4)), np.zeros((2, 3, 9)))
+            np.zeros((2, 2)), np.zeros((2, 4)), np.zeros((2, 3, 9)), np.zeros(1))
 
 
 @njit(cache=True)
@@ -253,7 +257,7 @@ def _pair(loc, Qth, A, B, H, s, v0, v1, kA, kB):
 @njit(cache=True)
 def _half_bending(x, xd, h, th, nh, thd, par, elastic, loc, Qth, nab):
     """Half bending (1.216) of half ``h`` on axes turning with its link (with ``elastic``), and its co-rotational
-    damping (section 5.4)."""
+    damping (section 5.4); returns the power of the damping forces (W)."""
     l, A_tau, A_n, beta = par[0], par[3], par[4], par[5]
     o = 10 * h + 4                                                # u_2 of the half
     t0, t1, n0, n1 = th[h, 0], th[h, 1], nh[h, 0], nh[h, 1]
@@ -270,7 +274,7 @@ def _half_bending(x, xd, h, th, nh, thd, par, elastic, loc, Qth, nab):
         for k in range(2):                                        # nabla = U' - theta' k x U
             nab[k, 0] = xd[o + 2 * k] + thd[h] * x[o + 2 * k + 1]
             nab[k, 1] = xd[o + 2 * k + 1] - thd[h] * x[o + 2 * k]
-        dth = 0.0
+        dth, power = 0.0, 0.0
         for k in range(2):
             a0 = (4 * nab[k, 0] + 2 * nab[1 - k, 0]) / l
             a1 = (4 * nab[k, 1] + 2 * nab[1 - k, 1]) / l
@@ -279,7 +283,10 @@ def _half_bending(x, xd, h, th, nh, thd, par, elastic, loc, Qth, nab):
             loc[o + 2 * k] -= beta * mb0
             loc[o + 2 * k + 1] -= beta * mb1
             dth += -x[o + 2 * k + 1] * mb0 + x[o + 2 * k] * mb1
+            power -= beta * (nab[k, 0] * mb0 + nab[k, 1] * mb1)
         Qth[h] += beta * dth
+        return power
+    return 0.0
 
 
 @njit(cache=True)
@@ -334,12 +341,13 @@ def _pin(x, xd, p, T_next, T_prev, b_joint, cs, arc, idx, sig_, cw, par, law, el
     with ``cached`` the geometry (frames, stations, contact normals and forces) of the previous call is reused
     (only ``xd`` changed since).
     """
-    tau, rho, thd, th, nh, Qth, H, Hp, Hpp, Ux, Vx, kA, kB, nab, Hs, CG = wk
+    tau, rho, thd, th, nh, Qth, H, Hp, Hpp, Ux, Vx, kA, kB, nab, Hs, CG, pw = wk
     l, c_half, b_half, b_roll, k_tie = par[0], par[1], par[2], par[9], par[10]
     k_stop, d_stop, f0, v0 = par[11], par[12], par[13], par[14]
     for h in range(2):
         o = 10 * h
         loc[o + 9] -= (2 * c_half * (2 * x[o + 9] - l) if elastic else 0.0) + 4 * b_half * xd[o + 9]
+        pw[0] -= 4 * b_half * xd[o + 9] * xd[o + 9]
     for h in range(2 if elastic else 0):                          # stoppers (erratum 13)
         s = x[10 * h + 8] - x[20]
         f = k_stop * max(abs(s) - d_stop, 0.0) * np.sign(s)
@@ -351,11 +359,13 @@ def _pin(x, xd, p, T_next, T_prev, b_joint, cs, arc, idx, sig_, cw, par, law, el
         R = -0.5 * (Tn + Tp) * _gain(abs(v_hh), f0, v0, law, SMOOTH_EPS) * v_hh
         loc[18] += R
         loc[8] -= R
+        pw[0] += R * v_hh
         for h in range(2):
             v_hp = xd[10 * h + 8] - xd[20]
             R = -(Tn if h == 0 else Tp) * _gain(abs(v_hp), f0, v0, law, SMOOTH_EPS) * v_hp
             loc[10 * h + 8] += R
             loc[20] -= R
+            pw[0] += R * v_hp
     if not lateral:
         return
     if not cached:
@@ -365,7 +375,7 @@ def _pin(x, xd, p, T_next, T_prev, b_joint, cs, arc, idx, sig_, cw, par, law, el
         thd[j] = (-tau[j, 1] * (xd[o + 2] - xd[o]) + tau[j, 0] * (xd[o + 3] - xd[o + 1])) / rho[j]
         Qth[j] = 0.0
     for h in range(2):
-        _half_bending(x, xd, h, th, nh, thd, par, elastic, loc, Qth, nab)
+        pw[0] += _half_bending(x, xd, h, th, nh, thd, par, elastic, loc, Qth, nab)
     for s in range(2):
         Hst = Hs[s]
         for h in range(2):
@@ -388,6 +398,7 @@ def _pin(x, xd, p, T_next, T_prev, b_joint, cs, arc, idx, sig_, cw, par, law, el
                 gdot = sig * (n0 * vr0 + n1 * vr1 + (n0 * kB[0] + n1 * kB[1]) * thd[B]
                               - (n0 * kA[0] + n1 * kA[1]) * thd[A])
                 _pair(loc, Qth, A, B, Hst, -wgt * b_roll * gdot * sig, n0, n1, kA, kB)
+                pw[0] -= wgt * b_roll * gdot * gdot
             if k_tie != 0.0 and ic == 0 and elastic:              # g_t = R_A ang(n, tau_A) + R_B ang(n, tau_B)
                 gt = (RA * np.arctan2(n0 * tau[A, 1] - n1 * tau[A, 0], n0 * tau[A, 0] + n1 * tau[A, 1])
                       + RB * np.arctan2(n0 * tau[B, 1] - n1 * tau[B, 0], n0 * tau[B, 0] + n1 * tau[B, 1]))
@@ -402,8 +413,10 @@ def _pin(x, xd, p, T_next, T_prev, b_joint, cs, arc, idx, sig_, cw, par, law, el
                 _pair(loc, Qth, A, B, Hst, Ft, t0, t1, kA, kB)
                 Qth[B] -= Ft * sig * RB
                 Qth[A] -= Ft * RA
+                pw[0] += Ft * vs
     if b_joint[p] != 0.0:                                         # joint damping (1.80)
         tq = b_joint[p] * (thd[0] - thd[1])
+        pw[0] -= tq * (thd[0] - thd[1])
         Qth[0] -= tq
         Qth[1] += tq
     for j in range(2):                                            # half torques to the link ends
@@ -437,6 +450,15 @@ def _axial_friction_slopes(xd, p, T_next, T_prev, f0, v0, law, out):
 def forces(q, v, gl, gp, L, c_twist, b_joint, cs, plate_w, plate_d, plate_c, plate_c1, plate_c2, arc, idx, sig,
            cw, par, ints):
     """Generalized forces ``Q (21 n,)`` of the A5 chain: elastic, dissipative and friction (``ChainA5.forces``)."""
+    return forces_power(q, v, gl, gp, L, c_twist, b_joint, cs, plate_w, plate_d, plate_c, plate_c1, plate_c2, arc,
+                        idx, sig, cw, par, ints)[0]
+
+
+@njit(cache=True)
+def forces_power(q, v, gl, gp, L, c_twist, b_joint, cs, plate_w, plate_d, plate_c, plate_c1, plate_c2, arc, idx,
+                 sig, cw, par, ints):
+    """``(Q, D)``: the forces of :func:`forces` and the power dissipated by their damping and friction parts,
+    ``D = -(Q_d + Q_fr) . v = 2 Phi - P_fr`` (W, >= 0), summed element by element."""
     n = L.shape[0]
     law, kmodel = ints[0], ints[1]
     Q = np.zeros(q.shape[0])
@@ -458,7 +480,7 @@ def forces(q, v, gl, gp, L, c_twist, b_joint, cs, plate_w, plate_d, plate_c, pla
         _pin(y, yd, p, T[p], T[(p - 1) % n], b_joint, cs, arc, idx, sig, cw, par, law, True, True, False, lp, pk)
         for j in range(29):
             Q[gp[p, j]] += lp[j]
-    return Q
+    return Q, -(wk[-1][0] + pk[-1][0])
 
 
 @njit(cache=True)
@@ -558,4 +580,4 @@ def jacobian(q, v, gl, gp, L, c_twist, b_joint, cs, plate_w, plate_d, plate_c, p
                         Jq[pos_t[p, j, r, c]] += slopes[j, r] * dT[e, c]
 
 
-__all__ = ["HAVE_NUMBA", "SMOOTH_EPS", "forces", "jacobian", "pack", "positions"]
+__all__ = ["HAVE_NUMBA", "SMOOTH_EPS", "forces", "forces_power", "jacobian", "pack", "positions"]

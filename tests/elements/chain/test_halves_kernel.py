@@ -53,6 +53,21 @@ def test_compiled_forces_equal_numpy_twin(case):
         assert contacts > no_holes > 0 and ref.potential_parts(q)["stoppers"] > 0
 
 
+@pytest.mark.parametrize("case", CASES)
+def test_compiled_dissipated_power_equals_numpy_twin(case):
+    """The compiled pass's dissipated power (accumulated element by element) equals ``2 Phi - P_fr`` of the numpy
+    twin and the power ``-(Q(q, v) - Q(q, 0)) . v`` of the damping and friction forces, to 1e-10."""
+    kw, v_scale = CASES[case]
+    fast, ref = chain(**kw), chain(use_numba=False, **kw)
+    q, v = state(ref, v_scale)
+    Q, D = fast.forces_and_dissipation(q, v)
+    Qr, Dr = ref.forces_and_dissipation(q, v)
+    assert slot_error(ref, Qr, Q) < 1e-12
+    D_work = -float((fast.forces(q, v) - fast.forces(q, 0 * v)) @ v)
+    assert D > 0 and Dr == pytest.approx(2 * ref.rayleigh(q, v) - ref.outputs(q, v)["chain.friction_power"].sum())
+    assert D == pytest.approx(Dr, rel=1e-10) and D == pytest.approx(D_work, rel=1e-9)
+
+
 def column_differences(ref, f, x0, steps):
     """Central differences of ``f(x)`` over every coordinate of ``x0`` with the steps ``steps`` (n,)."""
     out = np.empty((ref.n2, ref.n2))

@@ -1,0 +1,338 @@
+"""The chain with independent pin halves (A5) on two rigid shafts: :class:`ChainHalvesCVT`, variants (e) and (zh)
+of the source's Table 1.1 with rigid shafts instead of elastic ones (issue 13).
+
+Each half of every pin carries A1's ten coordinates (chain-models-2 §5.1), so each half has two ends,
+``u_0 -+ u_1`` in-plane and ``w_0 -+ w_1`` axially, linear in its coordinates; every half end touches the
+sheave on its side of each shaft with H1 (Hertz at the point on the half's axis, :class:`EndContact`; the
+contact of variant (zh)), as the whole-pin ends of :class:`~cvtfem.machines.chain_a_cvt.ChainACVT` do: four
+contact ends per pin, end ``e = 4 p + 2 h + s`` (half ``h`` 0 = ``p-``, 1 = ``p+``; side ``s`` 0 = ``x3 < 0``,
+1 = ``x3 > 0``).  The sheaves, clamping, loops and work integrals are ChainACVT's (a fixed and a movable sheave
+per shaft).  :class:`HalvesFamily` wraps :class:`~cvtfem.elements.chain.halves.ChainA5` in the chain-family
+interface ChainCVT drives; the internal friction of the chain (axial (1.221) and rolling) counts in the
+dissipated work with the Rayleigh damping.
+"""
+from __future__ import annotations
+
+from types import SimpleNamespace
+
+import numpy as np
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+from cvtfem.elements.base import Block
+from cvtfem.elements.chain.halves import ChainA5
+from cvtfem.elements.chain.placement import place_on_path
+from cvtfem.errors import InputError, NumericalError
+from cvtfem.machines.chain_a_cvt import PLATE_HEIGHT, PLATE_THICKNESS, POISSON, ChainACVT
+from cvtfem.outputs import OutputSpec
+
+#: Assumed half-pin and contact parameters (no source values; docs/chain.md "Parameters assumed"): half offset
+#: ``h_pin`` (m), rolling radii (m), rolling and hole penalties (N/m^2), hole contour, back face, its extent and
+#: the clearance (m), stopper stiffness (N/m) and play (m), turn of the section axes ``gamma_0`` (rad); the chain's
+#: internal friction (axial (1.221), rolling): ``f_0`` 0.1 (the source's estimate, §1.5.1.2), ``v_0`` (m/s) and law.
+HALF_PARAMETERS = dict(h_pin=1.2e-3, roll_radius=(0.004, 0.004), roll_stiffness=1e11, hole_radius=0.0031,
+                       back_radius=0.0024, back_extent=0.0025, hole_clearance=5e-4, hole_stiffness=1e11,
+                       stopper_stiffness=1e6, stopper_play=5e-4, gamma0=np.radians(5.0),
+                       friction_coefficient=0.1, friction_speed=0.01, friction_law="tanh")
+#: The chains with independent halves that run on the sheaves (both with H1: the contact point on the half's axis).
+HALVES_MODELS = ("chain-A5", "chain-A5-point")
+_ROT = np.array([[0.0, 1.0], [-1.0, 0.0]])      # a @ _ROT = k x a
+
+
+def halves_family(geom, damping, E: float, plate_model: str = "A4", use_numba: bool = True, **half_parameters) -> "HalvesFamily":
+    """A5 of a :class:`~cvtfem.elements.chain.geometry.ChainGeometry` with ``damping``
+    (:class:`~cvtfem.elements.chain.symmetric.ChainDamping`).
+
+    The geometry's pitch ``L`` is the pin pitch; the plates hang on the halves ``2 h_pin`` further apart.  Plates
+    ``PLATE_HEIGHT`` x ``PLATE_THICKNESS`` of Young's modulus ``E`` (Pa) as A1's; each half has half the pin's axial
+    and bending stiffnesses (§5.3: pair = 2 halves).  Damping times as A1's (the link time for plate extension,
+    shear and twist; ``beta_pin`` for the half axial damping ``b = beta c_p/2``), the rolling contact's normal
+    damping ``beta_link k_n``.  ``half_parameters`` override :data:`HALF_PARAMETERS`.
+    """
+    unknown = set(half_parameters) - set(HALF_PARAMETERS)
+    if unknown:
+        raise InputError("half_parameters", sorted(unknown), "must be among " + ", ".join(HALF_PARAMETERS))
+    hp = dict(HALF_PARAMETERS, **half_parameters)
+    mask = np.asarray(geom.plate_mask)
+    order = np.argsort(~mask, axis=1, kind="stable")                 # the existing plates first in every link
+    take = lambda a: np.take_along_axis(np.asarray(a, float), order, 1)  # noqa: E731
+    b, h = PLATE_HEIGHT, PLATE_THICKNESS
+    G = E / (2 * (1 + POISSON))
+    c_pin = np.asarray(geom.c_pin, float)
+    if np.ptp(c_pin) > 1e-12 * c_pin.max():
+        raise InputError("ChainGeometry.c_pin", (c_pin.min(), c_pin.max()), "must be equal for all pins (A5)")
+    chain = ChainA5(pitch=geom.L + 2 * hp["h_pin"], plate_offset=geom.l / 2 * take(geom.xi),
+                    n_plates=np.maximum(mask.sum(1), 1), plate_stiffness=take(geom.c_plate),
+                    plate_bending_stiffness=E * b * h ** 3 / 12, plate_thickness=h,
+                    plate_torsion_stiffness=(G * b * h ** 3 / 3) / (geom.L[:, None] + 2 * hp["h_pin"]),
+                    plate_mass=np.asarray(geom.m_plate).sum(1), pin_length=geom.l, pin_mass=geom.m_pin,
+                    pin_axial_stiffness=float(c_pin[0]), half_bending_tau=geom.A_tau / 2,
+                    half_bending_n=geom.A_n / 2, roll_damping=damping.beta_link * hp["roll_stiffness"],
+                    plate_model=plate_model,
+                    half_axial_damping=damping.beta_pin * float(c_pin[0]) / 2, beta_plate_ext=damping.beta_link,
+                    beta_plate_shear=damping.beta_link, beta_twist=damping.beta_link, beta_bend=damping.beta_bend,
+                    joint_damping=damping.b_joint, closed=geom.closed, use_numba=use_numba, **hp)
+    return HalvesFamily(chain, geom)
+
+
+class HalvesFamily:
+    """:class:`ChainA5` with the interface of the chain families :class:`~cvtfem.machines.chain_cvt.ChainCVT`
+    drives (``forces``, ``solve_mass``, ``jacobian``, ``rayleigh``, ...).
+
+    ``rayleigh`` and ``dissipative_forces`` describe the chain's whole dissipated power ``D = 2 Phi - P_fr``
+    (Rayleigh damping and internal friction, ``P_fr <= 0``): ``rayleigh = D / 2``, ``dissipative_forces =
+    -dD/dv / 2``, which is what ChainCVT's work integral and its Jacobian row read."""
+
+    name = "chain"
+
+    def __init__(self, chain: ChainA5, geom):
+        self.chain, self.geom = chain, geom
+        self.n, self.size = chain.n_pins, chain.n2
+        self.dof_index = chain.dof_index
+        self.ip1 = (np.arange(self.n) + 1) % self.n
+        self.on = geom.link_on
+        self._last: tuple = (None, None, None)
+        self._power: tuple = (None, 0.0)                # (state, dissipated power W) of the last force pass
+
+    @property
+    def blocks(self) -> tuple[Block, ...]:
+        """Half ``-`` and half ``+`` in A1's layout, then the plate packs (§5.1)."""
+        n = self.n
+        one = lambda s: (Block(f"chain.{s}.u_perp0", 2 * n, "m"), Block(f"chain.{s}.u_perp1", 2 * n, "m"),  # noqa: E731
+                         Block(f"chain.{s}.u_perp2", 2 * n, "-"), Block(f"chain.{s}.u_perp3", 2 * n, "-"),
+                         Block(f"chain.{s}.u_par0", n, "m"), Block(f"chain.{s}.u_par1", n, "m"))
+        return one("minus") + one("plus") + (Block("chain.pack", n, "m"),)
+
+    @property
+    def output_specs(self) -> tuple[OutputSpec, ...]:
+        return tuple(self.chain.output_specs)
+
+    @property
+    def jac_sparsity(self) -> sp.csr_matrix:
+        return self.chain.jac_sparsity
+
+    def split(self, q):
+        """``(u (2, 4, n, 2), w (2, 2, n), q_pack (n,))`` views (half -, half +)."""
+        return self.chain.split(q)
+
+    def join(self, u, w, qp):
+        return self.chain.join(u, w, qp)
+
+    def forces(self, q, v):
+        """All forces of the chain (N, N m); their pass also gives the dissipated power :meth:`rayleigh` reads."""
+        Q, D = self.chain.forces_and_dissipation(q, v)
+        self._power = (q.tobytes() + v.tobytes(), D)
+        return Q
+
+    def _nonconservative(self, q, v):
+        """Damping and friction forces: ``Q(q, v) - Q(q, 0)`` (both vanish at rest)."""
+        return self.chain.forces(q, v) - self.chain.forces(q, np.zeros_like(v))
+
+    def rayleigh(self, q, v) -> float:
+        """Half the dissipated power ``D = -(Q_d + Q_fr) . v`` (W); ChainCVT asks for it right after :meth:`forces`
+        at the same state, whose pass computed it."""
+        if self._power[0] != q.tobytes() + v.tobytes():
+            self.forces(q, v)
+        return 0.5 * self._power[1]
+
+    def dissipative_forces(self, q, v):
+        """``-dD/dv / 2 = (Q_nc + (dQ/dv)^T v) / 2``, N (``Q_nc`` damping and friction forces)."""
+        return 0.5 * (self._nonconservative(q, v) + self.jacobian(q, v, wrt=(1,))[0].T @ v)
+
+    def energy(self, q, v) -> float:
+        """Kinetic plus elastic energy of the chain, J."""
+        return float(self.chain.kinetic_energy(v) + self.chain.potential_energy(q))
+
+    def mass_matrix(self) -> sp.csr_matrix:
+        return self.chain.mass_matrix
+
+    def solve_mass(self, Q):
+        """``M^-1 Q`` (constant block-diagonal inverse)."""
+        return self.chain.inverse_mass @ Q
+
+    def jacobian(self, q, v, part: str = "all", wrt: tuple = (0, 1)):
+        """``(dQ/dq, dQ/dq')`` (CSR) of all forces, or with ``part="dissipative"`` of the damping and friction
+        forces alone (their ``dQ/dq`` is the total's less the one at ``q' = 0``)."""
+        key = np.concatenate([q, v]).tobytes()
+        if self._last[0] != key:                      # ChainCVT.jac asks for both parts at one state
+            self._last = (key, *self.chain.jacobian(q, v))
+        dq, dv = self._last[1:]
+        if part == "dissipative":
+            dq = dq - self.chain.jacobian(q, np.zeros_like(v), damping=False)[0]
+        return tuple(dq if k == 0 else dv for k in wrt)
+
+    def outputs(self, q, v):
+        return self.chain.outputs(q, v)
+
+
+class _HalfCentres:
+    """The in-plane positions ``u_0`` of both halves of every pin as one array: reading gives their mean (the pin
+    centre), writing sets both (the quasi-static start places and moves whole pins)."""
+
+    def __init__(self, u):
+        self.u = u
+
+    def __getitem__(self, key):
+        return (0.5 * (self.u[0, 0] + self.u[1, 0]))[key]
+
+    def __setitem__(self, key, value):
+        self.u[0, 0][key] = value
+        self.u[1, 0][key] = value
+
+
+class ChainHalvesCVT(ChainACVT):
+    """The A5 chain (independent pin halves) on two rigid shafts, each with a fixed and a movable sheave; H1 contact
+    at both ends of every half (:class:`ChainACVT`'s hooks for four ends per pin)."""
+
+    @property
+    def n_ends(self) -> int:
+        return 4 * self.family.n
+
+    def pin_of(self, ends):
+        return ends // 4
+
+    def pin_positions(self, q_chain):
+        return _HalfCentres(self.family.split(q_chain)[0])
+
+    def _candidates(self, q):
+        u = self.family.split(q[:self._idx[0]])[0]                      # (2, 4, n, 2)
+        ends = np.stack([u[:, 0] - u[:, 1], u[:, 0] + u[:, 1]], axis=2)  # (2 halves, n, 2 sides, 2)
+        return self.contact.candidates(ends.transpose(1, 0, 2, 3).reshape(-1, 2))
+
+    def _end_dofs(self, ends):
+        half = (ends // 2) % 2
+        return self.family.dof_index[ends // 4][np.arange(len(ends))[:, None], 10 * half[:, None] + np.arange(10)]
+
+    @property
+    def output_specs(self) -> tuple[OutputSpec, ...]:
+        specs = []
+        for s in super().output_specs:
+            if s.name.startswith("contact.") and s.size in (2 * self.n_ends, 6 * self.n_ends) and s.name not in (
+                    "contact.sheave_axial_force", "contact.fixed_sheave_axial_force", "contact.friction_power"):
+                s = OutputSpec(s.name, s.unit, s.doc.replace("per pin end", "per pin-half end (4 per pin: "
+                                                                     "half -, half +; x3 < 0, x3 > 0)"), s.size)
+            specs.append(s)
+        return tuple(specs)
+
+    # ----- quasi-static start ----------------------------------------------------------------------
+    def _placement(self, ratio: float):
+        """Rolling points ``U_p`` of the pins on the path of ``ratio``, spaced so that every link is unstretched.
+
+        With the halves placed by :meth:`_placed`, link ``(p, p+1)`` is ``|U_{p+1} - U_p| + 2 h_pin - R_- (1 -
+        cos(d_p/2)) - R_+ (1 - cos(d_{p+1}/2))`` long (``d_p`` the joint angle at pin ``p``): rolling shortens
+        it.  Three fixed-point passes of the joint angles (each changes the spacing by a fraction of it)."""
+        fam = self.family
+        L = fam.geom.L
+        Rm, Rp = fam.chain.roll_radius
+        for _ in range(3):
+            pl = place_on_path(L, ratio, self.contact.centres[0, 0])
+            c = np.cos(0.5 * self._joint_angles(pl.u))
+            L = fam.geom.L + Rm * (1 - c) + Rp * (1 - c[fam.ip1])
+        return pl
+
+    @staticmethod
+    def _joint_angles(U):
+        """Turn ``d_p`` (rad) of the chain at each pin of the closed polygon ``U (n, 2)``."""
+        t = np.roll(U, -1, 0) - U
+        t_prev = np.roll(t, 1, 0)
+        return np.abs(np.arctan2(t_prev[:, 0] * t[:, 1] - t_prev[:, 1] * t[:, 0], np.sum(t_prev * t, 1)))
+
+    def wedge_guess(self, ratio: float, F2: float):
+        """ChainCVT's wedge estimate with the sheaves moved to the half ends: on an arc both halves' axes run
+        ``(R - h_pin) sin(d/2)`` inside the rolling points ``U`` (:meth:`_placed`), where the wedge is narrower."""
+        pl, u3, z = super().wedge_guess(ratio, F2)
+        R = np.mean(self.family.chain.roll_radius)
+        h = self.family.chain.h_pin
+        d = self._joint_angles(pl.u)
+        for k in range(2):
+            r_half = pl.r[k] - (R - h) * np.sin(0.5 * np.median(d[pl.piece == k]))
+            face = self.contact.faces[k]
+            z[k] += face.lever(pl.r[k]) - face.lever(r_half)
+        return pl, u3, z
+
+    def placed_state(self, ratio: float, w1: float) -> np.ndarray:
+        """The start of the quasi-static solve as a running state: halves placed by :meth:`_placed` on the path of
+        ``ratio``, sheaves at the wedge estimate for ``F_appl[1]``, the chain moving along the path at ``w1 r1``
+        (rad/s, m) with the pins on the arcs turning with their sheave, shafts and loops at those speeds."""
+        pl, u3, z = self.wedge_guess(ratio, float(self.F_appl[1]))
+        nc, iphi, iz, _ = self._idx
+        q, v = np.zeros(self.n2), np.zeros(self.n2)
+        q[:nc], q[iz] = self._placed(pl, u3), z
+        speed = w1 * pl.r[0]
+        self.pin_positions(v[:nc])[:] = speed * pl.tangent
+        v[iphi] = speed / pl.r
+        for k in range(2):
+            self._turn_with_sheave(q[:nc], v[:nc], np.flatnonzero(pl.piece == k), v[iphi[k]], self.contact.centres[k])
+        return np.concatenate([q, v, self.control.initial_state(*v[iphi]), np.zeros(4)])
+
+    def start(self):
+        """``(x0, report)``: the quasi-static state of :meth:`static_state`, or, where its solve stalls (it does at the
+        reference operating point: docs/chain.md), :meth:`placed_state`, off balance, with the stall in ``kind``."""
+        try:
+            return super().start()
+        except NumericalError as err:
+            w1, _, i = self.regime.targets(0.0)
+            return self.placed_state(i, w1), {"kind": f"placed on the sheaves, off balance ({err})"}
+
+    def _solve_balance(self, residual, jacobian, y0, tol: float):
+        """Damped Newton on the sparse Jacobian (scipy ``splu``): step ``-(J - mu S)^-1 r`` with ``S`` the Jacobian's
+        diagonal magnitudes (floored at 1e-9 of the largest: the plate packs within their stoppers' play are held
+        only by the plates' geometric stiffness), ``mu`` divided by 10 after a step that lowers ``|r|`` and
+        multiplied by 10 (from the same point) otherwise; ends when ``max |r| < 1e-3 tol`` or the step is below
+        ``tol`` of the coordinates' scale."""
+        y, r = np.asarray(y0, float).copy(), residual(y0)
+        nfev, mu, status, msg = 1, 1e-6, 0, "the iteration limit was reached"
+        for _ in range(60):
+            J = sp.csc_matrix(jacobian(y))
+            S = sp.diags(np.maximum(np.abs(J.diagonal()), 1e-9 * np.abs(J.diagonal()).max()))
+            while mu < 1e8:
+                dy = spla.splu(J - mu * S).solve(-r)
+                r_new = residual(y + dy)
+                nfev += 1
+                if np.linalg.norm(r_new) < np.linalg.norm(r):
+                    y, r, mu = y + dy, r_new, max(mu / 10, 1e-12)
+                    break
+                mu *= 10
+            else:
+                msg = "no step lowered the residual"
+                break
+            if np.abs(r).max() < 1e-3 * tol or np.abs(dy).max() < tol * 1e-3:
+                status, msg = 1, "converged"
+                break
+        return SimpleNamespace(x=y, nfev=nfev, status=status, message=msg)
+
+    def _placed(self, pl, u3):
+        """Straight halves rolling on each other at ``pl.u`` (the rolling faces touch on the joint's bisector
+        ``b_p``): ``u-_p = U_p - R_- b_p - (h_pin - R_-) tau_p``, ``u+_p = U_p + R_+ b_p - (R_+ - h_pin) tau_{p-1}``,
+        ``tau`` the link directions; half lengths ``u3`` (n,) m, packs centred."""
+        fam = self.family
+        Rm, Rp = fam.chain.roll_radius
+        h = fam.chain.h_pin
+        t = np.roll(pl.u, -1, 0) - pl.u
+        tau = t / np.linalg.norm(t, axis=1, keepdims=True)
+        tau_prev = np.roll(tau, 1, 0)
+        bis = (tau + tau_prev) / np.linalg.norm(tau + tau_prev, axis=1, keepdims=True)
+        q = fam.chain.rest_state(pl.u, tau) + self._axial(u3)
+        u = fam.split(q)[0]
+        u[0, 0] = pl.u - Rm * bis - (h - Rm) * tau
+        u[1, 0] = pl.u + Rp * bis - (Rp - h) * tau_prev
+        return q
+
+    def _axial(self, u3):
+        """The half lengths ``w_1 = u3`` as an increment over the rest state's ``l/2``."""
+        fam = self.family
+        dq = np.zeros(fam.size)
+        fam.split(dq)[1][:, 1] = np.asarray(u3) - fam.chain.l / 2
+        return dq
+
+    def _turn_with_sheave(self, q_chain, v_chain, pins, w, centre):
+        u, vu = self.family.split(q_chain)[0], self.family.split(v_chain)[0]
+        vu[:, 0, pins] = w * (u[:, 0, pins] - centre) @ _ROT
+        vu[:, 1:, pins] = w * u[:, 1:, pins] @ _ROT
+
+    # ----- construction ----------------------------------------------------------------------------
+    @classmethod
+    def _family_for(cls, model: str, geom, damping, E: float):
+        if model not in HALVES_MODELS:
+            raise InputError("cvt.model", model, "must be one of " + ", ".join(HALVES_MODELS))
+        return halves_family(geom, damping, E)
