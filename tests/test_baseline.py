@@ -6,7 +6,8 @@ Run summaries are compared to 1e-9 relative (they differ between OpenBLAS kernel
 modal results to 1e-10, harmonic-balance peaks to 1e-8 (Newton stops at a relative step below 1e-10);
 the work-precision study (HIRES) gives the same cost counters and errors to 1e-9 relative or 1e-11 absolute (an
 error is a relative difference of nearly equal values: kernel-level bits of y move it absolutely; recorded with the
-code of f26a565, before the restructuring).  Stabilized methods are left out: their adaptive steps follow
+code of f26a565, before the restructuring; the trapezoidal rule's rows were re-recorded when issue 19 changed its error
+estimate to the third divided difference of the states, session 6).  Stabilized methods are left out: their adaptive steps follow
 a power-iteration estimate whose last bits, and so the step counts, depend on the BLAS kernel.
 """
 import json

@@ -191,12 +191,13 @@ class _Memory(dict):
 
 
 def export_state(method, solver, n, n2):
-    """The memory of a :class:`CvtfemSolver`'s method (:meth:`Stepper.state`)."""
-    return _Memory(solver.stepper.state(solver.t, solver.y))
+    """The memory a checkpoint holds of a :class:`CvtfemSolver`: its method's and its step-size controller's
+    (:meth:`NativeEngine.state`)."""
+    return _Memory(solver.stepping.engine.state(solver.t, solver.y))
 
 
 def import_state(method, solver, mem, n, n2):
-    solver.stepper.restore(mem, solver.t, solver.y)
+    solver.stepping.engine.restore(mem, solver.t, solver.y)
 
 
 def state_size(method, n, n2):
@@ -219,7 +220,9 @@ def test_solver_state_round_trip_restores_the_lu(tmp_path):
     for _ in range(5):
         a.step()
     vec = export_state("trapezoidal", a, 2, 1)
-    assert vec.size == state_size("trapezoidal", 2, 1) == 5 + 2 * 2 + 4
+    # gamma, lu_valid, prev_h, prev_f (2), hist_t (2), hist_x (2 x 2), J (2 x 2), f_start (2), newton_stale,
+    # newton_eta, controller (4)
+    assert vec.size == state_size("trapezoidal", 2, 1) == 3 + 2 + 2 + 4 + 4 + 2 + 2 + 4
     b = CvtfemSolver(a.fun, a.t, a.y, 1.0, cvtfem_method="trapezoidal", rtol=1e-6, atol=1e-9, n2=1,
                      first_step=a.h_next)
     import_state("trapezoidal", b, vec, 2, 1)
