@@ -84,6 +84,8 @@ class HalvesFamily:
     -dD/dv / 2``, which is what ChainCVT's work integral and its Jacobian row read."""
 
     name = "chain"
+    #: No homogenised A1 pre-solve of the start (ChainACVT's for A3/A4): the halves' start is their own.
+    homogenised = None
 
     def __init__(self, chain: ChainA5, geom):
         self.chain, self.geom = chain, geom
