@@ -115,7 +115,7 @@ def pin_force_problem(scene, window: tuple[float, float] = (1e-3, 5e-3), sample:
     report = {"start": start["kind"], "output": output, "pin": pin, "samples": len(t_eval), "window": (t1, t2),
               "reference": f"{reference[0]} rtol {reference[1]:g}", "check": f"{check[0]} rtol {check[1]:g}",
               "reference_E": window_error(forces[check[0]][:, pin], p_all[:, pin]),
-              "force_range_N": (float(p_all[:, pin].min()), float(p_all[:, pin].max()))}
+              "force_range": (float(p_all[:, pin].min()), float(p_all[:, pin].max()))}
     return problem, report
 
 

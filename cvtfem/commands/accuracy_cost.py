@@ -170,8 +170,9 @@ def run(args: argparse.Namespace) -> int:
     reference, check = _pair(args.reference, "--reference"), _pair(args.check, "--check")
     scene = load_scene(args.scene)
     problem, report = ac.pin_force_problem(scene, window, args.sample, reference, check)
-    print(f"{args.scene}: {report['start']}; pin {report['pin']} axial force {report['force_range_N'][0]:.0f}.."
-          f"{report['force_range_N'][1]:.0f} N over {window[0]:g}..{window[1]:g} s; references {report['reference']}"
+    what = ("pin {} axial force, N" if report["output"] == ac.PIN_FORCE else "Gauss node {} sheave normal force, N/m")
+    print(f"{args.scene}: {report['start']}; {what.format(report['pin'])} {report['force_range'][0]:.0f}.."
+          f"{report['force_range'][1]:.0f} over {window[0]:g}..{window[1]:g} s; references {report['reference']}"
           f" and {report['check']} differ by E = {report['reference_E']:.2e}")
     lam, lam_v0 = ac.spectrum_with_v0(scene, problem.y0)
     v0 = scene.cvt.friction.v0
@@ -187,7 +188,7 @@ def run(args: argparse.Namespace) -> int:
     for line in markdown_table(table):
         print(line)
     plots.plot_accuracy_cost(rows, _out(args.png), ac.ACCEPT_E,
-                             f"{args.scene}: E of pin {report['pin']}'s axial force over {window[0]:g}..{window[1]:g} s"
+                             f"{args.scene}: E of {what.format(report['pin'])} over {window[0]:g}..{window[1]:g} s"
                              f" vs reference {report['reference']}")
     write_csv(rows, _out(args.csv))
     with open(_out(args.json), "w", encoding="utf-8") as fh:

@@ -33,7 +33,7 @@ def test_two_references_agree_far_below_the_acceptance(study):
     _, problem, report = study
     assert report["reference_E"] < 1e-6 < ac.ACCEPT_E
     assert report["samples"] == len(problem.t_eval) == 11
-    assert report["force_range_N"][0] < -500          # a pin on an arc: compressed by its contacts
+    assert report["force_range"][0] < -500          # a pin on an arc: compressed by its contacts
 
 
 def test_global_error_falls_with_the_step_and_matches_the_series(study):
