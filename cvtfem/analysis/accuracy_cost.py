@@ -139,12 +139,15 @@ def spectrum_with_v0(scene, x, factor: float = 0.1, t: float = 0.0) -> tuple[np.
 def measure(problem: PinForceProblem, fixed, steps, adaptive, rtols, repeats: int = 3) -> list[dict]:
     """Test 2 for every fixed-step method at every step ``h`` (s) and every adaptive method at every rtol
     (``atol = 1e-3 rtol``): rows of :func:`~cvtfem.integrate.study.work_precision` (error = ``E``, wall time =
-    median of ``repeats``, RHS calls, Jacobians, LU factorisations) with a ``setting`` label."""
+    median of ``repeats``, RHS calls, Jacobians, LU factorisations) with a ``setting`` label; a method run both
+    ways is labelled ``"NAME adaptive"`` in its adaptive runs."""
     from cvtfem.integrate.study import work_precision
 
+    both = {label for label, _, _ in fixed} & {label for label, _, _ in adaptive}
     runs = [(label, method, {**opts, "h": h, "adaptive": False, "t_eval": problem.t_eval})
             for label, method, opts in fixed for h in steps]
-    runs += [(label, method, {**opts, "rtol": r, "atol": 1e-3 * r, "t_eval": problem.t_eval})
+    runs += [(label + " adaptive" if label in both else label, method,
+              {**opts, "rtol": r, "atol": 1e-3 * r, "t_eval": problem.t_eval})
              for label, method, opts in adaptive for r in rtols]
     rows = work_precision(problem, runs, repeats=repeats, error=problem.error)
     for row in rows:

@@ -154,3 +154,18 @@ def test_the_study_from_the_command_line(cli, tmp_path):
     assert table["rk4"]["setting"] == "h=1e-06" and table["rk4"]["speedup"] > 5      # 20x fewer steps
     assert table["rodas5p"]["error"] <= ac.ACCEPT_E
     assert out["png"].stat().st_size > 10_000 and spectrum.stat().st_size > 10_000
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("preset", ["chain-S2", "chain-S2,regime-chapter2"])
+def test_the_chain_presets_default_solver_meets_the_acceptance(preset):
+    """The chain presets' solver (the study's choice, docs/accuracy-cost.md) reaches the source's acceptance
+    E <= 0.05 on the most varying pin force over 1..2 ms, against a reference that a second method confirms, at the
+    preset's own regime (3500 rpm, 200 N m) and at the chapter-2 one (2000 rpm, 150 N m)."""
+    scene = load_scene(preset)
+    problem, report = ac.pin_force_problem(scene, (1e-3, 2e-3), 1e-5, ("Radau", 1e-7), ("rodas5p", 1e-7))
+    assert report["reference_E"] < 1e-3
+    sol = scene.solver
+    res = solve(**problem.solve_kwargs(), method=sol.method, rtol=sol.rtol, atol=sol.atol, t_eval=problem.t_eval)
+    assert res.success
+    assert problem.error(res) <= ac.ACCEPT_E
