@@ -30,7 +30,7 @@ done
 if [[ $part == all || $part == chain-A1 ]]; then   # A1 costs ~20x S2 per RHS call: a 2 ms run, one law
   test2 chain-A1-linear-saturated studies/accuracy-cost/scenes/chain-A1-chapter2-linear-saturated.toml \
     --window 1e-3:2e-3 --sample 1e-5 --fixed rk4 --steps 2e-6,4e-6 \
-    --adaptive rodas5p,dopri45 --rtols 1e-2 --repeats 1 --reference Radau:1e-6 --check rodas5p:1e-6
+    --adaptive rodas5p,dopri45,rock4 --rtols 1e-2 --repeats 1 --reference Radau:1e-6 --check rodas5p:1e-6
 fi
 if [[ $part == all || $part == band ]]; then
   test2 band-6+2n band-6+2n,regime-chapter2 --window 1e-3:5e-3 --sample 1e-5 --fixed rk4,dopri45 \
