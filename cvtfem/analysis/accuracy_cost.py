@@ -8,10 +8,12 @@ Spec ``numerics-and-periodic.md`` section 9.  On a chain-CVT scene started in it
   axial force ``P`` of the pin that enters a sheave in the window (A:(2.9)), for each method and step or
   tolerance, with its cost (wall time, RHS calls, Jacobians, LU factorisations);
 * the reference ``P*`` computed two independent ways whose mutual ``E`` is reported (it must be far below the
-  acceptance 0.05 for the study to mean anything).
+  acceptance 0.05 for the study to mean anything);
+* test 1 (section 9.4): the local error of one step of size ``h`` from a state of the run, in a norm weighted
+  per state block (positions, velocities, first-order states: section 9.7), and the effective order (A:(2.8)).
 
-Test 1 (local error and effective order) reuses :func:`cvtfem.integrate.study.local_errors` on
-:meth:`PinForceProblem` from a state of the run.
+On a band model the output is the sheave normal force (N/m) at the Gauss node whose force varies most (the band
+has no pins); everything else is the same.
 """
 from __future__ import annotations
 
@@ -23,12 +25,14 @@ from cvtfem.errors import InputError
 from cvtfem.problems.base import Problem
 
 __all__ = ["PinForceProblem", "pin_force_problem", "window_error", "jacobian_spectrum", "spectrum_with_v0",
-           "ACCEPT_E"]
+           "local_error_table", "block_scales", "baseline_time", "state_at", "ACCEPT_E"]
 
 #: The source's acceptance of test 2.
 ACCEPT_E = 0.05
 #: Output of the chain families whose global error test 2 measures.
 PIN_FORCE = "chain.pin_axial_force"
+#: Output of the band models measured instead (they have no pins): sheave normal force per Gauss node, N/m.
+BAND_FORCE = "band.normal_force"
 
 
 def window_error(p, p_ref) -> float:
@@ -41,17 +45,23 @@ def window_error(p, p_ref) -> float:
 
 @dataclass(frozen=True)
 class PinForceProblem(Problem):
-    """A chain transmission from its start state over ``[0, t2]``; the error of a run is :func:`window_error`
-    of the axial force of pin ``pin`` at the samples ``t_eval`` of the window ``[t1, t2]``."""
+    """A CVT from its start state over ``[0, t2]``; the error of a run is :func:`window_error` of component
+    ``pin`` of the output ``output`` (a pin's axial force, or a band model's normal force at a Gauss node) at the
+    samples ``t_eval`` of the window ``[t1, t2]``."""
 
     loop: object = None
     pin: int = 0
     t_eval: np.ndarray = field(default_factory=lambda: np.zeros(0))
     p_ref: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    output: str = PIN_FORCE
 
-    def pin_forces(self, y) -> np.ndarray:
-        """Axial force of every pin (N), (samples, n_pins), at the states ``y`` (n, samples): the chain family's
-        output alone (the contacts and loops of the full output set are not needed for it)."""
+    def pin_forces(self, y, t=None) -> np.ndarray:
+        """The output (samples, components) at the states ``y`` (n, samples) and times ``t`` (default
+        ``t_eval``): a chain's pin axial forces (N) from the chain family's output alone (the contacts and loops
+        of the full output set are not needed for it), a band's normal forces (N/m) from the loop's outputs."""
+        t = self.t_eval if t is None else t
+        if self.output == BAND_FORCE:
+            return np.array([self.loop.outputs(ti, yi)[BAND_FORCE] for ti, yi in zip(t, np.asarray(y).T)])
         fam = self.loop.family
         out = []
         for yi in np.asarray(y).T:
@@ -62,16 +72,17 @@ class PinForceProblem(Problem):
     def error(self, res) -> float:
         if not res.success or len(res.t) != len(self.t_eval):
             return float("inf")
-        return window_error(self.pin_forces(res.y)[:, self.pin], self.p_ref)
+        return window_error(self.pin_forces(res.y, res.t)[:, self.pin], self.p_ref)
 
 
 def pin_force_problem(scene, window: tuple[float, float] = (1e-3, 5e-3), sample: float = 1e-5,
                       reference: tuple[str, float] = ("Radau", 1e-8),
                       check: tuple[str, float] = ("rodas5p", 1e-8)) -> tuple[PinForceProblem, dict]:
-    """Test 2 of the protocol on a chain-CVT scene: the problem, and a report of its reference.
+    """Test 2 of the protocol on a CVT scene: the problem, and a report of its reference.
 
     The pin is the one whose axial force varies most over the window in the reference run (a pin entering or
-    leaving an arc: the sharply varying output of A:(2.9)).  ``reference`` and ``check`` are two methods with
+    leaving an arc: the sharply varying output of A:(2.9)); on a band model the Gauss node whose normal force
+    varies most.  ``reference`` and ``check`` are two methods with
     their rtol (``atol = 1e-3 rtol``, analytic sparse Jacobian); the report holds the ``E`` between them.
     """
     from cvtfem.integrate import solve
@@ -82,15 +93,14 @@ def pin_force_problem(scene, window: tuple[float, float] = (1e-3, 5e-3), sample:
         raise InputError("--window", window, "must be two simulated times 0 <= t1 < t2, s")
     if not (0 < sample <= (t2 - t1) / 4):
         raise InputError("--sample", sample, f"must be positive and give at least 4 samples in {t2 - t1:g} s")
-    if not scene.cvt.model.startswith("chain"):
-        raise InputError("cvt.model", scene.cvt.model, "must be a discrete chain (the protocol measures a pin's "
-                         "axial force)")
+    output = PIN_FORCE if scene.cvt.model.startswith("chain") else BAND_FORCE
     loop = closed_loop(scene)
     x0, start = loop.start()
     t_eval = np.arange(t1, t2 + 0.5 * sample, sample)
     t_eval = t_eval[t_eval <= t2]
-    base = PinForceProblem("chain", loop.rhs, x0, (0.0, t2), n2=loop.n2, jac=loop.jac,
-                           jac_sparsity=loop.jac_sparsity, loop=loop, t_eval=t_eval)
+    sparsity = loop.jac_sparsity() if callable(loop.jac_sparsity) else loop.jac_sparsity
+    base = PinForceProblem(scene.cvt.model, loop.rhs, x0, (0.0, t2), n2=loop.n2, jac=loop.jac,
+                           jac_sparsity=sparsity, loop=loop, t_eval=t_eval, output=output)
     forces = {}
     for method, rtol in (reference, check):
         res = solve(**base.solve_kwargs(), method=method, rtol=rtol, atol=1e-3 * rtol, t_eval=t_eval)
@@ -99,13 +109,13 @@ def pin_force_problem(scene, window: tuple[float, float] = (1e-3, 5e-3), sample:
         forces[method] = base.pin_forces(res.y)
     p_all = forces[reference[0]]
     pin = int(np.argmax(np.ptp(p_all, axis=0)))
-    problem = PinForceProblem("chain", loop.rhs, x0, (0.0, t2), n2=loop.n2, jac=loop.jac,
-                              jac_sparsity=loop.jac_sparsity, loop=loop, pin=pin, t_eval=t_eval,
-                              p_ref=p_all[:, pin], info={"n": len(x0), "n2": loop.n2})
-    report = {"start": start["kind"], "pin": pin, "samples": len(t_eval), "window": (t1, t2),
+    problem = PinForceProblem(scene.cvt.model, loop.rhs, x0, (0.0, t2), n2=loop.n2, jac=loop.jac,
+                              jac_sparsity=sparsity, loop=loop, pin=pin, t_eval=t_eval, p_ref=p_all[:, pin],
+                              output=output, info={"n": len(x0), "n2": loop.n2})
+    report = {"start": start["kind"], "output": output, "pin": pin, "samples": len(t_eval), "window": (t1, t2),
               "reference": f"{reference[0]} rtol {reference[1]:g}", "check": f"{check[0]} rtol {check[1]:g}",
               "reference_E": window_error(forces[check[0]][:, pin], p_all[:, pin]),
-              "force_range_N": (float(p_all[:, pin].min()), float(p_all[:, pin].max()))}
+              "force_range": (float(p_all[:, pin].min()), float(p_all[:, pin].max()))}
     return problem, report
 
 
@@ -129,12 +139,15 @@ def spectrum_with_v0(scene, x, factor: float = 0.1, t: float = 0.0) -> tuple[np.
 def measure(problem: PinForceProblem, fixed, steps, adaptive, rtols, repeats: int = 3) -> list[dict]:
     """Test 2 for every fixed-step method at every step ``h`` (s) and every adaptive method at every rtol
     (``atol = 1e-3 rtol``): rows of :func:`~cvtfem.integrate.study.work_precision` (error = ``E``, wall time =
-    median of ``repeats``, RHS calls, Jacobians, LU factorisations) with a ``setting`` label."""
+    median of ``repeats``, RHS calls, Jacobians, LU factorisations) with a ``setting`` label; a method run both
+    ways is labelled ``"NAME adaptive"`` in its adaptive runs."""
     from cvtfem.integrate.study import work_precision
 
+    both = {label for label, _, _ in fixed} & {label for label, _, _ in adaptive}
     runs = [(label, method, {**opts, "h": h, "adaptive": False, "t_eval": problem.t_eval})
             for label, method, opts in fixed for h in steps]
-    runs += [(label, method, {**opts, "rtol": r, "atol": 1e-3 * r, "t_eval": problem.t_eval})
+    runs += [(label + " adaptive" if label in both else label, method,
+              {**opts, "rtol": r, "atol": 1e-3 * r, "t_eval": problem.t_eval})
              for label, method, opts in adaptive for r in rtols]
     rows = work_precision(problem, runs, repeats=repeats, error=problem.error)
     for row in rows:
@@ -150,7 +163,84 @@ def speedups(rows: list[dict], baseline: dict | None, accept: float = ACCEPT_E) 
         ok = [r for r in rows if r["label"] == label and r["error"] <= accept]
         best = min(ok, key=lambda r: r["time"]) if ok else None
         out.append({"label": label, "setting": best["setting"] if best else None,
-                    "error": best["error"] if best else None, "time": best["time"] if best else None,
-                    "nfev": best["nfev"] if best else None,
+                    **{k: best.get(k) if best else None for k in ("error", "time", "nfev", "njev", "nlu", "nsteps")},
                     "speedup": baseline["time"] / best["time"] if best and baseline else None})
     return out
+
+
+def baseline_time(rows: list[dict], h: float, t_end: float) -> dict | None:
+    """The baseline of the speed-up table, RK4 at step ``h`` (s) over ``[0, t_end]``: its run if the study made
+    it, else its wall time estimated from the study's RK4 runs (a fixed-step RK4 run costs 4 RHS calls per step
+    and nothing else, so its wall time is ``4 t_end / h`` times the median wall time per RHS call of those runs;
+    ``estimated`` says which).  ``None`` without RK4 runs."""
+    rk4 = [r for r in rows if r["method"] == "rk4" and "h" in r and np.isfinite(r["time"]) and r["nfev"] > 0]
+    exact = [r for r in rk4 if abs(r["h"] - h) <= 1e-9 * h]
+    if exact:
+        return {"time": exact[0]["time"], "nfev": exact[0]["nfev"], "estimated": False}
+    if not rk4:
+        return None
+    nfev = 4 * int(round(t_end / h))
+    return {"time": nfev * float(np.median([r["time"] / r["nfev"] for r in rk4])), "nfev": nfev, "estimated": True}
+
+
+def block_scales(x0, n2: int) -> np.ndarray:
+    """Per-component scales of the weighted norm of test 1 (section 9.7: positions, velocities and first-order
+    states differ in units): each block's largest ``|x0|`` (1 for a block of zeros)."""
+    x0 = np.abs(np.asarray(x0, float))
+    scales = np.empty_like(x0)
+    for sl in (slice(0, n2), slice(n2, 2 * n2), slice(2 * n2, len(x0))):
+        block = x0[sl]
+        scales[sl] = block.max() if block.size and block.max() > 0 else 1.0
+    return scales
+
+
+def local_error_table(problem: Problem, methods, hs, reference_rtol: float = 1e-13) -> list[dict]:
+    """Test 1 (section 9.4) from ``problem.y0`` at ``problem.t_span[0]``: for every ``(label, method, options)``
+    and step ``h`` (s), the local error ``e = max_i |x_1 - x(t0 + h)|_i / s_i`` of one step (``s`` from
+    :func:`block_scales`) and the effective order ``p~ = d ln e / d ln h - 1`` (A:(2.8)) between neighbouring
+    steps (NaN at the first).  ``x(t0 + h)`` is DOP853 at ``reference_rtol`` with ``atol = reference_rtol s``
+    (one run per ``h``, ending exactly there).  Rows: label, method, h, error, p_eff, nominal order."""
+    from cvtfem.integrate import solve
+    from cvtfem.integrate.methods import METHODS
+    from cvtfem.integrate.study import effective_order
+    from cvtfem.integrate.system import as_system
+
+    hs = np.asarray(sorted(float(h) for h in hs))
+    kw = problem.solve_kwargs()
+    t0, x0 = problem.t_span[0], problem.y0
+    scales = block_scales(x0, problem.n2)
+    exact = []
+    for h in hs:
+        ref = solve(kw["fun"], (t0, t0 + h), x0, "DOP853", n2=problem.n2, rtol=reference_rtol,
+                    atol=reference_rtol * scales)
+        if not ref.success:
+            raise InputError("--hs", h, f"must allow the reference run (DOP853 at rtol {reference_rtol:g}): "
+                             f"{ref.message}")
+        exact.append(ref.y[:, -1])
+    system = as_system(kw["fun"], x0, n2=problem.n2, jac=kw.get("jac"), jac_sparsity=kw.get("jac_sparsity"))
+    rows = []
+    for label, method, opts in methods:
+        nominal = METHODS[method](system, None, **opts).order
+        errs = []
+        for h, x_ref in zip(hs, exact):
+            res = solve(**{**kw, "t_span": (t0, t0 + h)}, method=method, h=h, adaptive=False, **opts)
+            ok = res.success and np.all(np.isfinite(res.y[:, -1]))
+            errs.append(float(np.max(np.abs(res.y[:, -1] - x_ref) / scales)) if ok else np.inf)
+        p_eff = [np.nan, *effective_order(hs, np.where(np.isfinite(errs), errs, np.nan))]
+        rows += [{"label": label, "method": method, "h": float(h), "error": e, "p_eff": float(q), "nominal": nominal}
+                 for h, e, q in zip(hs, errs, p_eff)]
+    return rows
+
+
+def state_at(problem: Problem, t: float, method: str = "Radau", rtol: float = 1e-8) -> np.ndarray:
+    """The state of ``problem`` at time ``t`` (s) by ``method`` at ``rtol`` (``atol = 1e-3 rtol``): the start of
+    test 1 inside the run (its start state is the quasi-static one, where the pins on the arcs stick)."""
+    from cvtfem.integrate import solve
+
+    if t <= problem.t_span[0]:
+        return np.asarray(problem.y0, float)
+    res = solve(**{**problem.solve_kwargs(), "t_span": (problem.t_span[0], t)}, method=method, rtol=rtol,
+                atol=1e-3 * rtol)
+    if not res.success:
+        raise InputError("--local-at", t, f"must be reached by {method} at rtol {rtol:g}: {res.message}")
+    return res.y[:, -1]

@@ -1,6 +1,7 @@
-"""``cvtfem study accuracy-cost SCENE``: what accuracy costs on a chain transmission (issue 16; spec
+"""``cvtfem study accuracy-cost SCENE``: what accuracy costs on a CVT transmission (issue 16; spec
 numerics-and-periodic section 9): Jacobian spectra with ``v0`` and ``v0/10``, the global error ``E`` of a
-pin's axial force over a window for every method and step or tolerance, its cost, and the speed-up table."""
+pin's axial force over a window for every method and step or tolerance, its cost, and the speed-up table;
+with ``--local``, test 1 instead: the local error of one step and the effective order of every method."""
 from __future__ import annotations
 
 import argparse
@@ -11,6 +12,9 @@ import math
 MAX_SETTINGS = 20
 MAX_FIXED_STEPS = 2_000_000     # steps of one fixed-step run
 MAX_SAMPLES = 100_000           # output samples in the window
+MAX_LOCAL_HS = 40               # steps of test 1
+#: Steps of test 1 by default, s: the source's grid 1e-8 .. 1e-5 (section 9.4).
+LOCAL_HS = "1e-8:1e-5:13"
 #: The source's Table 2.4 baseline: RK4 at this step, s.
 BASELINE_H = 5e-8
 
@@ -34,6 +38,14 @@ def add_subparser(s) -> None:
                    help="Jacobian eigenvalues at the window's start, with v0 and v0/10")
     e.add_argument("--csv", default="out/studies/accuracy_cost.csv", help="one row per run")
     e.add_argument("--json", default="out/studies/accuracy_cost.json", help="reference report and speed-up table")
+    e.add_argument("--local", action="store_true",
+                   help="test 1 instead of test 2: local error of one step against h and the effective order")
+    e.add_argument("--methods", default="", help="with --local: methods (default every method of the playground)")
+    e.add_argument("--hs", default=LOCAL_HS, help="with --local: steps LO:HI:COUNT (log grid) or a list, s")
+    e.add_argument("--local-at", type=float, default=None,
+                   help="with --local: time of the state the steps start from, s (default T1 of --window)")
+    e.add_argument("--local-png", default="out/studies/accuracy_cost_local.png", help="with --local: e(h) and p~(h)")
+    e.add_argument("--local-csv", default="out/studies/accuracy_cost_local.csv", help="with --local: one row per step")
 
 
 def _pair(text: str, where: str) -> tuple[str, float]:
@@ -74,6 +86,66 @@ def _check(args, fixed, steps, adaptive, rtols, window) -> None:
         raise InputError("--repeats", args.repeats, "must be 1..100")
 
 
+def _local_steps(text: str) -> list[float]:
+    """``LO:HI:COUNT`` (log grid) or a comma-separated list of steps, s."""
+    from cvtfem.commands.study import _floats
+    from cvtfem.errors import InputError
+
+    import numpy as np
+
+    if ":" in text:
+        try:
+            lo, hi, count = (float(v) for v in text.split(":"))
+        except ValueError:
+            lo = hi = count = math.nan
+        if not (0 < lo < hi < 1 and 2 <= count <= MAX_LOCAL_HS and count == int(count)):
+            raise InputError("--hs", text, f"must be LO:HI:COUNT with 0 < LO < HI < 1 s and 2 <= COUNT <= "
+                             f"{MAX_LOCAL_HS}, or a list of steps")
+        return [float(h) for h in np.geomspace(lo, hi, int(count))]
+    hs = _floats(text, "--hs")
+    if not (2 <= len(hs) <= MAX_LOCAL_HS and all(math.isfinite(h) and 0 < h < 1 for h in hs)):
+        raise InputError("--hs", text, f"must be 2..{MAX_LOCAL_HS} steps in (0, 1) s")
+    return hs
+
+
+def run_local(args: argparse.Namespace, window) -> int:
+    """Test 1 (section 9.4): one step of every method from a state of the run, at every step of ``--hs``."""
+    import dataclasses
+
+    from cvtfem.analysis import accuracy_cost as ac
+    from cvtfem.commands.study import _out, parse_method
+    from cvtfem.errors import InputError
+    from cvtfem.integrate.methods import METHODS
+    from cvtfem.post import accuracy_cost as plots
+    from cvtfem.post.integrators import write_csv
+    from cvtfem.scene.loader import load_scene
+
+    names = [m for m in args.methods.split(",") if m.strip()] or list(METHODS)
+    methods = [parse_method(m) for m in names]
+    for _, method, _ in methods:
+        if method not in METHODS:
+            raise InputError("--methods", method, "must name fixed-step methods of the playground: "
+                             + ", ".join(sorted(METHODS)))
+    hs = _local_steps(args.hs)
+    t_at = window[0] if args.local_at is None else args.local_at
+    if not (math.isfinite(t_at) and 0 <= t_at <= window[1]):
+        raise InputError("--local-at", t_at, f"must be a time in 0..{window[1]:g} s (T2 of --window)")
+    reference = _pair(args.reference, "--reference")
+    scene = load_scene(args.scene)
+    problem, _ = ac.pin_force_problem(scene, (0.0, window[1]), window[1] / 4, reference, reference)
+    x = ac.state_at(problem, t_at, *reference)
+    rows = ac.local_error_table(dataclasses.replace(problem, y0=x, t_span=(t_at, window[1])), methods, hs)
+    print(f"{args.scene}: local error of one step from the state at t = {t_at:g} s ({len(x)} states; norm: max over "
+          f"components of |error| / block scale)")
+    for label in dict.fromkeys(r["label"] for r in rows):
+        mine = [r for r in rows if r["label"] == label]
+        print(f"{label:28s} nominal {mine[0]['nominal']}  p~ = " + " ".join(f"{r['p_eff']:5.2f}" for r in mine[1:]))
+    plots.plot_local_errors(rows, _out(args.local_png), f"{args.scene}: test 1 from the state at t = {t_at:g} s")
+    write_csv(rows, _out(args.local_csv))
+    print(f"wrote {args.local_png}, {args.local_csv}")
+    return 0
+
+
 def run(args: argparse.Namespace) -> int:
     from cvtfem.analysis import accuracy_cost as ac
     from cvtfem.analysis.timing import machine
@@ -89,6 +161,8 @@ def run(args: argparse.Namespace) -> int:
         window = ()
     if len(window) != 2 or not (0 <= window[0] < window[1] <= 1.0):
         raise InputError("--window", args.window, "must be T1:T2 in s with 0 <= T1 < T2 <= 1")
+    if args.local:
+        return run_local(args, window)
     fixed = [parse_method(m) for m in args.fixed.split(",") if m.strip()]
     adaptive = [parse_method(m) for m in args.adaptive.split(",") if m.strip()]
     steps, rtols = _floats(args.steps, "--steps"), _floats(args.rtols, "--rtols")
@@ -96,29 +170,48 @@ def run(args: argparse.Namespace) -> int:
     reference, check = _pair(args.reference, "--reference"), _pair(args.check, "--check")
     scene = load_scene(args.scene)
     problem, report = ac.pin_force_problem(scene, window, args.sample, reference, check)
-    print(f"{args.scene}: {report['start']}; pin {report['pin']} axial force {report['force_range_N'][0]:.0f}.."
-          f"{report['force_range_N'][1]:.0f} N over {window[0]:g}..{window[1]:g} s; references {report['reference']}"
+    what = ("pin {} axial force, N" if report["output"] == ac.PIN_FORCE else "Gauss node {} sheave normal force, N/m")
+    print(f"{args.scene}: {report['start']}; {what.format(report['pin'])} {report['force_range'][0]:.0f}.."
+          f"{report['force_range'][1]:.0f} over {window[0]:g}..{window[1]:g} s; references {report['reference']}"
           f" and {report['check']} differ by E = {report['reference_E']:.2e}")
     lam, lam_v0 = ac.spectrum_with_v0(scene, problem.y0)
     v0 = scene.cvt.friction.v0
     plots.plot_spectra({f"v0 = {v0:g} m/s": lam, f"v0 = {v0 / 10:g} m/s": lam_v0}, _out(args.spectrum_png),
                        f"{args.scene}: Jacobian eigenvalues at the start state ({len(lam)} states)")
     rows = ac.measure(problem, fixed, steps, adaptive, rtols, args.repeats)
-    base = [r for r in rows if r["method"] == "rk4" and r.get("h") == BASELINE_H]
-    table = ac.speedups(rows, base[0] if base else None)
-    print(f"{'method':<22}{'setting':>12}{'E':>11}{'wall s':>9}{'RHS':>9}{'speed-up':>10}   "
-          f"(cheapest run with E <= {ac.ACCEPT_E}; baseline rk4 h={BASELINE_H:g})")
-    for t in table:
-        if t["setting"] is None:
-            print(f"{t['label']:<22}{'none':>12}")
-            continue
-        up = f"{t['speedup']:.1f}x" if t["speedup"] else "-"
-        print(f"{t['label']:<22}{t['setting']:>12}{t['error']:>11.2e}{t['time']:>9.2f}{t['nfev']:>9}{up:>10}")
+    base = ac.baseline_time(rows, BASELINE_H, window[1])
+    table = ac.speedups(rows, base)
+    how = ("none: no rk4 runs" if base is None else
+           f"{base['time']:.1f} s, " + ("estimated from the rk4 runs' wall time per RHS call" if base["estimated"]
+                                        else "measured"))
+    print(f"cheapest run with E <= {ac.ACCEPT_E} per method; speed-up over rk4 at h = {BASELINE_H:g} s ({how})")
+    for line in markdown_table(table):
+        print(line)
     plots.plot_accuracy_cost(rows, _out(args.png), ac.ACCEPT_E,
-                             f"{args.scene}: E of pin {report['pin']}'s axial force over {window[0]:g}..{window[1]:g} s"
+                             f"{args.scene}: E of {what.format(report['pin'])} over {window[0]:g}..{window[1]:g} s"
                              f" vs reference {report['reference']}")
     write_csv(rows, _out(args.csv))
     with open(_out(args.json), "w", encoding="utf-8") as fh:
-        json.dump({"scene": args.scene, "machine": machine(), "reference": report, "speedups": table}, fh, indent=1)
+        json.dump({"scene": args.scene, "machine": machine(), "reference": report, "baseline": base,
+                   "wall_per_simulated_s": wall_per_simulated_second(table, window[1]), "speedups": table}, fh, indent=1)
     print(f"wrote {args.png}, {args.spectrum_png}, {args.csv}, {args.json}")
     return 0
+
+
+def wall_per_simulated_second(table, t_end: float) -> dict:
+    """Wall time (s) per simulated second of each method's cheapest accepted run over ``[0, t_end]``."""
+    return {t["label"]: t["time"] / t_end for t in table if t["time"] is not None}
+
+
+def markdown_table(table) -> list[str]:
+    """The speed-up table in the style of the source's Table 2.4, as Markdown lines."""
+    lines = ["| method | cheapest setting with E <= 0.05 | E | wall s | RHS calls | Jacobians | LUs | steps | speed-up |",
+             "|---|---|---|---|---|---|---|---|---|"]
+    for t in table:
+        if t["setting"] is None:
+            lines.append(f"| {t['label']} | none | | | | | | | |")
+            continue
+        up = f"{t['speedup']:.1f}x" if t["speedup"] else "-"
+        lines.append(f"| {t['label']} | {t['setting']} | {t['error']:.2e} | {t['time']:.2f} | {t['nfev']} | "
+                     f"{t['njev']} | {t['nlu']} | {t['nsteps']} | {up} |")
+    return lines

@@ -75,3 +75,33 @@ def plot_accuracy_cost(rows, path: str | Path, accept: float, title: str = "") -
     fig.savefig(path, dpi=120)
     plt.close(fig)
     return Path(path)
+
+
+def plot_local_errors(rows, path: str | Path, title: str = "") -> Path:
+    """Test 1: local error e(h) of one step (left) and the effective order p~(h) (right, at the geometric mean
+    of neighbouring steps) of each method; its nominal order dotted on the right."""
+    fig, (a1, a2) = plt.subplots(1, 2, figsize=(13, 5.5))
+    labels = list(dict.fromkeys(r["label"] for r in rows))
+    colours = plt.get_cmap("tab20")(np.linspace(0, 1, max(len(labels), 2)))
+    for k, (label, colour) in enumerate(zip(labels, colours)):
+        mine = [r for r in rows if r["label"] == label]
+        hs = np.array([r["h"] for r in mine])
+        errs = np.array([r["error"] for r in mine])
+        style = ("-", "--", "-.", ":")[k % 4]
+        finite = np.isfinite(errs) & (errs > 0)
+        a1.loglog(hs[finite], errs[finite], "o" + style, ms=3, color=colour, label=f"{label} ({mine[0]['nominal']})")
+        p = np.array([r["p_eff"] for r in mine[1:]], float)
+        a2.semilogx(np.sqrt(hs[:-1] * hs[1:]), p, "o" + style, ms=3, color=colour)
+    a1.set_xlabel("step h, s")
+    a1.set_ylabel("local error e(h), weighted max norm")
+    a2.set_xlabel("step h, s")
+    a2.set_ylabel("effective order p~ = d ln e / d ln h - 1")
+    a2.set_ylim(-1, 9)
+    a1.legend(fontsize=6, ncol=2, loc="upper left", title="method (nominal order)", title_fontsize=7)
+    for ax in (a1, a2):
+        ax.grid(alpha=0.3, which="both")
+    fig.suptitle(title or "local error and effective order", fontsize=9)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return Path(path)

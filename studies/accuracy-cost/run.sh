@@ -1,0 +1,46 @@
+#!/usr/bin/env bash
+# Regenerates every figure, CSV and JSON of studies/accuracy-cost/README.md (issue 16; spec
+# numerics-and-periodic section 9) into studies/accuracy-cost/results/.  Run from the repository root:
+#     bash studies/accuracy-cost/run.sh            # all (about 2 h of one core)
+#     bash studies/accuracy-cost/run.sh chain-S2   # the chain-S2 part only (also chain-A1, band, local)
+# Each test-2 run prints its speed-up table (Table 2.4 style); the logs go next to the results.
+set -euo pipefail
+cd "$(dirname "$0")/../.."
+out=studies/accuracy-cost/results
+mkdir -p "$out"
+cvtfem=${CVTFEM:-.venv/bin/cvtfem}
+part=${1:-all}
+
+test2() {  # test2 TAG SCENE ARGS...: spectra with v0 and v0/10, test 2, table
+  local tag=$1 scene=$2; shift 2
+  nice "$cvtfem" study accuracy-cost "$scene" "$@" \
+    --png "$out/$tag.png" --spectrum-png "$out/$tag-spectrum.png" --csv "$out/$tag.csv" --json "$out/$tag.json" \
+    | tee "$out/$tag.log"
+  uptime | tee -a "$out/$tag.log"
+}
+
+for law in linear-saturated smoothed; do
+  if [[ $part == all || $part == chain-S2 || $part == "chain-S2-$law" ]]; then
+    test2 "chain-S2-$law" "studies/accuracy-cost/scenes/chain-S2-chapter2-$law.toml" \
+      --window 1e-3:5e-3 --sample 1e-5 --fixed rk4,dopri45,gbs-smooth:stages=2 --steps 1e-6,2e-6,4e-6 \
+      --adaptive Radau,BDF,rodas5p,dopri45,rock4 --rtols 1e-1,1e-2,1e-3 --repeats 1 \
+      --reference Radau:1e-7 --check rodas5p:1e-7
+  fi
+done
+if [[ $part == all || $part == chain-A1 ]]; then   # A1 costs ~20x S2 per RHS call: a 2 ms run, one law
+  test2 chain-A1-linear-saturated studies/accuracy-cost/scenes/chain-A1-chapter2-linear-saturated.toml \
+    --window 1e-3:2e-3 --sample 1e-5 --fixed rk4 --steps 2e-6,4e-6 \
+    --adaptive rodas5p,dopri45,rock4 --rtols 1e-2 --repeats 1 --reference Radau:1e-6 --check rodas5p:1e-6
+fi
+if [[ $part == all || $part == band ]]; then
+  test2 band-6+2n band-6+2n,regime-chapter2 --window 1e-3:5e-3 --sample 1e-5 --fixed rk4,dopri45 \
+    --steps 5e-8,1e-6,2e-6,5e-6,1e-5 --adaptive Radau,BDF,rodas5p,dopri45,rock4 --rtols 1e-1,1e-2,1e-3 --repeats 3
+fi
+if [[ $part == all || $part == local ]]; then   # test 1: every playground method, one step from the state at 1 ms
+  for law in linear-saturated smoothed; do
+    nice "$cvtfem" study accuracy-cost "studies/accuracy-cost/scenes/chain-S2-chapter2-$law.toml" --local \
+      --window 1e-3:5e-3 --hs 1e-8:1e-5:13 \
+      --local-png "$out/chain-S2-$law-local.png" --local-csv "$out/chain-S2-$law-local.csv" \
+      | tee "$out/chain-S2-$law-local.log"
+  done
+fi
