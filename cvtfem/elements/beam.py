@@ -14,12 +14,15 @@ element of §3.1.  The gyroscopic matrix per unit spin speed is
 force ``P`` (tension > 0) is ``P * int Nw'^T Nw' dx`` (exact 4-point Gauss).
 
 Tapered elements (outer/inner diameter varying linearly from the left to the
-right end) integrate the varying section over the same shape functions by
-6-point Gauss quadrature (exact: the integrands are polynomials of degree <= 10
-in x): ``K = int EI Nb'^T Nb' + kappa G A (Nw' - Nb)^T (Nw' - Nb) dx``,
-``M = int rho A Nw^T Nw + rho I Nb^T Nb dx``; their shear parameter ``phi``
-takes the element-mean ``A`` and ``I``.  With equal ends these integrals equal
-the closed forms above to round-off.
+right end) integrate the varying section by 6-point Gauss quadrature: the
+bending stiffness is the inverse of the element's flexibility as a cantilever,
+``int [[s^2/EI + 1/kappa G A, s/EI], [s/EI, 1/EI]] dx`` (exact under nodal
+loads, like the uniform element; integrating ``EI Nb'^T Nb' + kappa G A
+gamma^T gamma`` over the shape functions instead converges only as h^2 with
+shear, because their fixed ``phi`` cannot follow the section), the mass
+``M = int rho A Nw^T Nw + rho I Nb^T Nb dx`` over the shape functions of the
+element-mean ``phi`` (exact: polynomials of degree <= 10).  With equal ends
+both equal the closed forms above to round-off.
 """
 from __future__ import annotations
 
@@ -214,11 +217,36 @@ class BeamFamily:
         G[:, PLANE2[:, None], PLANE1] = -R * SIGN2[None, :, None]
         return G
 
+    def _flexibility_stiffness(self, eta: np.ndarray, w: np.ndarray, A: np.ndarray, I: np.ndarray,
+                               ratio: np.ndarray) -> np.ndarray:
+        """(n, 4, 4) bending stiffness from the element's flexibility as a cantilever (exact under nodal loads).
+
+        Right-end deflection and rotation under a right-end force and moment: ``F = int [[s^2/EI + 1/kGA, s/EI],
+        [s/EI, 1/EI]] dx`` with ``s = L - x`` (the shear term only with ``options.shear``); ``K22 = F^-1`` and the
+        left-end rows follow from equilibrium ``(V1, M1) = -(V2, M2 + L V2)``.
+        """
+        s = self.L[:, None] * (1 - eta)
+        EI = self.E[:, None] * I
+        F = np.empty((len(self.L), 2, 2))
+        F[:, 0, 0] = np.sum(w * s**2 / EI, axis=1)
+        F[:, 0, 1] = F[:, 1, 0] = np.sum(w * s / EI, axis=1)
+        F[:, 1, 1] = np.sum(w / EI, axis=1)
+        if self.options.shear:
+            kappa = self.shear_coefficient[:, None] if self.kappa is not None else \
+                cowper_kappa((self.E / (2 * self.G) - 1)[:, None], ratio)
+            F[:, 0, 0] += np.sum(w / (kappa * self.G[:, None] * A), axis=1)
+        K22 = np.linalg.inv(F)
+        T = np.zeros_like(F)
+        T[:, 0, 0] = T[:, 1, 1] = -1.0
+        T[:, 1, 0] = -self.L
+        TK = T @ K22
+        return np.block([[TK @ np.swapaxes(T, 1, 2), TK], [np.swapaxes(TK, 1, 2), K22]])
+
     def integrated_blocks(self) -> dict[str, np.ndarray]:
         """Bending blocks of every element by Gauss quadrature of its (linearly tapered) section.
 
-        Returns ``stiffness`` = ``int EI Nb'^T Nb' + kappa G A (Nw' - Nb)^T (Nw' - Nb) dx`` (the shear term only
-        with ``options.shear``), ``mass`` = ``int rho A Nw^T Nw dx``, ``rotary`` = ``int rho I Nb^T Nb dx`` (each
+        Returns ``stiffness`` from the flexibility ``int`` of the varying ``1/EI`` and ``1/kappa G A`` (exact under
+        nodal loads, :meth:`_flexibility_stiffness`), ``mass`` = ``int rho A Nw^T Nw dx``, ``rotary`` = ``int rho I Nb^T Nb dx`` (each
         (n, 4, 4), per bending plane) and the (n, 2, 2) ``axial_mass`` / ``torsion_mass`` of the linear bar
         shape functions with ``rho A`` / ``rho 2I``.  For uniform elements these equal the closed forms.
         """
@@ -228,13 +256,8 @@ class BeamFamily:
         Do, Di, Dor, Dir = self.ends
         do, di = Do[:, None] + (Dor - Do)[:, None] * eta, Di[:, None] + (Dir - Di)[:, None] * eta
         A, I = np.pi / 4 * (do**2 - di**2), np.pi / 64 * (do**4 - di**4)
-        Nw, dNw, Nb, dNb = shape_functions(eta, L, ph)
-        K = np.einsum("ng,ngi,ngj->nij", w * self.E[:, None] * I, dNb, dNb)
-        if self.options.shear:
-            kappa = self.shear_coefficient[:, None] if self.kappa is not None else \
-                cowper_kappa((self.E / (2 * self.G) - 1)[:, None], di / do)
-            gamma = dNw - Nb
-            K = K + np.einsum("ng,ngi,ngj->nij", w * kappa * self.G[:, None] * A, gamma, gamma)
+        Nw, _, Nb, _ = shape_functions(eta, L, ph)
+        K = self._flexibility_stiffness(eta, w, A, I, di / do)
         bar = np.stack([1 - eta, eta], axis=-1)
         rho = self.rho[:, None]
         return {"stiffness": K, "mass": np.einsum("ng,ngi,ngj->nij", w * rho * A, Nw, Nw),
