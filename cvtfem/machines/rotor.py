@@ -117,8 +117,11 @@ class RotorModel(ModelBase):
         return tuple(out)
 
     def support_stiffness(self) -> sp.csr_matrix:
-        """``(n, n)`` stiffness of all bearings (and tabulated ones at the model's speed), N/m, N m/rad."""
-        K = assemble(self.n_dof, self.bearings.relative(self.bearings.stiffness()))
+        """``(n, n)`` stiffness of the bearings on shaft nodes, to ground or linked to a support node (and the
+        tabulated ones at the model's speed), N/m, N m/rad; the supports of pedestal nodes are not included."""
+        blocks = self.bearings.stiffness()
+        blocks[self.bearings.nodes >= self.n_shaft_nodes] = 0.0
+        K = assemble(self.n_dof, self.bearings.relative(blocks))
         if self.tables is not None:
             K = K + _lateral(self.n_dof, self.tables.nodes, self.tables.blocks(self.speed)[0])
         return K.tocsr()

@@ -103,3 +103,12 @@ def test_bad_links_are_rejected(change, key):
     with pytest.raises(InputError) as err:
         build_model(scene_from_dict(data))
     assert err.value.where == key
+
+
+def test_support_stiffness_holds_the_shaft_bearings_and_leaves_the_pedestals_on_their_springs():
+    """The critical-speed map replaces the bearings on shaft nodes (here the links); the pedestal supports stay."""
+    model = build_model(scene_from_dict(pedestal_rotor()))
+    free = (model.K - model.support_stiffness()).toarray()
+    shaft_only = build_model(scene_from_dict(dict(pedestal_rotor(), bearing=[]))).K.toarray()
+    np.testing.assert_allclose(free[:18, :18], shaft_only, rtol=0, atol=1e-9 * np.abs(shaft_only).max())
+    assert free[18, 18] == K2 and free[24, 24] == K2 and not np.any(free[:18, 18:])
