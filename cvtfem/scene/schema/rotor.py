@@ -111,8 +111,8 @@ DISK = TableArray("disk", "Rigid disks / sheaves on shaft nodes.", Table("disk",
 BEARING = TableArray("bearing", "Bearings (supports to ground or between two nodes) on shaft nodes.", Table(
     "bearing", "A bearing.", (
     Key("node", "int", "Shaft node the bearing supports (or a support node, see `link_node`).", "-", ge=0),
-    Key("link_node", "int", "-1: the bearing acts to ground; else the node it connects `node` to (ROSS `n_link`): "
-        "its coefficients act on the relative motion u_node - u_link. A shaft node, or a support node numbered "
+    Key("link_node", "int", "Node the bearing connects `node` to (ROSS `n_link`; -1: ground): its coefficients "
+        "act on the relative motion u_node - u_link. A shaft node, or a support node numbered "
         "after the shaft's (n_shaft_nodes, n_shaft_nodes + 1, ..: a pedestal, which gets its mass and its own "
         "support from a `[[bearing]]` whose `node` it is).", "-", -1, ge=-1),
     *(Key(f"k{ij}", "float", f"Lateral stiffness coefficient {ij}.", "N/m", 0.0) for ij in ("xx", "yy", "xy", "yx")),
