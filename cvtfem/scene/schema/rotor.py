@@ -244,8 +244,8 @@ def _check_links(bearings: list, n_nodes: int) -> None:
                          f"{n_nodes + 1}, .. without gaps (the shaft has nodes 0..{n_nodes - 1})")
     for i, b in enumerate(bearings):
         if b["node"] >= n_nodes and b["node"] not in supports:
-            raise InputError(f"bearing[{i}].node", b["node"], f"must be a shaft node 0..{n_nodes - 1} or a support "
-                             f"node some bearing's `link_node` names ({supports or 'none'})")
+            raise InputError(f"bearing[{i}].node", b["node"], f"must be a shaft node, 0..{n_nodes - 1} (or a support "
+                             f"node some bearing's `link_node` names: {supports or 'none'})")
         if b["link_node"] == b["node"]:
             raise InputError(f"bearing[{i}].link_node", b["link_node"], "must differ from `node` (or be -1: ground)")
         if b["link_node"] >= 0 and b["speeds"]:
