@@ -245,9 +245,9 @@ class BeamFamily:
     def integrated_blocks(self) -> dict[str, np.ndarray]:
         """Bending blocks of every element by Gauss quadrature of its (linearly tapered) section.
 
-        Returns ``stiffness`` from the flexibility ``int`` of the varying ``1/EI`` and ``1/kappa G A`` (exact under
-        nodal loads, :meth:`_flexibility_stiffness`), ``mass`` = ``int rho A Nw^T Nw dx``, ``rotary`` = ``int rho I Nb^T Nb dx`` (each
-        (n, 4, 4), per bending plane) and the (n, 2, 2) ``axial_mass`` / ``torsion_mass`` of the linear bar
+        Returns ``stiffness`` from the flexibility integrals of the varying ``1/EI`` and ``1/kappa G A`` (exact
+        under nodal loads, :meth:`_flexibility_stiffness`), ``mass`` = ``int rho A Nw^T Nw dx``, ``rotary`` =
+        ``int rho I Nb^T Nb dx`` (each (n, 4, 4), per bending plane) and the (n, 2, 2) ``axial_mass`` / ``torsion_mass`` of the linear bar
         shape functions with ``rho A`` / ``rho 2I``.  For uniform elements these equal the closed forms.
         """
         L, ph = self.L, self.phi
