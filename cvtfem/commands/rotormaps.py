@@ -49,7 +49,7 @@ def _supports(text: str | None, model) -> list[int]:  # noqa: ANN001
         model.support_dofs(nodes)  # checks the range
         return nodes
     b = model.bearings
-    lateral = (np.abs(b.kxx) + np.abs(b.kyy)) > 0
+    lateral = ((np.abs(b.kxx) + np.abs(b.kyy)) > 0) & (b.nodes < model.n_shaft_nodes)  # not pedestals' own
     nodes = sorted(set(b.nodes[lateral].tolist()) | set(model.tables.nodes.tolist() if model.tables else ()))
     if not nodes:
         raise InputError("--supports", "", "is needed: the scene has no bearing with lateral stiffness")

@@ -12,6 +12,17 @@ for a uniform element under nodal loads, shear parameter ``phi = 12 EI /
 element of §3.1.  The gyroscopic matrix per unit spin speed is
 ``G8 = rho Ip [[0, R], [-R, 0]]`` (§12.2a), the geometric stiffness of an axial
 force ``P`` (tension > 0) is ``P * int Nw'^T Nw' dx`` (exact 4-point Gauss).
+
+Tapered elements (outer/inner diameter varying linearly from the left to the
+right end) integrate the varying section by 6-point Gauss quadrature: the
+bending stiffness is the inverse of the element's flexibility as a cantilever,
+``int [[s^2/EI + 1/kappa G A, s/EI], [s/EI, 1/EI]] dx`` (exact under nodal
+loads, like the uniform element; integrating ``EI Nb'^T Nb' + kappa G A
+gamma^T gamma`` over the shape functions instead converges only as h^2 with
+shear, because their fixed ``phi`` cannot follow the section), the mass
+``M = int rho A Nw^T Nw + rho I Nb^T Nb dx`` over the shape functions of the
+element-mean ``phi`` (exact: polynomials of degree <= 10).  With equal ends
+both equal the closed forms above to round-off.
 """
 from __future__ import annotations
 
@@ -77,12 +88,14 @@ class BeamFamily:
     nodes : int array (n, 2)
         Global node numbers of the element ends.
     L, Do, Di : arrays (n,)
-        Length, outer and inner diameter, m.
+        Length, outer and inner diameter (at the left end of tapered elements), m.
     E, G, rho : arrays (n,)
         Young's and shear modulus (Pa), density (kg/m^3).
     kappa : array (n,), optional
         Shear coefficient; default Cowper's formula for the hollow circle.
     options : BeamOptions
+    Do_right, Di_right : arrays (n,), optional
+        Outer and inner diameter at the right end, m (default: uniform elements).
     """
 
     nodes: np.ndarray
@@ -94,32 +107,54 @@ class BeamFamily:
     rho: np.ndarray
     kappa: np.ndarray | None = None
     options: BeamOptions = field(default_factory=BeamOptions)
+    Do_right: np.ndarray | None = None
+    Di_right: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         for name in ("L", "Do", "E", "G", "rho"):
             v = np.asarray(getattr(self, name), dtype=float)
             if v.shape != (len(self.nodes),) or not np.all(np.isfinite(v)) or np.any(v <= 0):
                 raise InputError(f"BeamFamily.{name}", v, f"must be {len(self.nodes)} positive finite numbers")
-        if np.any(np.asarray(self.Di) < 0) or np.any(np.asarray(self.Di) >= np.asarray(self.Do)):
-            raise InputError("BeamFamily.Di", self.Di, "must satisfy 0 <= Di < Do")
+        for inner, outer in (("Di", "Do"), ("Di_right", "Do_right")):
+            Di = self.Di if getattr(self, inner) is None else getattr(self, inner)
+            Do = self.Do if getattr(self, outer) is None else getattr(self, outer)
+            if np.shape(Do) != (len(self.nodes),) or np.shape(Di) != (len(self.nodes),):
+                raise InputError(f"BeamFamily.{outer}", Do, f"must have {len(self.nodes)} values, as {inner}")
+            if np.any(np.asarray(Di) < 0) or np.any(np.asarray(Di) >= np.asarray(Do)):
+                raise InputError(f"BeamFamily.{inner}", Di, f"must satisfy 0 <= {inner} < {outer}")
 
     # -- section properties -------------------------------------------------
     @property
+    def ends(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """``(Do, Di, Do_right, Di_right)``: the diameters at both ends (equal for uniform elements), m."""
+        right = (self.Do if self.Do_right is None else self.Do_right, self.Di if self.Di_right is None else self.Di_right)
+        return (np.asarray(self.Do, float), np.asarray(self.Di, float), *(np.asarray(r, float) for r in right))
+
+    @property
+    def tapered(self) -> np.ndarray:
+        """Boolean (n,): elements whose diameters differ between the ends."""
+        Do, Di, Dor, Dir = self.ends
+        return (Do != Dor) | (Di != Dir)
+
+    @property
     def area(self) -> np.ndarray:
-        """Section area A, m^2."""
-        return np.pi / 4 * (self.Do**2 - self.Di**2)
+        """Section area A (element mean of tapered elements), m^2."""
+        Do, Di, Dor, Dir = self.ends
+        return np.pi / 4 * (_mean_power(Do, Dor, 2) - _mean_power(Di, Dir, 2))
 
     @property
     def inertia(self) -> np.ndarray:
-        """Second moment of area I about a diameter, m^4."""
-        return np.pi / 64 * (self.Do**4 - self.Di**4)
+        """Second moment of area I about a diameter (element mean of tapered elements), m^4."""
+        Do, Di, Dor, Dir = self.ends
+        return np.pi / 64 * (_mean_power(Do, Dor, 4) - _mean_power(Di, Dir, 4))
 
     @property
     def shear_coefficient(self) -> np.ndarray:
-        """kappa: given, else Cowper's hollow-circle formula with nu = E/2G - 1."""
+        """kappa: given, else Cowper's hollow-circle formula with nu = E/2G - 1 (mid-element diameters)."""
         if self.kappa is not None:
             return np.asarray(self.kappa, dtype=float)
-        return cowper_kappa(self.E / (2 * self.G) - 1, self.Di / self.Do)
+        Do, Di, Dor, Dir = self.ends
+        return cowper_kappa(self.E / (2 * self.G) - 1, (Di + Dir) / (Do + Dor))
 
     @property
     def phi(self) -> np.ndarray:
@@ -139,6 +174,9 @@ class BeamFamily:
         """Elastic stiffness (+ geometric stiffness of the axial force ``P``, N, tension > 0)."""
         L, EI, ph = self.L, self.E * self.inertia, self.phi
         Kb = EI[:, None, None] / ((1 + ph) * L**3)[:, None, None] * _kb_pattern(L, ph)
+        t = self.tapered
+        if np.any(t):
+            Kb[t] = self.integrated_blocks()["stiffness"][t]
         P = np.broadcast_to(np.asarray(axial_force, dtype=float), L.shape)
         if np.any(P != 0):
             Kb = Kb + P[:, None, None] * _geometric(L, ph)
@@ -153,10 +191,16 @@ class BeamFamily:
         Mb = rA[:, None, None] * _mt(L, ph)
         if self.options.rotary_inertia:
             Mb = Mb + (self.rho * self.inertia)[:, None, None] * _rot(L, ph)
-        M = _planes(Mb, Mb)
         bar = (L / 6)[:, None, None] * _BAR_M
-        M[:, AXIAL[:, None], AXIAL] += rA[:, None, None] * bar
-        M[:, TORSION[:, None], TORSION] += (self.rho * 2 * self.inertia)[:, None, None] * bar
+        axial, torsion = rA[:, None, None] * bar, (self.rho * 2 * self.inertia)[:, None, None] * bar
+        t = self.tapered
+        if np.any(t):
+            q = self.integrated_blocks()
+            Mb[t] = q["mass"][t] + (q["rotary"][t] if self.options.rotary_inertia else 0.0)
+            axial[t], torsion[t] = q["axial_mass"][t], q["torsion_mass"][t]
+        M = _planes(Mb, Mb)
+        M[:, AXIAL[:, None], AXIAL] += axial
+        M[:, TORSION[:, None], TORSION] += torsion
         return M
 
     def gyroscopic(self) -> np.ndarray:
@@ -165,11 +209,70 @@ class BeamFamily:
         if not self.options.gyroscopic:
             return G
         R = (self.rho * 2 * self.inertia)[:, None, None] * _rot(self.L, self.phi)
+        t = self.tapered
+        if np.any(t):
+            R[t] = 2 * self.integrated_blocks()["rotary"][t]
         # plane-1 rows, plane-2 columns: +rho Ip R (spec §12.2a), with the plane-2 signs
         G[:, PLANE1[:, None], PLANE2] = R * SIGN2[None, None, :]
         G[:, PLANE2[:, None], PLANE1] = -R * SIGN2[None, :, None]
         return G
 
+    def _flexibility_stiffness(self, eta: np.ndarray, w: np.ndarray, A: np.ndarray, I: np.ndarray,
+                               ratio: np.ndarray) -> np.ndarray:
+        """(n, 4, 4) bending stiffness from the element's flexibility as a cantilever (exact under nodal loads).
+
+        Right-end deflection and rotation under a right-end force and moment: ``F = int [[s^2/EI + 1/kGA, s/EI],
+        [s/EI, 1/EI]] dx`` with ``s = L - x`` (the shear term only with ``options.shear``); ``K22 = F^-1`` and the
+        left-end rows follow from equilibrium ``(V1, M1) = -(V2, M2 + L V2)``.
+        """
+        s = self.L[:, None] * (1 - eta)
+        EI = self.E[:, None] * I
+        F = np.empty((len(self.L), 2, 2))
+        F[:, 0, 0] = np.sum(w * s**2 / EI, axis=1)
+        F[:, 0, 1] = F[:, 1, 0] = np.sum(w * s / EI, axis=1)
+        F[:, 1, 1] = np.sum(w / EI, axis=1)
+        if self.options.shear:
+            kappa = self.shear_coefficient[:, None] if self.kappa is not None else \
+                cowper_kappa((self.E / (2 * self.G) - 1)[:, None], ratio)
+            F[:, 0, 0] += np.sum(w / (kappa * self.G[:, None] * A), axis=1)
+        K22 = np.linalg.inv(F)
+        T = np.zeros_like(F)
+        T[:, 0, 0] = T[:, 1, 1] = -1.0
+        T[:, 1, 0] = -self.L
+        TK = T @ K22
+        return np.block([[TK @ np.swapaxes(T, 1, 2), TK], [np.swapaxes(TK, 1, 2), K22]])
+
+    def integrated_blocks(self) -> dict[str, np.ndarray]:
+        """Bending blocks of every element by Gauss quadrature of its (linearly tapered) section.
+
+        Returns ``stiffness`` from the flexibility integrals of the varying ``1/EI`` and ``1/kappa G A`` (exact
+        under nodal loads, :meth:`_flexibility_stiffness`), ``mass`` = ``int rho A Nw^T Nw dx``, ``rotary`` =
+        ``int rho I Nb^T Nb dx`` (each (n, 4, 4), per bending plane) and the (n, 2, 2) ``axial_mass`` / ``torsion_mass`` of the linear bar
+        shape functions with ``rho A`` / ``rho 2I``.  For uniform elements these equal the closed forms.
+        """
+        L, ph = self.L, self.phi
+        eta = (_TAPER_X + 1) / 2
+        w = (_TAPER_W / 2)[None, :] * L[:, None]
+        Do, Di, Dor, Dir = self.ends
+        do, di = Do[:, None] + (Dor - Do)[:, None] * eta, Di[:, None] + (Dir - Di)[:, None] * eta
+        A, I = np.pi / 4 * (do**2 - di**2), np.pi / 64 * (do**4 - di**4)
+        Nw, _, Nb, _ = shape_functions(eta, L, ph)
+        K = self._flexibility_stiffness(eta, w, A, I, di / do)
+        bar = np.stack([1 - eta, eta], axis=-1)
+        rho = self.rho[:, None]
+        return {"stiffness": K, "mass": np.einsum("ng,ngi,ngj->nij", w * rho * A, Nw, Nw),
+                "rotary": np.einsum("ng,ngi,ngj->nij", w * rho * I, Nb, Nb),
+                "axial_mass": np.einsum("ng,gi,gj->nij", w * rho * A, bar, bar),
+                "torsion_mass": np.einsum("ng,gi,gj->nij", w * rho * 2 * I, bar, bar)}
+
+
+def _mean_power(a: np.ndarray, b: np.ndarray, p: int) -> np.ndarray:
+    """Mean of ``d^p`` over an element whose ``d`` varies linearly from ``a`` to ``b``."""
+    return sum(a ** k * b ** (p - k) for k in range(p + 1)) / (p + 1)
+
+
+#: Gauss points of tapered elements: 6 (exact to degree 11; the mass integrand rho A Nw^T Nw has degree 8).
+_TAPER_X, _TAPER_W = np.polynomial.legendre.leggauss(6)
 
 _BAR_K = np.array([[1.0, -1.0], [-1.0, 1.0]])
 _BAR_M = np.array([[2.0, 1.0], [1.0, 2.0]])

@@ -1,9 +1,12 @@
-"""Shaft supports (bearings) to ground: linear coefficients and the nonlinear radial law.
+"""Shaft supports (bearings) to ground or between two nodes: linear coefficients and the nonlinear radial law.
 
 Linear bearing (per node, DOF ``(u1, u2, u3, theta1, theta2, phi)``): lateral
 stiffness/damping ``[[kxx, kxy], [kyx, kyy]]``, axial ``kzz``, tilt ``ktt``
 (isotropic), torsional ``kphi``, and a lumped rigid body ``(m, Id, Ip)`` at the
-attachment point (spec §5.4 with ``eta* = 0``).
+attachment point (spec §5.4 with ``eta* = 0``).  A bearing linked to a second
+node ``j`` (ROSS ``n_link``: a pedestal) acts on the relative motion
+``u_i - u_j``: its 6x6 block ``B`` enters as ``[[B, -B], [-B, B]]``; its lumped
+mass stays on node ``i``.
 
 Nonlinear isotropic radial law (spec §5.3, (1.274)-(1.277)): the radial force
 magnitude ``f_r(u)`` of the radial deflection ``u = |u_perp|``, given as a
@@ -101,13 +104,15 @@ class RadialLaw:
 
 @dataclass(frozen=True)
 class BearingFamily:
-    """Linear bearings to ground (tangent matrices of nonlinear ones) on nodes.
+    """Linear bearings (tangent matrices of nonlinear ones) on nodes, to ground or to a second node.
 
     Parameters
     ----------
     nodes : int array (n,)
     kxx ... Ip : arrays (n,)
         See :data:`COEFFICIENTS` (N/m, N s/m, N m/rad, N m s/rad, kg, kg m^2).
+    links : int array (n,), optional
+        Second node of each bearing, -1 for ground (default: all to ground).
     """
 
     nodes: np.ndarray
@@ -128,17 +133,38 @@ class BearingFamily:
     m: np.ndarray
     Id: np.ndarray
     Ip: np.ndarray
+    links: np.ndarray | None = None
 
     @classmethod
-    def from_dicts(cls, nodes: np.ndarray, entries: list[dict[str, float]]) -> BearingFamily:
+    def from_dicts(cls, nodes: np.ndarray, entries: list[dict[str, float]],
+                   links: np.ndarray | None = None) -> BearingFamily:
         """Family from per-bearing dicts; absent coefficients are 0."""
         cols = {k: np.array([float(e.get(k, 0.0)) for e in entries]) for k in COEFFICIENTS}
-        return cls(np.asarray(nodes, dtype=np.int64), **cols)
+        return cls(np.asarray(nodes, dtype=np.int64), **cols,
+                   links=None if links is None else np.asarray(links, dtype=np.int64))
 
     @property
     def dofs(self) -> np.ndarray:
         """Global DOF map, shape (n, 6)."""
         return np.asarray(self.nodes, dtype=np.int64)[:, None] * 6 + np.arange(6)
+
+    @property
+    def linked(self) -> np.ndarray:
+        """Boolean (n,): bearings acting between two nodes."""
+        return np.zeros(len(self.nodes), bool) if self.links is None else np.asarray(self.links) >= 0
+
+    def relative(self, blocks: np.ndarray) -> list[tuple[np.ndarray, np.ndarray]]:
+        """``(blocks, dofs)`` pairs to assemble (n, 6, 6) stiffness or damping blocks acting on ``u_i - u_j``.
+
+        Bearings to ground give their 6x6 block on node ``i``; linked ones ``[[B, -B], [-B, B]]`` on ``(i, j)``.
+        """
+        ln = self.linked
+        pairs = [(blocks[~ln], self.dofs[~ln])]
+        if np.any(ln):
+            B = blocks[ln]
+            pairs.append((np.block([[B, -B], [-B, B]]),
+                          np.concatenate([self.dofs[ln], self.links[ln, None] * 6 + np.arange(6)], axis=1)))
+        return pairs
 
     def _blocks(self, xx: str, xy: str, yx: str, yy: str, zz: str, tt: str, ph: str) -> np.ndarray:
         n = len(self.nodes)

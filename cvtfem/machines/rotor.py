@@ -1,8 +1,9 @@
 """Rotor scenes -> layout and linear model (sparse M, K, C, G), a :class:`~cvtfem.assembly.model.Model`.
 
 Nodes are numbered from 0 at the left end of the first shaft element; each
-node has the 6 DOF ``(u1, u2, u3, theta1, theta2, phi)``.  Disks with an
-elastic connection get their own node after the shaft nodes.  Equation of
+node has the 6 DOF ``(u1, u2, u3, theta1, theta2, phi)``.  Support (pedestal)
+nodes named by a bearing's ``link_node`` follow the shaft nodes; disks with an
+elastic connection get their own node after those.  Equation of
 motion (spec §12.6): ``M q'' + (C + Omega G) q' + K q = 0``; the time-domain
 model runs at the spin speed ``Omega = speed`` (rad/s).
 """
@@ -24,7 +25,7 @@ from cvtfem.elements.disk import DiskFamily, connection_stiffness, disc_profile,
 from cvtfem.errors import InputError
 from cvtfem.outputs import OutputSpec
 from cvtfem.scene.loader import Scene
-from cvtfem.scene.schema.rotor import MAX_ELEMENTS
+from cvtfem.scene.schema.rotor import MAX_ELEMENTS, right_diameters
 
 #: Names of the 6 DOF of a node, in order.
 DOF_NAMES = ("u1", "u2", "u3", "theta1", "theta2", "phi")
@@ -45,7 +46,7 @@ class RotorModel(ModelBase):
     M, K, C, G : scipy.sparse.csr_matrix (n, n)
         Mass, stiffness, damping, gyroscopic per unit spin speed (skew).
     z : array (n_nodes,)
-        Axial node positions, m (elastic-connection disk nodes sit at their shaft node).
+        Axial node positions, m (support nodes and elastic-connection disk nodes sit at their shaft node).
     beam, disks, bearings : element families
         For rendering and outputs.
     profiles : tuple
@@ -98,16 +99,29 @@ class RotorModel(ModelBase):
         return shaft + bearings
 
     def bearing_force_map(self) -> tuple[sp.csr_matrix, sp.csr_matrix]:
-        """``(D, V)``, each ``(2 n_bearings, n)``: the x, y bearing forces are ``D u + V v`` (N)."""
+        """``(D, V)``, each ``(2 n_bearings, n)``: the x, y bearing forces are ``D u + V v`` (N); a bearing
+        between two nodes carries ``B (u_i - u_j)``."""
         b, n = self.bearings, self.n_dof
         rows = np.repeat(np.arange(2 * len(b.nodes)), 6)
         cols = np.repeat(b.dofs, 2, axis=0).ravel()
-        return tuple(sp.csr_matrix((X[:, :2, :].ravel(), (rows, cols)), shape=(2 * len(b.nodes), n))
-                     for X in (b.stiffness(), b.damping()))
+        ln = np.repeat(b.linked, 2)
+        other = np.repeat(np.where(b.linked, b.links if b.links is not None else 0, 0)[:, None] * 6 + np.arange(6),
+                          2, axis=0)
+        out = []
+        for X in (b.stiffness(), b.damping()):
+            rows_x = X[:, :2, :].reshape(-1, 6)
+            own = sp.csr_matrix((rows_x.ravel(), (rows, cols)), shape=(2 * len(b.nodes), n))
+            far = sp.csr_matrix((-rows_x[ln].ravel(), (rows.reshape(-1, 6)[ln].ravel(), other[ln].ravel())),
+                                shape=(2 * len(b.nodes), n))
+            out.append((own + far).tocsr())
+        return tuple(out)
 
     def support_stiffness(self) -> sp.csr_matrix:
-        """``(n, n)`` stiffness of all bearings (and tabulated ones at the model's speed), N/m, N m/rad."""
-        K = assemble(self.n_dof, [(self.bearings.stiffness(), self.bearings.dofs)])
+        """``(n, n)`` stiffness of the bearings on shaft nodes, to ground or linked to a support node (and the
+        tabulated ones at the model's speed), N/m, N m/rad; the supports of pedestal nodes are not included."""
+        blocks = self.bearings.stiffness()
+        blocks[self.bearings.nodes >= self.n_shaft_nodes] = 0.0
+        K = assemble(self.n_dof, self.bearings.relative(blocks))
         if self.tables is not None:
             K = K + _lateral(self.n_dof, self.tables.nodes, self.tables.blocks(self.speed)[0])
         return K.tocsr()
@@ -218,9 +232,11 @@ def _shaft_arrays(scene: Scene) -> dict[str, np.ndarray]:
         raise InputError("shaft[].repeat", n, f"must add up to at most {MAX_ELEMENTS} shaft elements "
                          f"({6 * (n + 1):.3g} DOF asked for)")
     rows = [s for s in scene.shaft for _ in range(s.repeat)]
+    right = np.array([right_diameters(s) for s in rows]).reshape(-1, 2)
     return {"L": np.array([s.length for s in rows]), "parallel": np.array([s.parallel for s in rows], bool),
             "Do": np.array([s.outer_diameter for s in rows]),
             "Di": np.array([s.inner_diameter for s in rows]),
+            "Do_right": right[:, 0], "Di_right": right[:, 1],
             "E": np.array([mats[s.material].E for s in rows]),
             "G": np.array([mats[s.material].G for s in rows]),
             "rho": np.array([mats[s.material].rho for s in rows])}
@@ -263,7 +279,25 @@ def _bearings(scene: Scene) -> BearingFamily:
             e.update(kxx=Kt[0, 0], kxy=Kt[0, 1], kyx=Kt[1, 0], kyy=Kt[1, 1], cxx=e["cxx"] + Dt[0, 0],
                      cxy=e["cxy"] + Dt[0, 1], cyx=e["cyx"] + Dt[1, 0], cyy=e["cyy"] + Dt[1, 1])
         entries.append(e)
-    return BearingFamily.from_dicts(np.array([b.node for b in scene.bearing], dtype=np.int64), entries)
+    return BearingFamily.from_dicts(np.array([b.node for b in scene.bearing], dtype=np.int64), entries,
+                                    np.array([b.link_node for b in scene.bearing], dtype=np.int64))
+
+
+def _support_nodes(scene: Scene, n_shaft: int) -> int:
+    """Number of support (pedestal) nodes: those after the shaft's that a bearing's ``link_node`` names."""
+    return len({b.link_node for b in scene.bearing if b.link_node >= n_shaft})
+
+
+def _support_positions(scene: Scene, z: np.ndarray, n_shaft: int, n_support: int) -> np.ndarray:
+    """Axial position of each support node: that of the shaft node linked to it (through a chain of links), m."""
+    links = {(b.node, b.link_node) for b in scene.bearing if b.link_node >= 0}
+    pos = {}
+    for _ in range(n_support):  # follow chains of pedestals out from the shaft
+        for a, b in links:
+            for here, there in ((a, b), (b, a)):
+                if there >= n_shaft and there not in pos and (here < n_shaft or here in pos):
+                    pos[there] = z[here] if here < n_shaft else pos[here]
+    return np.array([pos.get(n_shaft + k, 0.0) for k in range(n_support)])
 
 
 def _speed_tables(scene: Scene) -> SpeedTables | None:
@@ -339,13 +373,14 @@ def build_model(scene: Scene) -> RotorModel:
                                           rotary_inertia=opts.rotary_inertia if opts else True,
                                           gyroscopic=opts.gyroscopic if opts else True), **arrays)
     n_shaft = int(left[-1]) + 2
+    n_support = _support_nodes(scene, n_shaft)
     elastic = [i for i, d in enumerate(scene.disk) if d.connection == "elastic"]
     disk_nodes = np.array([d.node for d in scene.disk], dtype=np.int64)
-    disk_nodes[elastic] = n_shaft + np.arange(len(elastic))
+    disk_nodes[elastic] = n_shaft + n_support + np.arange(len(elastic))
     m, Id, Ip, profiles = _disk_properties(scene)
     disks = DiskFamily(disk_nodes, m, Id, Ip)
     bearings = _bearings(scene)
-    n = 6 * (n_shaft + len(elastic))
+    n = 6 * (n_shaft + n_support + len(elastic))
     Kshaft = beam.stiffness(opts.axial_force if opts else 0.0)
     conn_dofs = np.zeros((0, 12), dtype=np.int64)
     conn = np.zeros((0, 12, 12))
@@ -364,15 +399,16 @@ def build_model(scene: Scene) -> RotorModel:
         n += len(flexible.kinds)
     M = assemble(n, [(beam.mass(), beam.dofs), (disks.mass()[rigid], disks.dofs[rigid]),
                      (bearings.mass(), bearings.dofs), *(flexible.mass if flexible else ())])
-    K = assemble(n, [(Kshaft, beam.dofs), (bearings.stiffness(), bearings.dofs), (conn, conn_dofs),
+    K = assemble(n, [(Kshaft, beam.dofs), *bearings.relative(bearings.stiffness()), (conn, conn_dofs),
                      *(flexible.stiffness if flexible else ())])
     beta = opts.damping_beta if opts else 0.0
-    C = assemble(n, [(bearings.damping(), bearings.dofs), (beta * Kshaft, beam.dofs),
+    C = assemble(n, [*bearings.relative(bearings.damping()), (beta * Kshaft, beam.dofs),
                      *(flexible.damping if flexible else ())])
     G = assemble(n, [(beam.gyroscopic(), beam.dofs), (disks.gyroscopic()[rigid], disks.dofs[rigid]),
                      (bearings.gyroscopic(), bearings.dofs), *(flexible.gyroscopic if flexible else ())])
-    z = np.concatenate([[0.0], np.cumsum(arrays["L"][~parallel]), np.zeros(len(elastic))])
-    z[n_shaft:] = z[[scene.disk[i].node for i in elastic]]
+    z = np.concatenate([[0.0], np.cumsum(arrays["L"][~parallel]), np.zeros(n_support + len(elastic))])
+    z[n_shaft + n_support:] = z[[scene.disk[i].node for i in elastic]]
+    z[n_shaft:n_shaft + n_support] = _support_positions(scene, z, n_shaft, n_support)
     speed = opts.speed if opts else 0.0
     tables = _speed_tables(scene)
     if tables is not None:  # M, K, C hold the tabulated coefficients at the model's speed
@@ -399,9 +435,10 @@ def layout(scene: Scene) -> tuple[Layout, ...]:
         size = 4 * scene.sheave.modes * count if flexibility == "reduced" else None
         parts.append(Layout("sheaves", f"craig-bampton-sheave ({flexibility})",
                             size if size is not None else build_model(scene).n_dof - 6 * nodes - 6 * sum(
-                                d.connection == "elastic" for d in scene.disk),
+                                d.connection == "elastic" for d in scene.disk) - 6 * _support_nodes(scene, nodes),
                             note=f"{count} sheaves: modal coordinates of n = 0 (axial, torsion) and n = 1 (x, y)"))
     if scene.bearing:
-        parts.append(Layout("bearings", "bearing", 0, outputs=bearings,
-                            note=f"{len(scene.bearing)} bearings on shaft nodes"))
+        supports = _support_nodes(scene, nodes)
+        parts.append(Layout("bearings", "bearing", 6 * supports, outputs=bearings,
+                            note=f"{len(scene.bearing)} bearings, {supports} support nodes x 6"))
     return tuple(parts)

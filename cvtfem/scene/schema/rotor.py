@@ -25,8 +25,14 @@ MATERIAL = TableArray("material", "Materials referenced by name.", Table("materi
 
 SHAFT = TableArray("shaft", "Shaft elements in order along the axis.", Table("shaft", "A shaft element.", (
     Key("length", "float", "Element length (1 um .. 100 m).", "m", ge=1e-6, le=100.0),
-    Key("outer_diameter", "float", "Outer diameter (1 um .. 100 m).", "m", ge=1e-6, le=100.0),
-    Key("inner_diameter", "float", "Inner diameter (0: solid).", "m", 0.0, ge=0.0),
+    Key("outer_diameter", "float", "Outer diameter (1 um .. 100 m); at the left end of a tapered element.", "m",
+        ge=1e-6, le=100.0),
+    Key("inner_diameter", "float", "Inner diameter (0: solid); at the left end of a tapered element.", "m", 0.0,
+        ge=0.0),
+    Key("outer_diameter_right", "float", "Outer diameter at the right end of a tapered element (the diameters "
+        "vary linearly along it; -1: `outer_diameter`, a uniform element).", "m", -1.0, ge=-1.0, le=100.0),
+    Key("inner_diameter_right", "float", "Inner diameter at the right end of a tapered element (-1: "
+        "`inner_diameter`).", "m", -1.0, ge=-1.0),
     Key("material", "str", "Name of a `[[material]]`.", ""),
     Key("repeat", "int", "Number of identical consecutive elements this entry stands for.", "-", 1, ge=1,
         le=MAX_ELEMENTS),
@@ -102,8 +108,13 @@ DISK = TableArray("disk", "Rigid disks / sheaves on shaft nodes.", Table("disk",
     Key("c_phi", "float", "Elastic connection torsional stiffness.", "N m/rad", 0.0, ge=0.0),
 ), checks=(lambda t, p: _check_disk(t, p),)))
 
-BEARING = TableArray("bearing", "Bearings (supports to ground) on shaft nodes.", Table("bearing", "A bearing.", (
-    Key("node", "int", "Shaft node the bearing supports.", "-", ge=0),
+BEARING = TableArray("bearing", "Bearings (supports to ground or between two nodes) on shaft nodes.", Table(
+    "bearing", "A bearing.", (
+    Key("node", "int", "Shaft node the bearing supports (or a support node, see `link_node`).", "-", ge=0),
+    Key("link_node", "int", "Node the bearing connects `node` to (ROSS `n_link`; -1: ground): its coefficients "
+        "act on the relative motion u_node - u_link. A shaft node, or a support node numbered "
+        "after the shaft's (n_shaft_nodes, n_shaft_nodes + 1, ..: a pedestal, which gets its mass and its own "
+        "support from a `[[bearing]]` whose `node` it is).", "-", -1, ge=-1),
     *(Key(f"k{ij}", "float", f"Lateral stiffness coefficient {ij}.", "N/m", 0.0) for ij in ("xx", "yy", "xy", "yx")),
     *(Key(f"c{ij}", "float", f"Lateral damping coefficient {ij}.", "N s/m", 0.0) for ij in ("xx", "yy", "xy", "yx")),
     Key("kzz", "float", "Axial stiffness.", "N/m", 0.0),
@@ -138,6 +149,20 @@ def _check_section(table: Mapping[str, Any], path: str) -> None:
     if table["inner_diameter"] >= table["outer_diameter"]:
         raise InputError(f"{path}.inner_diameter", table["inner_diameter"],
                          f"must be smaller than `outer_diameter` = {table['outer_diameter']} m")
+    outer, inner = right_diameters(table)
+    if table["outer_diameter_right"] != -1.0 and outer < 1e-6:
+        raise InputError(f"{path}.outer_diameter_right", outer, "must be -1 (uniform) or 1 um .. 100 m")
+    if table["inner_diameter_right"] != -1.0 and inner < 0:
+        raise InputError(f"{path}.inner_diameter_right", inner, "must be -1 (uniform) or >= 0")
+    if inner >= outer:
+        raise InputError(f"{path}.inner_diameter_right", inner,
+                         f"must be smaller than the right outer diameter {outer} m")
+
+
+def right_diameters(table: Mapping[str, Any]) -> tuple[float, float]:
+    """Outer and inner diameter at the right end of a `[[shaft]]` entry (its left ones unless tapered), m."""
+    outer, inner = table["outer_diameter_right"], table["inner_diameter_right"]
+    return (table["outer_diameter"] if outer == -1.0 else outer, table["inner_diameter"] if inner == -1.0 else inner)
 
 
 def _check_disk(table: Mapping[str, Any], path: str) -> None:
@@ -195,11 +220,10 @@ def check_rotor(scene: Mapping[str, Any], path: str) -> None:
             raise InputError(f"shaft[{i}].parallel", True, "needs repeat = 1 and an element before it of the same "
                              "`length` (a sleeve lies on that element's nodes)")
     n_nodes = sum(s["repeat"] for s in scene["shaft"] if not s["parallel"]) + 1
-    for table in ("disk", "bearing"):
-        for i, entry in enumerate(scene[table]):
-            if entry["node"] >= n_nodes:
-                raise InputError(f"{table}[{i}].node", entry["node"],
-                                 f"must be a shaft node, 0..{n_nodes - 1}")
+    for i, entry in enumerate(scene["disk"]):
+        if entry["node"] >= n_nodes:
+            raise InputError(f"disk[{i}].node", entry["node"], f"must be a shaft node, 0..{n_nodes - 1}")
+    _check_links(scene["bearing"], n_nodes)
     flexibility = (scene.get("sheave") or {}).get("flexibility", "rigid")
     if flexibility != "rigid" and not any(d["geometry"] == "sheave" for d in scene["disk"]):
         raise InputError("sheave.flexibility", flexibility, "needs a [[disk]] with geometry = 'sheave' "
@@ -210,6 +234,25 @@ def check_rotor(scene: Mapping[str, Any], path: str) -> None:
                              "sheaves take their sections from [[disk]] (the key is for CVT scenes)")
     if (scene["disk"] or scene["bearing"]) and not scene["shaft"]:
         raise InputError("shaft", [], "needs at least one entry when disks or bearings are given")
+
+
+def _check_links(bearings: list, n_nodes: int) -> None:
+    """Bearings sit on shaft or support nodes; support nodes n_nodes.. are consecutive and each one linked."""
+    supports = sorted({b["link_node"] for b in bearings if b["link_node"] >= n_nodes})
+    if supports != list(range(n_nodes, n_nodes + len(supports))):
+        raise InputError("bearing[].link_node", supports, f"support nodes must be numbered {n_nodes}, "
+                         f"{n_nodes + 1}, .. without gaps (the shaft has nodes 0..{n_nodes - 1})")
+    for i, b in enumerate(bearings):
+        if b["node"] >= n_nodes and b["node"] not in supports:
+            raise InputError(f"bearing[{i}].node", b["node"], f"must be a shaft node, 0..{n_nodes - 1} (or a support "
+                             f"node some bearing's `link_node` names: {supports or 'none'})")
+        if b["link_node"] == b["node"]:
+            raise InputError(f"bearing[{i}].link_node", b["link_node"], "must differ from `node` (or be -1: ground)")
+        if b["link_node"] >= 0 and b["speeds"]:
+            raise InputError(f"bearing[{i}].speeds", b["speeds"], "must be left out of a bearing between two nodes "
+                             "(speed tables act to ground only)")
+        if b["link_node"] >= 0 and b["law"] != "linear":
+            raise InputError(f"bearing[{i}].law", b["law"], "must be 'linear' for a bearing between two nodes")
 
 
 ROOT_ITEMS = (ROTOR, MATERIAL, SHAFT, DISK, BEARING, SHEAVE)
