@@ -32,3 +32,15 @@ class ChainS1CVT(ChainCVT):
         c_p, zero = 2 * n2 + pins, np.full(len(pins), 2 * n2 + self.family.n)
         return np.column_stack([dof[pins, 0], dof[pins, 1], c_p, iz[shafts], n2 + dof[pins, 0], n2 + dof[pins, 1],
                                 zero, n2 + iz[shafts], n2 + iphi[shafts]])
+
+    def pin_end_axial(self, q_chain, z) -> np.ndarray:
+        """Axial positions (n,) m of the pins' ``x3 > 0`` ends at chain coordinates ``q_chain`` and sheave positions
+        ``z`` (2,) m: ``l/2``, or the face ``z_k + s(r)`` where it lies inside the free end (the dependent coordinate)."""
+        u, con = self.pin_positions(q_chain), self.contact
+        x3 = np.full(self.family.n, con.half_length)
+        for k in (0, 1):
+            r = np.linalg.norm(u - con.centres[k], axis=1)
+            near = r < con.r_outer
+            face = z[k] - con._profiles[k](r[near])[0]
+            x3[near] = np.minimum(x3[near], face)
+        return x3

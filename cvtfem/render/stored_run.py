@@ -17,6 +17,8 @@ from cvtfem.errors import InputError
 from cvtfem.io.results import Results
 from cvtfem.render.transmission import ChainFrame, chain_frame, check_colour, colour_kind
 
+#: Chains whose pins and sheaves are drawn (the halves of A2 and A5 and elastic shafts are not yet).
+DRAWN_CHAINS = ("chain-S1", "chain-S2", "chain-S3", "chain-A1")
 #: Series a results file needs for drawing its chain.
 GEOMETRY = ("chain.coordinates", "driving.sheave_position", "driven.sheave_position")
 
@@ -43,10 +45,12 @@ class StoredRun:
 
         res = results
         model_name = scene.cvt.model if scene.kind == "cvt" and scene.cvt is not None else None
-        if model_name is None or not model_name.startswith("chain-") or chain_refusal(scene) is not None:
+        drawn = model_name in DRAWN_CHAINS and not scene.cvt.effects.shaft_elasticity
+        if model_name is None or not drawn or chain_refusal(scene) is not None:
             what = f"a {scene.kind} scene" if model_name is None else f"cvt.model = {model_name!r}"
-            raise InputError(where, str(res.path), f"must be the results file of a chain-CVT run (a running "
-                             f"chain: chain-S2, chain-S3 or chain-A1); its scene has {what}")
+            raise InputError(where, str(res.path), "must be the results file of a chain-CVT run on rigid shafts "
+                             f"that can be drawn ({', '.join(DRAWN_CHAINS)}); its scene has {what}"
+                             + (" on elastic shafts" if drawn else ""))
         missing = [name for name in GEOMETRY if name not in res.series]
         if missing:
             raise InputError(where, str(res.path), "must store the chain's geometry to be drawn: it lacks the "

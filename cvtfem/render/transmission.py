@@ -37,8 +37,9 @@ def whole_pin(model) -> bool:
     return hasattr(model, "fixed_z")
 
 
-def pin_axis_points(model, q_chain, xi) -> np.ndarray:
-    """Points (n, len(xi), 3), m, on each pin's axis at the parameters ``xi`` (-1 far end, +1 near end)."""
+def pin_axis_points(model, q_chain, xi, z=None) -> np.ndarray:
+    """Points (n, len(xi), 3), m, on each pin's axis at the parameters ``xi`` (-1 far end, +1 near end); S1's pin
+    ends follow the sheave faces at the sheave positions ``z`` (2,) m (``model.pin_end_axial``)."""
     xi = np.asarray(xi, float)
     fam = model.family
     if whole_pin(model):
@@ -48,6 +49,8 @@ def pin_axis_points(model, q_chain, xi) -> np.ndarray:
         axial = w[0][:, None] + xi[None, :] * w[1][:, None]
     else:
         u, u3, _ = fam.split(np.asarray(q_chain, float))
+        if u3 is None:                                   # S1: the ends are not coordinates
+            u3 = model.pin_end_axial(q_chain, np.asarray(z, float))
         perp = np.repeat(u[:, None, :], xi.size, axis=1)
         axial = xi[None, :] * u3[:, None]
     return np.concatenate([perp, axial[..., None]], axis=2)
@@ -82,10 +85,10 @@ def chain_frame(model, q_chain, z, reference=None, axial_scale: float = 1.0) -> 
     """The drawn geometry at chain coordinates ``q_chain`` and sheave positions ``z`` (2,); with ``reference``
     ``(q_chain_ref, z_ref)`` the axial coordinates are exaggerated by ``axial_scale`` about those."""
     xi = np.concatenate([np.linspace(-1.0, 1.0, PIN_POINTS), [-PACK_FRACTION, PACK_FRACTION]])
-    pts = pin_axis_points(model, q_chain, xi)
+    pts = pin_axis_points(model, q_chain, xi, z)
     sheaves = sheave_positions(model, z)
     if reference is not None and axial_scale != 1.0:
-        ref = pin_axis_points(model, reference[0], xi)
+        ref = pin_axis_points(model, reference[0], xi, reference[1])
         pts[..., 2] = ref[..., 2] + axial_scale * (pts[..., 2] - ref[..., 2])
         ref_sheaves = sheave_positions(model, reference[1])
         sheaves = ref_sheaves + axial_scale * (sheaves - ref_sheaves)

@@ -134,3 +134,17 @@ def test_stationary_regime_against_the_band_model(scene):
     np.testing.assert_allclose(axial, clamp, rtol=0.01)
     assert T[0] == pytest.approx(T_band[0], rel=0.05)
     assert 0.03 < T[1] / T_band[1] - 1 < 0.09
+
+
+def test_pin_end_axial_positions_follow_the_faces(model, static):
+    """What the renderings draw: each pin end at l/2 less the deepest face intrusion among its contacts."""
+    x = perturbed(model, static[0], seed=3)
+    q = x[:model.n2]
+    nc, _, iz, _ = model._idx
+    pins, shafts, X, _ = model._contacts(q, np.zeros(model.n2))
+    delta = model.contact.local(X, shafts, details=True)[1]["delta"]
+    deepest = np.zeros(model.family.n)
+    np.maximum.at(deepest, pins, delta)
+    expected = model.contact.half_length - deepest
+    np.testing.assert_allclose(model.pin_end_axial(q[:nc], q[iz]), expected, rtol=0, atol=1e-15)
+    assert (deepest > 0).sum() > 30
