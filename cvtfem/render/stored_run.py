@@ -50,7 +50,7 @@ class StoredRun:
             what = f"a {scene.kind} scene" if model_name is None else f"cvt.model = {model_name!r}"
             raise InputError(where, str(res.path), "must be the results file of a chain-CVT run on rigid shafts "
                              f"that can be drawn ({', '.join(DRAWN_CHAINS)}); its scene has {what}"
-                             + (" on elastic shafts" if drawn else ""))
+                             + (" on elastic shafts" if model_name in DRAWN_CHAINS and not drawn else ""))
         missing = [name for name in GEOMETRY if name not in res.series]
         if missing:
             raise InputError(where, str(res.path), "must store the chain's geometry to be drawn: it lacks the "
