@@ -63,9 +63,9 @@ FIXED_STEP_TOL, FIXED_STEP_MAXITER = (1e-12, 1e-12), 30
 JAC_RATE = 1e-3
 
 
-# The small stage transforms (3 x 3 against 3 x n) and the norms go through np.einsum, not BLAS: OpenBLAS kernels (Sandybridge)
-# round such products differently with the operands' memory alignment, so a run restored from its memory drifted from
-# the original in the last bits (tests/integrate/test_radau5.py::test_memory_restores_bit_for_bit).
+# The small stage transforms (3 x 3 against 3 x n) and the norms go through np.einsum, not BLAS: OpenBLAS
+# kernels (Sandybridge) round such products differently with the operands' memory alignment, so a run restored from
+# its memory drifted from the original in the last bits (test_radau5.py::test_memory_restores_bit_for_bit).
 
 
 def rms(a: np.ndarray) -> float:
