@@ -604,7 +604,8 @@ def shaft_parameters(scene) -> tuple[ShaftParameters, ShaftParameters]:
 
 
 def elastic(rigid: ChainCVT, structure: ShaftStructure) -> ElasticChainCVT:
-    """The rigid transmission ``rigid`` (ChainCVT, or ChainACVT: :class:`ElasticChainACVT`) on ``structure`` (``z_ref`` set by :meth:`ElasticChainCVT.static_state`)."""
+    """The rigid transmission ``rigid`` (ChainCVT, or ChainACVT: :class:`ElasticChainACVT`) on ``structure``
+    (``z_ref`` set by :meth:`ElasticChainCVT.static_state`)."""
     args = (rigid.family, rigid.contact, rigid.J, rigid.m_sheave, rigid.regime, rigid.F_appl, rigid.control)
     if isinstance(rigid, ChainACVT):
         return ElasticChainACVT(*args, movable_side=rigid.movable_side, fixed_z=rigid.fixed_z,

@@ -35,7 +35,8 @@ class ChainS1CVT(ChainCVT):
 
     def pin_end_axial(self, q_chain, z) -> np.ndarray:
         """Axial positions (n,) m of the pins' ``x3 > 0`` ends at chain coordinates ``q_chain`` and sheave positions
-        ``z`` (2,) m: ``l/2``, or the face ``z_k + s(r)`` where it lies inside the free end (the dependent coordinate)."""
+        ``z`` (2,) m: ``l/2``, or the face ``z_k + s(r)`` where it lies inside the free end (the dependent
+        coordinate)."""
         u, con = self.pin_positions(q_chain), self.contact
         x3 = np.full(self.family.n, con.half_length)
         for k in (0, 1):

@@ -255,9 +255,9 @@ def chain_refusal(scene: Scene) -> InputError | None:
         return InputError("cvt.effects.shaft_elasticity", True, f"is not available with contact '{eff.contact}' yet: "
                           "elastic shafts run with H1 contact ('hertz'; set it false for the refined or rigid contact)")
     if model != "chain-S1" and eff.contact not in ("hertz", "hertz-refined"):
-        return InputError("cvt.effects.contact", eff.contact, f"must be 'hertz' or 'hertz-refined' for `{model}`: Hertz "
-                          "contact at the pin-axis end or refined (the rigid contact runs with `chain-S1` only, the impact "
-                          "contact is not coupled to a running chain yet)")
+        return InputError("cvt.effects.contact", eff.contact, f"must be 'hertz' or 'hertz-refined' for `{model}`: "
+                          "Hertz contact at the pin-axis end or refined (the rigid contact runs with `chain-S1` only, "
+                          "the impact contact is not coupled to a running chain yet)")
     if eff.contact == "hertz-refined" and model not in ("chain-S2", "chain-S3", "chain-A1", "chain-A2"):
         return InputError("cvt.effects.contact", eff.contact, f"must be 'hertz' for `{model}`: the refined contact "
                           "runs with chain-S2, chain-S3, chain-A1 and chain-A2 only so far")
