@@ -73,3 +73,15 @@ def stationary_means(model, x0, t_end: float = 10e-3, window: float = 6e-3):
     axial = np.mean([o["contact.sheave_axial_force"] for o in outs], axis=0)
     clamp = np.mean([[o["driving.clamping_force"], o["driven.clamping_force"]] for o in outs], axis=0)
     return T, axial, clamp
+
+
+def assert_jacobian_on_pattern(model, x, n_chain: int = 25) -> None:
+    """``model.jac`` at ``x`` is zero off ``jac_sparsity`` and equals central differences on ``n_chain`` random chain
+    position and velocity columns and on every shaft, sheave and loop column (:func:`assert_jacobian_columns`)."""
+    J = model.jac(0.0, x).toarray()
+    assert not np.any(J[~model.jac_sparsity.toarray()])
+    rng = np.random.default_rng(5)
+    n2, nc = model.n2, model.family.size
+    cols = np.concatenate([rng.choice(nc, n_chain, replace=False), n2 + rng.choice(nc, n_chain, replace=False),
+                           np.arange(nc, n2), n2 + np.arange(nc, n2), np.arange(2 * n2, 2 * n2 + 4)])
+    assert_jacobian_columns(model, x, J, cols)
