@@ -28,7 +28,7 @@ def run(outdir: pathlib.Path) -> list[str]:
     png = plot_history(read_results(h5), outdir / "lowered_4dof_regime.png",
                        title="4-DOF band model: loops pull ratio 2.3 -> 2.4 and 3360 -> 3500 rpm")
     lines.append(f"{h5.name}: 4-DOF run, 0.6 s simulated in {summary.wall_time_s:.2f} s wall (HDF5 time histories)")
-    lines.append(f"{png.name}: speeds, ratio, efficiency and clamping forces settling to the targets "
+    lines.append(f"{png.name}: speeds, ratio, efficiency, slip and clamping forces settling to the targets "
                  f"(final ratio {summary.ratio:.4f}, efficiency {summary.efficiency:.4f})")
     js = outdir / "lowered_4dof_summary.json"
     js.write_text(json.dumps(summary.to_dict(), indent=2) + "\n", encoding="utf-8")
