@@ -331,18 +331,28 @@ class ChainCVT(ModelBase):
         Wr[0, n2 + iphi[0]] = M[0]
         Wr[1, in_cols] = -w[1] * G[2]
         Wr[1, n2 + iphi[1]] += -M[1]
-        Qd = self.family.dissipative_forces(q[:nc], v[:nc])
-        Kd = self.family.jacobian(q[:nc], v[:nc], part="dissipative", wrt=(0,))[0]
-        d2phi = np.concatenate([-(Kd.T @ v[:nc]), -2 * Qd])
-        chain_cols = np.concatenate([np.arange(nc), n2 + np.arange(nc)])
-        dPf = np.zeros(N)
-        cw = np.where(ccols < 2 * n2, coef, 0.0)
-        np.add.at(dPf, np.where(cw != 0, ccols, 0).ravel(), (cw * Jl[:, -1, :, None]).ravel())
-        dD = -dPf
-        dD[chain_cols] += d2phi
-        Wr[2, :] = dD
+        Wr[2, :] = self._dissipation_gradient(q, v, ccols, coef, Jl)
         Wr[3, n2 + iz] = -self.sheaves_per_z * F
         Wr[3, in_cols] = -self.sheaves_per_z * (v[iz] @ G[:2])
+        return self._stacked_jacobian(acc, G, in_cols, Wr)
+
+    def _dissipation_gradient(self, q, v, cols, coef, Jl) -> np.ndarray:
+        """``d D / d y`` (N,) of the chain's dissipated power ``D = 2 Phi - P_fr`` (its Rayleigh function and the
+        contact friction power, whose local Jacobians ``Jl`` act through the contact map ``cols``, ``coef``)."""
+        nc, n2, N = self._idx[0], self.n2, self.size
+        dD = np.zeros(N)
+        cw = np.where(cols < 2 * n2, coef, 0.0)
+        np.add.at(dD, np.where(cw != 0, cols, 0).ravel(), -(cw * Jl[:, -1, :, None]).ravel())
+        Qd = self.family.dissipative_forces(q[:nc], v[:nc])
+        Kd = self.family.jacobian(q[:nc], v[:nc], part="dissipative", wrt=(0,))[0]
+        dD[:nc] += -(Kd.T @ v[:nc])
+        dD[n2:n2 + nc] += -2 * Qd
+        return dD
+
+    def _stacked_jacobian(self, acc, G, in_cols, Wr) -> sp.csr_matrix:
+        """``d rhs / dx`` from the acceleration rows ``acc``, the loops' gradient ``G`` over their inputs ``in_cols``
+        and the work-rate rows ``Wr`` (``x' = v`` on top)."""
+        n2, nz, N = self.n2, self.control.size, self.size
         ctrl_rows = sp.csr_matrix((G[3:].ravel(), (np.repeat(np.arange(nz), 2 + nz), np.tile(in_cols, nz))),
                                   shape=(nz, N))
         top = sp.csr_matrix((np.ones(n2), (np.arange(n2), n2 + np.arange(n2))), shape=(n2, N))

@@ -307,23 +307,14 @@ class ElasticChainCVT(ChainCVT):
         Wr[0, n2 + iphi[0]] = M[0]
         Wr[1, in_cols] = -w[1] * G[2]
         Wr[1, n2 + iphi[1]] += -M[1]
-        Qd = self.family.dissipative_forces(q[:nc], v[:nc])
-        Kd = self.family.jacobian(q[:nc], v[:nc], part="dissipative", wrt=(0,))[0]
-        dD = np.zeros(N)
-        cw = np.where(cols < 2 * n2, coef, 0.0)
-        np.add.at(dD, np.where(cw != 0, cols, 0).ravel(), -(cw * Jl[:, -1, :, None]).ravel())
-        dD[np.arange(nc)] += -(Kd.T @ v[:nc])
-        dD[n2 + np.arange(nc)] += -2 * Qd
+        dD = self._dissipation_gradient(q, v, cols, coef, Jl)
         dD[n2 + nc:2 * n2] += 2 * (s.C @ vs)
         Wr[2, :] = dD
         Wr[3, n2 + iz] = -side * F
         Wr[3, n2 + mu3] = side * F
         rel = v[iz] - v[mu3]
         Wr[3, in_cols] = -((side * rel) @ G[:2])
-        ctrl_rows = sp.csr_matrix((G[3:].ravel(), (np.repeat(np.arange(nz), 2 + nz), np.tile(in_cols, nz))),
-                                  shape=(nz, N))
-        top = sp.csr_matrix((np.ones(n2), (np.arange(n2), n2 + np.arange(n2))), shape=(n2, N))
-        return sp.vstack([top, acc, ctrl_rows, Wr.tocsr()], format="csr")
+        return self._stacked_jacobian(acc, G, in_cols, Wr)
 
     @cached_property
     def jac_sparsity(self) -> sp.csr_matrix:
