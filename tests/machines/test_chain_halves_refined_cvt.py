@@ -94,6 +94,20 @@ def test_construction_and_contact_inputs(model, placed):
         ChainHalvesRefinedCVT.from_parameters(reference_geometry(), contact="hertz", model="chain-A5")
 
 
+def test_compiled_contact_pass_equals_its_numpy_twin(model, placed):
+    """HalfEndContact's compiled map and kernel equal the numpy formulas (``reference=True``) to round-off, and the
+    ``details`` pass gives the same outputs."""
+    x = _perturbed(model, placed, seed=8)
+    q, v = x[:model.n2], x[model.n2:2 * model.n2]
+    _, shafts, _, _, X, Y = model._contact_set(q, v)
+    Yr = model.contact.pair.local(X, shafts, reference=True)
+    Yd = model.contact.pair.local(X, shafts, details=True)[0]
+    scale = np.abs(Yr).max(axis=0)
+    np.testing.assert_allclose(2 * Y, Yr, rtol=0, atol=1e-11 * scale.max())     # EndContact takes one end: 1/2
+    np.testing.assert_array_equal(Yd, Yr)
+    assert np.abs(Yr[:, 2:4]).max() > 0                                          # the twist is in the comparison
+
+
 def test_contact_forces_are_minus_the_gradient_of_the_hertz_potential(model, placed):
     """Through the contact map (half end, its slope, the link chord, movable or fixed sheave): the frictionless
     generalized forces on every coordinate of a half (both halves of six pins), the neighbours' halves and the

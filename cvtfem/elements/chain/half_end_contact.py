@@ -26,10 +26,38 @@ import numpy as np
 
 from cvtfem.elements.chain.sheave_contact import central_local_jacobian
 from cvtfem.elements.chain.sheave_contact_refined import RefinedSheaveContact
+from cvtfem.elements.jit import njit
 from cvtfem.errors import InputError
 
 #: Position inputs: half end (2), link chord (2), ``u3``, end slope (2), ``z``.
 N_POS = 8
+
+
+@njit(cache=True)
+def _spread(X, Xk, n_pos_kernel):
+    """Compiled :meth:`HalfEndContact.kernel_inputs` into ``Xk`` (m, 2 n_pos_kernel + 1)."""
+    for i in range(X.shape[0]):
+        for a in range(2):
+            off, ko = a * N_POS, a * n_pos_kernel
+            for j in range(2):
+                x, c = X[i, off + j], X[i, off + 2 + j]
+                Xk[i, ko + j] = x - c
+                Xk[i, ko + 2 + j] = x
+                Xk[i, ko + 4 + j] = x + c
+            for j in range(4):
+                Xk[i, ko + 6 + j] = X[i, off + 4 + j]
+        Xk[i, Xk.shape[1] - 1] = X[i, X.shape[1] - 1]
+
+
+@njit(cache=True)
+def _gather(Yk, Y):
+    """Compiled back map of :meth:`HalfEndContact.local` into ``Y`` (m, 10)."""
+    for i in range(Yk.shape[0]):
+        for j in range(2):
+            Y[i, j] = Yk[i, j] + Yk[i, 2 + j] + Yk[i, 4 + j]
+            Y[i, 2 + j] = Yk[i, 4 + j] - Yk[i, j]
+        for j in range(Y.shape[1] - 4):
+            Y[i, 4 + j] = Yk[i, 6 + j]
 
 
 @dataclass(frozen=True)
@@ -99,7 +127,15 @@ class HalfEndContact:
 
     def local(self, X, shafts, details: bool = False, reference: bool = False):
         """Outputs ``Y`` (m, 10): the kernel's forces mapped back by the transpose of :meth:`kernel_inputs`
-        (end: the sum of the three; chord: front minus rear), the rest as the kernel's (``details`` too)."""
+        (end: the sum of the three; chord: front minus rear), the rest as the kernel's (``details`` too).
+        Without ``details`` or ``reference`` the map and the kernel run compiled; else the numpy twins."""
+        if not (details or reference):
+            X = np.ascontiguousarray(X, float)
+            Xk = np.empty((len(X), self.pair.n_in))
+            _spread(X, Xk, self.pair.n_pos)
+            Y = np.empty((len(X), self.n_out))
+            _gather(self.pair.local(Xk, shafts), Y)
+            return Y
         out = self.pair.local(self.kernel_inputs(X), shafts, details, reference)
         Yk = out[0] if details else out
         Y = np.empty((len(X), self.n_out))
