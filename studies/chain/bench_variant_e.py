@@ -79,7 +79,8 @@ def main() -> None:
     a = ap.parse_args()
     scene = load_scene("band-6+2n")
     lines = [f"machine: {machine()}"]
-    for contact, name in (("hertz-refined", "A5 + H2 (variant (e), rigid shafts)"), ("hertz", "A5 + H1 (variant (zh))")):
+    for contact, name in (("hertz-refined", "A5 + H2 (variant (e), rigid shafts)"),
+                          ("hertz", "A5 + H1 (variant (zh))")):
         m = from_scene(scene, reference_geometry(), F_APPL, model="chain-A5", contact=contact)
         rng = np.random.default_rng(0)
         x = m.placed_state(2.4, scene.cvt.regime.input_speed)

@@ -36,7 +36,7 @@ def placed(model, scene):
 
 
 def _perturbed(model, x0, seed=0):
-    """A running state off balance: random chain offsets (0.2 um; slopes 2e-7) and velocities, sheave and shaft rates."""
+    """A running state off balance: random chain offsets (0.2 um; slopes 2e-7), velocities, sheave and shaft rates."""
     rng = np.random.default_rng(seed)
     x = x0.copy()
     nc, n2 = model.family.size, model.n2
