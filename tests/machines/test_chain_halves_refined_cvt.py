@@ -261,24 +261,25 @@ def test_scene_path_and_refusals():
 
 @pytest.mark.slow
 def test_energy_balance_over_a_short_run(model, placed):
-    """From the placed state (off balance), 2 us of Radau (rtol 1e-6): the work integrals, with the chain's internal
-    friction and damping and the H2 friction in the dissipated work, close the energy balance to 1e-6 of the input
-    work."""
+    """From the placed state (off balance), 1 us of Radau (rtol 1e-6, about 320 steps, 50 s CPU): the work integrals,
+    with the chain's internal friction and damping and the H2 friction in the dissipated work, close the energy
+    balance to 1e-6 of the input work (about 0.07 J; found 2e-9)."""
     from cvtfem.integrate import solve
 
-    res = solve(model, (0.0, 2e-6), placed, method="Radau", rtol=1e-6, atol=1e-9, n2=model.n2, jac=model.jac,
+    res = solve(model, (0.0, 1e-6), placed, method="Radau", rtol=1e-6, atol=1e-9, n2=model.n2, jac=model.jac,
                 jac_sparsity=model.jac_sparsity)
     assert res.status == 0
     x1 = res.y[:, -1]
     W = model.split(x1)[3]
-    assert W[0] > 0.05 and W[2] > 0.01 * W[0]
+    assert W[0] > 0.03 and W[2] > 0.05 * W[0]
     assert model.energy(x1) - model.energy(placed) == pytest.approx(W[0] - W[1] + W[3] - W[2], abs=1e-6 * W[0])
 
 
 @pytest.mark.slow
 def test_cvtfem_run_variant_e_on_rigid_shafts(cli, tmp_path):
     """`cvtfem run` of variant (e) with `shaft_elasticity = false` (chain-A5's solver settings) for 3 us through the
-    CLI: it runs, every output is finite and the work integrals close the energy balance to 1e-5 of the input work."""
+    CLI (after the quasi-static attempt, from the placement): it runs, every output is finite and the work
+    integrals close the energy balance to 1e-5 of the input work."""
     import json
 
     import h5py
