@@ -144,9 +144,24 @@ def test_friction_power_is_the_work_rate_of_the_friction_forces(model, placed):
     Q0, Pf0 = _contact_forces(_frictionless(model), q, v)
     assert Pf0 == 0.0 and Pf < -1.0
     assert Pf == pytest.approx(float((Q - Q0) @ v), rel=1e-10)
-    # and the twist part is there: the chord inputs carry forces
-    ends, shafts, cols, coef, X, Y = model._contact_set(q, v)
-    assert np.abs(Y[:, 2:4]).max() > 1e-3 * np.abs(Y[:, 0:2]).max()
+
+def test_twist_acts_on_the_halves_of_one_link_as_1_352(model, placed):
+    """The force on the link chord of a half end is (1.352): the twist moment ``F . ((k + gamma) x rho)`` of the
+    friction force at ``R_*`` (``rho = R_* - R_pin``, ``gamma`` the end slope) over ``|c|`` along ``n = k x c/|c|``,
+    +on the front half, -on the rear one (spec §5.5, independent halves), per end (EndContact's half of the pair)."""
+    from cvtfem.elements.chain.symmetric import END_SLOPE_FACTOR
+
+    x = _perturbed(model, placed, seed=2)
+    q, v = x[:model.n2], x[model.n2:2 * model.n2]
+    _, shafts, _, _, X, (Y, d) = model._contact_set(q, v, details=True)
+    c = X[:, 2:4]
+    n = np.column_stack([-c[:, 1], c[:, 0]]) / np.linalg.norm(c, axis=1)[:, None]
+    rho = d["point"] - np.column_stack([X[:, 0:2], X[:, 4]])
+    g = np.column_stack([END_SLOPE_FACTOR * X[:, 5:7], np.zeros(len(X))])
+    moment = np.sum(d["F_fr"] * np.cross(np.array([0.0, 0.0, 1.0]) + g, rho), axis=1)
+    expected = (moment / np.linalg.norm(c, axis=1))[:, None] * n
+    assert np.abs(expected).max() > 1.0                                  # N: the twist is not negligible
+    np.testing.assert_allclose(Y[:, 2:4], expected, rtol=0, atol=1e-9 * np.abs(expected).max())
 
 
 def _a1_state_in_halves(a1, a5, x1):
