@@ -334,6 +334,15 @@ class ChainHalvesCVT(ChainACVT):
 
     # ----- construction ----------------------------------------------------------------------------
     @classmethod
+    def from_parameters(cls, geom, *, contact: str = "hertz", **kw) -> "ChainHalvesCVT":
+        """:meth:`ChainACVT.from_parameters`; ``contact = "hertz-refined"`` builds variant (e) on rigid shafts
+        (:class:`~cvtfem.machines.chain_halves_refined_cvt.ChainHalvesRefinedCVT`: H2 at every half end)."""
+        if contact == "hertz-refined" and cls is ChainHalvesCVT:
+            from cvtfem.machines.chain_halves_refined_cvt import ChainHalvesRefinedCVT   # builds on this module
+            return ChainHalvesRefinedCVT.from_parameters(geom, contact=contact, **kw)
+        return super().from_parameters(geom, contact=contact, **kw)
+
+    @classmethod
     def _family_for(cls, model: str, geom, damping, E: float):
         if model not in HALVES_MODELS:
             raise InputError("cvt.model", model, "must be one of " + ", ".join(HALVES_MODELS))

@@ -258,9 +258,9 @@ def chain_refusal(scene: Scene) -> InputError | None:
         return InputError("cvt.effects.contact", eff.contact, f"must be 'hertz' or 'hertz-refined' for `{model}`: "
                           "Hertz contact at the pin-axis end or refined (the rigid contact runs with `chain-S1` only, "
                           "the impact contact is not coupled to a running chain yet)")
-    if eff.contact == "hertz-refined" and model not in ("chain-S2", "chain-S3", "chain-A1", "chain-A2"):
+    if eff.contact == "hertz-refined" and model not in ("chain-S2", "chain-S3", "chain-A1", "chain-A2", "chain-A5"):
         return InputError("cvt.effects.contact", eff.contact, f"must be 'hertz' for `{model}`: the refined contact "
-                          "runs with chain-S2, chain-S3, chain-A1 and chain-A2 only so far")
+                          "runs with chain-S2, chain-S3, chain-A1, chain-A2 and chain-A5 only so far")
     if model == "chain-A2" and eff.contact != "hertz-refined":
         return InputError("cvt.effects.contact", eff.contact, "must be 'hertz-refined' for `chain-A2`: its coupled "
                           "pin halves touch the sheaves with their biconvex end faces (Table 1.1 (v))")
@@ -319,7 +319,8 @@ def _contact_note(scene: Scene) -> str:
     if scene.cvt.model == "chain-S1":
         return "rigid contact: the pin ends follow the faces of"
     refined = scene.cvt.effects.contact == "hertz-refined"
-    where = "both ends of both pin halves" if scene.cvt.model == "chain-A2" else "both pin ends"
+    where = "both ends of both pin halves" if scene.cvt.model in ("chain-A2", "chain-A5", "chain-A5-point") else \
+        "both pin ends"
     return f"{'refined (H2)' if refined else 'Hertz (H1)'} contact at {where} with"
 
 

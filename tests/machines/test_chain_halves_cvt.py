@@ -196,5 +196,5 @@ def test_scene_path_builds_a5_and_describes_its_outputs_once():
     assert sorted(listed) == sorted(o.name for o in m.output_specs)
     assert sum(p.n2 for p in layout(scene)) == m.n2
     with pytest.raises(InputError, match=r"cvt\.effects\.contact"):
-        chain_loop(scene.replace({"cvt": {"effects": {"contact": "hertz-refined"}}}))
+        chain_loop(scene.replace({"cvt": {"model": "chain-A5-point", "effects": {"contact": "hertz-refined"}}}))
     assert replace(m, movable_side=(-1, 1)).movable_side == (-1, 1)

@@ -16,6 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from cvtfem.elements.chain.half_contact import CoupledHalvesContact
+from cvtfem.elements.chain.half_end_contact import HalfEndContact
 from cvtfem.elements.chain.sheave_contact import SheaveContact
 from cvtfem.elements.chain.sheave_contact_refined import RefinedSheaveContact
 
@@ -26,16 +27,17 @@ class EndContact:
 
     Attributes
     ----------
-    pair : SheaveContact, RefinedSheaveContact or CoupledHalvesContact (A2: H2 at a pin half's end)
+    pair : SheaveContact, RefinedSheaveContact, CoupledHalvesContact (A2: H2 at a pin half's end) or
+        HalfEndContact (A5: H2 at an independent half's end)
         The kernel of the mirrored pair; this contact takes half of its outputs (one end, one sheave).
     """
 
-    pair: SheaveContact | RefinedSheaveContact | CoupledHalvesContact
+    pair: SheaveContact | RefinedSheaveContact | CoupledHalvesContact | HalfEndContact
 
     @property
     def refined(self) -> bool:
         """The pair kernel is H2 (refined biconvex kinematics, contact digest §5), at the pin or a half of it."""
-        return isinstance(self.pair, (RefinedSheaveContact, CoupledHalvesContact))
+        return isinstance(self.pair, (RefinedSheaveContact, CoupledHalvesContact, HalfEndContact))
 
     def extra_approach(self, k: int, r) -> float:
         """Penetration beyond H1's of an untilted pin end at radius ``r`` (m) on shaft ``k`` (m; 0 for H1)."""
