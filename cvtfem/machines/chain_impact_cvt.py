@@ -169,8 +169,9 @@ class ImpactChainCVT(ChainCVT):
     @cached_property
     def output_specs(self) -> tuple[OutputSpec, ...]:
         return super().output_specs + (
-            OutputSpec("contact.state", "-", "Discrete state of each pin end and shaft (pin-major, driving then driven): "
-                       "0 free, 1 in contact after a sliding impact (or at the start), 2 after a stuck impact.",
+            OutputSpec("contact.state", "-", "Discrete state of each pin end and shaft (pin-major, driving then "
+                       "driven): 0 free, 1 in contact after a sliding impact (or at the start), 2 after a stuck "
+                       "impact.",
                        self.n_discrete),
             OutputSpec("contact.impact_loss", "J", "Kinetic energy taken by the impacts at contact onset since t = 0 "
                        "(included in the dissipated work)."))

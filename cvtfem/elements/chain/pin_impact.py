@@ -73,8 +73,9 @@ def symmetric_compliance(m_pin, m_z, J, arm) -> np.ndarray:
 
 
 def pin_end_impulses(w, normal, A, f):
-    """``(P (m, 3) N s, state (m,))`` of the impacts with relative velocities ``w`` (m/s), normals, compliances ``A`` and
-    friction coefficient ``f``: :func:`~cvtfem.elements.contact.impact.impact_impulse` (state FREE where separating)."""
+    """``(P (m, 3) N s, state (m,))`` of the impacts with relative velocities ``w`` (m/s), normals, compliances
+    ``A`` and friction coefficient ``f``: :func:`~cvtfem.elements.contact.impact.impact_impulse` (state FREE where
+    separating)."""
     return impact_impulse(w, normal, A, np.broadcast_to(np.asarray(f, float), (len(w),)))
 
 
