@@ -123,11 +123,25 @@ class ImpactChainCVT(ChainCVT):
     def switch(self, t: float, x, fired) -> np.ndarray:
         """The state after the events ``fired`` (2n,) bool at ``(t, x)``: each end that approaches its sheave
         (``n . w < 0``) gets its impact (one after the other, with the velocities the previous left), the others are
-        released; the impacts' kinetic energy goes to ``contact.impact_loss`` and to the dissipated work."""
+        released; the impacts' kinetic energy goes to ``contact.impact_loss`` and to the dissipated work.  An end the
+        flow pulls off the face right after its impact (touch and leave: ``Delta'' < 0`` at zero approach speed, which
+        the event locator does not see as a crossing) is free again."""
         x = np.array(x, float)
-        for j in np.flatnonzero(fired):
+        ends = np.flatnonzero(fired)
+        for j in ends:
             x = self.impact(x, np.array([j // 2]), np.array([j % 2]))[0]
+        hit = ends[x[self._discrete.start + ends] != FREE]
+        if len(hit):
+            leaving = self._gap_curvature(t, x)[hit] < 0
+            x[self._discrete.start + hit[leaving]] = FREE
         return x
+
+    def _gap_curvature(self, t: float, x, dt: float = 1e-9) -> np.ndarray:
+        """``Delta''`` (2n,) m/s^2 estimated from two explicit steps of ``dt`` s (the positions move by ``2 dt v + dt^2
+        a``): its sign says where an end at zero approach speed goes next."""
+        x1 = x + dt * self.rhs(t, x)
+        x2 = x1 + dt * self.rhs(t + dt, x1)
+        return (self.events(t, x2) - 2 * self.events(t, x1) + self.events(t, x)) / dt ** 2
 
     def impact_map(self, x, end: int, shaft: int):
         """``(w (3,), normal (3,), G (3, n2), MinvGt (n2, 3))`` of pin end ``end`` on ``shaft``: relative velocity,
