@@ -31,6 +31,11 @@ from cvtfem.machines.chain_cvt import ChainCVT
 from cvtfem.outputs import OutputSpec
 
 
+#: Offset (m) of the indicator of an end in contact: far above the round-off of ``Delta`` (~1e-17 m), far below the
+#: Hertz penetrations (~1e-5 m); the release fires this far off the face, where H1 carries no force already.
+HYSTERESIS = 1e-10
+
+
 class ImpactChainCVT(ChainCVT):
     """chain-S2 + H1 contact with C2 impacts at contact onset + two rigid shafts + regime + loops."""
 
@@ -105,12 +110,15 @@ class ImpactChainCVT(ChainCVT):
 
     # ----- events and the discrete state -------------------------------------------------------------
     def events(self, t: float, x) -> np.ndarray:
-        """Penetration ``Delta`` (2n,) m of every pin end against each shaft's sheave (pin-major); a rise through
-        zero is a contact onset (impact), a fall a release."""
+        """Penetration ``Delta`` (2n,) m of every pin end against each shaft's sheave (pin-major), plus
+        :data:`HYSTERESIS` for the ends in contact: a free end's rise through zero is a contact onset (impact), an
+        end in contact is released where ``Delta`` falls below ``-HYSTERESIS``.  Without the offset an end left at
+        ``Delta = 0`` by its impact would cross zero again in round-off and be hit again and again (Zeno)."""
         q = x[:self.n2]
         nc, _, iz, _ = self._idx
         u3 = self.family.split(q[:nc])[1]
-        return gap_indicators(self.contact, self.pin_positions(q[:nc]), u3, q[iz]).ravel()
+        e = gap_indicators(self.contact, self.pin_positions(q[:nc]), u3, q[iz]).ravel()
+        return e + HYSTERESIS * (x[self._discrete.start:self._discrete.stop - 1] != FREE)
 
     @cached_property
     def event_direction(self) -> np.ndarray:
