@@ -77,6 +77,22 @@ def test_scene_routing_and_what_impact_refuses(scene, model, x0):
     assert np.array_equal(o["contact.state"], state) and o["contact.impact_loss"] == 0.0
 
 
+def test_jacobian_on_its_pattern_and_the_discrete_block_inert(model, x0):
+    """``jac`` equals central differences on chain, shaft, sheave and loop columns and is zero off ``jac_sparsity``;
+    the discrete block (contact state, impact loss) has zero rate and no column the right-hand side reads."""
+    from tests.machines.chain_checks import assert_jacobian_on_pattern, perturbed
+
+    x = perturbed(model, x0)
+    assert_jacobian_on_pattern(model, x)
+    d = model._discrete
+    assert not model.jac_sparsity[d].nnz and not model.jac_sparsity[:, d].nnz
+    x_flip = x.copy()
+    x_flip[d] = np.arange(d.stop - d.start) % 3
+    assert np.array_equal(np.delete(model.rhs(0.0, x_flip), np.arange(d.start, d.stop)),
+                          np.delete(model.rhs(0.0, x), np.arange(d.start, d.stop)))
+    assert not model.rhs(0.0, x_flip)[d].any()
+
+
 def test_compliance_equals_the_digest_closed_form(model, x0):
     """``A = 2 G M^-1 G^T`` from the model's mass matrix and contact map equals (1.304) with the per-end masses of the
     mirrored pin (m_p/2, axially m_p/6), the sheave pair (m_z/2) and the shaft (J/2)."""
