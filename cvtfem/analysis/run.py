@@ -187,6 +187,7 @@ class _Run:
         self.retry_log: list[str] = []
         self._layout = None
         self.events = None      # (indicators, direction, terminal) of `[[solver.event]]`, set by `check_events`
+        self.switch = None      # the model's discrete-state switch at its own events (`check_events`)
         self.event_names: list[str] = []
 
     @classmethod
@@ -197,9 +198,12 @@ class _Run:
         return run
 
     def check_events(self, x0) -> None:
-        """Event indicators ``output(t, x) - value`` of the scene's ``[[solver.event]]`` (scalar outputs only)."""
+        """Event indicators ``output(t, x) - value`` of the scene's ``[[solver.event]]`` (scalar outputs only), then
+        the model's own (its discrete state: :attr:`switch` applies them)."""
         declared = self.scene.solver.event
         if not declared:
+            self.events = None
+            self._model_events(0)
             return
         outputs = self.loop.outputs(0.0, x0)
         for i, ev in enumerate(declared):
@@ -219,6 +223,28 @@ class _Run:
         direction = np.array([{"rising": 1, "falling": -1, "either": 0}[ev.direction] for ev in declared])
         self.events = (indicators, direction, np.array([ev.terminal for ev in declared]))
         self.event_names = [ev.name or f"{ev.output} = {ev.value:g}" for ev in declared]
+        self._model_events(len(declared))
+
+    def _model_events(self, n_scene: int) -> None:
+        """Append the model's event indicators (if it has any) after the ``n_scene`` of the scene and route their
+        firing to the model's ``switch`` (an impact changes the state)."""
+        loop = self.loop
+        if getattr(loop, "events", None) is None:
+            return
+        scene_events, model_events = self.events, loop.events
+
+        def indicators(t, x):
+            own = np.asarray(model_events(t, x), float)
+            return own if scene_events is None else np.concatenate([scene_events[0](t, x), own])
+
+        def switch(t, x, fired):
+            mine = fired[n_scene:]
+            return loop.switch(t, x, mine) if mine.any() else None
+
+        first = (np.zeros(0, int), np.zeros(0, bool)) if scene_events is None else scene_events[1:]
+        self.events = (indicators, np.concatenate([first[0], loop.event_direction]),
+                       np.concatenate([first[1], loop.event_terminal]))
+        self.switch = switch
 
     def settings(self) -> tuple[str, float, float, float]:
         """``(method, h, rtol, atol)`` of the current attempt: the scene's, then per retry half the fixed step
@@ -320,7 +346,8 @@ class _Run:
         try:
             run = make_stepper(method, loop.rhs, t0, x0, t_end, rtol, atol, h_fixed, loop.jac, n2,
                                first_step=0.0 if fresh_solver else first_step, error_check=sol.error_check,
-                               events=self.events, jac_sparsity=getattr(loop, "jac_sparsity", None),
+                               events=self.events, switch=self.switch,
+                               jac_sparsity=getattr(loop, "jac_sparsity", None),
                                stall_steps=STALL_STEPS, stall_h=STALL_FRACTION * t_end)
         except BaseException as err:
             if writer is not None:

@@ -436,7 +436,12 @@ class ChainCVT(ModelBase):
                     "ratio": w[0] / w[1] if w[1] else math.nan, "efficiency": P[1] / P[0] if P[0] else 0.0,
                     "power": P, "work": W, "energy": self.energy(x),
                     "control.ratio_estimate": diag["ratio_estimate"], "control.resistance": diag["resistance"]})
+        out.update(self._more_outputs(x))
         return {s.name: out[s.name] for s in self.output_specs}
+
+    def _more_outputs(self, x) -> dict[str, Any]:
+        """Outputs a subclass adds to :attr:`output_specs` (none here)."""
+        return {}
 
     def span_tensions(self, q, v, pins, delta):
         """Mean link tension (N) of the tight and the slack span: links with both pins off contact

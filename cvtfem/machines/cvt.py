@@ -245,6 +245,13 @@ def chain_refusal(scene: Scene) -> InputError | None:
     if model not in ("chain-S1", "chain-S2") and not eff.pin_bending:
         return InputError("cvt.effects.pin_bending", False, f"must be true for `{model}` (its pins bend); "
                           "without pin bending use `chain-S2`")
+    if model == "chain-S1" and eff.contact == "impact":
+        return InputError("cvt.effects.contact", eff.contact, "must be 'rigid' for `chain-S1`: its pins carry no axial "
+                          "inertia, so a pin end entering a sheave takes no impulse (chain-models-1 2.1); the impact "
+                          "at contact onset runs with `chain-S2`")
+    if eff.contact == "impact" and model != "chain-S2":
+        return InputError("cvt.effects.contact", eff.contact, f"must be 'hertz' or 'hertz-refined' for `{model}`: the "
+                          "impact at contact onset runs with `chain-S2` only so far (rigid shafts)")
     if model == "chain-S1" and eff.contact != "rigid":
         return InputError("cvt.effects.contact", eff.contact, "must be 'rigid' for `chain-S1`: its pins have no axial "
                           "coordinate, their ends follow the sheave faces (chain-models-1 2.2)")
@@ -254,10 +261,10 @@ def chain_refusal(scene: Scene) -> InputError | None:
     if eff.shaft_elasticity and eff.contact != "hertz":
         return InputError("cvt.effects.shaft_elasticity", True, f"is not available with contact '{eff.contact}' yet: "
                           "elastic shafts run with H1 contact ('hertz'; set it false for the refined or rigid contact)")
-    if model != "chain-S1" and eff.contact not in ("hertz", "hertz-refined"):
+    if model != "chain-S1" and eff.contact not in ("hertz", "hertz-refined", "impact"):
         return InputError("cvt.effects.contact", eff.contact, f"must be 'hertz' or 'hertz-refined' for `{model}`: "
                           "Hertz contact at the pin-axis end or refined (the rigid contact runs with `chain-S1` only, "
-                          "the impact contact is not coupled to a running chain yet)")
+                          "the impact at contact onset with `chain-S2`)")
     if eff.contact == "hertz-refined" and model not in ("chain-S2", "chain-S3", "chain-A1", "chain-A2", "chain-A5"):
         return InputError("cvt.effects.contact", eff.contact, f"must be 'hertz' for `{model}`: the refined contact "
                           "runs with chain-S2, chain-S3, chain-A1, chain-A2 and chain-A5 only so far")
@@ -300,6 +307,9 @@ def chain_loop(scene: Scene):
     if eff.shaft_elasticity:
         from cvtfem.machines.chain_cvt_elastic import from_scene as elastic_from_scene
         return elastic_from_scene(scene, chain_geometry(scene), F_appl, model=model, contact=eff.contact, **overrides)
+    if eff.contact == "impact":
+        from cvtfem.machines.chain_impact_cvt import from_scene as impact_from_scene
+        return impact_from_scene(scene, chain_geometry(scene), F_appl, model=model, **overrides)
     return from_scene(scene, chain_geometry(scene), F_appl, model=model, contact=eff.contact, **overrides)
 
 
@@ -318,6 +328,8 @@ def _contact_note(scene: Scene) -> str:
     """Which contact the running chain's pin ends have, for `describe`."""
     if scene.cvt.model == "chain-S1":
         return "rigid contact: the pin ends follow the faces of"
+    if scene.cvt.effects.contact == "impact":
+        return "impact at contact onset (C2), then Hertz (H1) contact at both pin ends with"
     refined = scene.cvt.effects.contact == "hertz-refined"
     where = "both ends of both pin halves" if scene.cvt.model in ("chain-A2", "chain-A5", "chain-A5-point") else \
         "both pin ends"
@@ -334,8 +346,10 @@ def _running_chain_layout(scene: Scene) -> tuple[Layout, ...]:
         return tuple(o for o in model.output_specs if o.name.startswith(prefixes))
 
     parts = [Layout("chain", scene.cvt.model, n * per_pin, outputs=outputs("chain.", "contact."),
+                    n1=getattr(model, "n_discrete", -1) + 1, discrete=getattr(model, "n_discrete", 0),
                     note=f"{n} pins x {per_pin}; {_contact_note(scene)} each shaft's sheaves "
-                         "(continuous: no discrete state)"),
+                         + ("(discrete state per pin end and shaft, impact loss)" if hasattr(model, "n_discrete")
+                            else "(continuous: no discrete state)")),
              *_pulley_layouts(model, outputs, sheave)]
     if scene.cvt.effects.stabilisation:
         parts.append(Layout("stabilisation", "speed-ratio-control", 0, n1=Stabilisation.size,
