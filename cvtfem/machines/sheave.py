@@ -126,7 +126,8 @@ def unit_prestress(axisymmetric: HarmonicSheave):  # noqa: ANN201 - tuple of skf
     return axisymmetric.stress(axisymmetric.centrifugal_displacement(1.0))
 
 
-def own_waves_model(section: SheaveSection, n: int, n_modes: int | None, cells: tuple[int, int], prestress):  # noqa: ANN001, ANN201
+def own_waves_model(section: SheaveSection, n: int, n_modes: int | None, cells: tuple[int, int],
+                    prestress) -> tuple[np.ndarray, ...]:  # noqa: ANN001 - tuple of skfem fields
     """The bore-clamped waves of ``n >= 2`` nodal diameters reduced to ``n_modes`` fixed-interface modes and their
     twins (:func:`spin_reduction`, fixed frame), coordinates interleaved ``[cos_0, twin_0, cos_1, ...]`` so that
     each pair is one orbit: ``(M, K, G, K2)`` (kg; N/m; per unit spin, kg; per ``Omega^2``, kg)."""
