@@ -65,6 +65,9 @@ class RotorModel(ModelBase):
     K2 : scipy.sparse.csr_matrix (n, n) or None
         Flexible sheaves' stiffness per ``Omega^2`` (kg; spin stiffening and softening, fixed frame); K holds
         ``speed^2 K2``, :attr:`speed_terms` the change with the speed.
+    sheave_faces : tuple of FaceModes
+        Flexible sheaves' contact faces as their modal coordinates move them (for the radiated power,
+        :class:`~cvtfem.machines.sheave_face_modes.FaceModes`).
     """
 
     M: sp.csr_matrix
@@ -82,6 +85,7 @@ class RotorModel(ModelBase):
     tables: SpeedTables | None = None
     extra_diameters: tuple = ()
     K2: sp.csr_matrix | None = None
+    sheave_faces: tuple = ()
 
     @property
     def speed_terms(self) -> SpeedTerms | None:
@@ -441,7 +445,7 @@ def build_model(scene: Scene) -> RotorModel:
         K, C = (K + Kb).tocsr(), (C + Cb).tocsr()
     return RotorModel(M, K, C, G, z, beam, disks, bearings, profiles, speed,
                       tuple(d.node for d in scene.disk), tuple(flexible.kinds) if flexible else (),
-                      tables, tuple(flexible.diameters) if flexible else (), K2)
+                      tables, tuple(flexible.diameters) if flexible else (), K2, flexible.faces if flexible else ())
 
 
 def layout(scene: Scene) -> tuple[Layout, ...]:

@@ -66,6 +66,9 @@ class FlexibleSheaves:
         Nodal-diameter number of each modal coordinate.
     disks : tuple of int
         The ``[[disk]]`` indices made flexible.
+    faces : tuple of FaceModes
+        Per sheave its contact face's axial displacement per modal coordinate
+        (:class:`~cvtfem.machines.sheave_face_modes.FaceModes`).
     """
 
     mass: list
@@ -76,6 +79,7 @@ class FlexibleSheaves:
     kinds: np.ndarray
     diameters: np.ndarray
     disks: tuple[int, ...]
+    faces: tuple = ()
 
 
 def reduced_harmonics(section: SheaveSection, n_modes: int | None, cells: tuple[int, int],
@@ -130,12 +134,14 @@ def own_waves_model(section: SheaveSection, n: int, n_modes: int | None, cells: 
                     prestress) -> tuple[np.ndarray, ...]:  # noqa: ANN001 - tuple of skfem fields
     """The bore-clamped waves of ``n >= 2`` nodal diameters reduced to ``n_modes`` fixed-interface modes and their
     twins (:func:`spin_reduction`, fixed frame), coordinates interleaved ``[cos_0, twin_0, cos_1, ...]`` so that
-    each pair is one orbit: ``(M, K, G, K2)`` (kg; N/m; per unit spin, kg; per ``Omega^2``, kg)."""
+    each pair is one orbit: ``(M, K, G, K2, Phi)`` (kg; N/m; per unit spin, kg; per ``Omega^2``, kg; the ``cos``
+    coordinates' section basis, the twins' being ``P Phi``)."""
     model = HarmonicSheave(section, n, "cos", *cells)
-    spin = spin_reduction(model, craig_bampton(model, n_modes), prestress)
+    reduced = craig_bampton(model, n_modes)
+    spin = spin_reduction(model, reduced, prestress)
     m = spin.M.shape[0] // 2
     order = np.ravel(np.column_stack([np.arange(m), m + np.arange(m)]))
-    return tuple(X[np.ix_(order, order)] for X in (spin.M, spin.K, spin.G_fixed, spin.K2_fixed))
+    return tuple(X[np.ix_(order, order)] for X in (spin.M, spin.K, spin.G_fixed, spin.K2_fixed)) + (reduced.basis,)
 
 
 def flexible_sheaves(scene: Scene, nodes: np.ndarray, first_extra: int) -> FlexibleSheaves:
@@ -146,11 +152,12 @@ def flexible_sheaves(scene: Scene, nodes: np.ndarray, first_extra: int) -> Flexi
     disk's mass and gyroscopic matrix for these disks: the fixed-frame gyroscopic matrix of the harmonics
     (:func:`reduced_harmonics`) holds the rigid sheave's ``Ip`` and the spin of its own modes."""
     from cvtfem.elements.disk import axisymmetric_properties, sheave_profile
+    from cvtfem.machines.sheave_face_modes import face_modes, face_nodes
 
     opts = scene.sheave
     n_modes = None if opts.flexibility == "full" else opts.modes
     cells = (opts.cells_radial, opts.cells_axial)
-    mass, stiffness, gyroscopic, damping, spin_stiffness, kinds, diameters = [], [], [], [], [], [], []
+    mass, stiffness, gyroscopic, damping, spin_stiffness, kinds, diameters, faces = [], [], [], [], [], [], [], []
     nxt = first_extra
     for i in sheave_indices(scene):
         d = scene.disk[i]
@@ -167,6 +174,7 @@ def flexible_sheaves(scene: Scene, nodes: np.ndarray, first_extra: int) -> Flexi
                     "cos1": nxt + n_axial + n_torsion + 2 * np.arange(n_lateral)}
         own_dofs["twin1"] = own_dofs["cos1"] + 1
         pair_dofs, pair_signs = {0: [], 1: []}, {0: [], 1: []}
+        face_blocks = []                           # (own DOFs, their section basis, n, sin n a): the face's motion
         for n, family, node_dofs, signs in HARMONICS:
             red = models[(n, "cos" if family == "twin" else family)]
             own = own_dofs[f"{family}{n}"]
@@ -182,6 +190,8 @@ def flexible_sheaves(scene: Scene, nodes: np.ndarray, first_extra: int) -> Flexi
                 damping.append((np.diag(2 * opts.damping_ratio * omega)[None], own[None]))
             pair_dofs[n].append(dofs)
             pair_signs[n].append(S)
+            if (n, family) != (0, "sin"):           # torsion moves no face axially
+                face_blocks.append((own, red.basis[:, -n_own:] if n_own else red.basis[:, :0], n, family == "twin"))
         for n in (0, 1):
             # the mirror keeps x, y and the spin's sense from x to y: only the signs S of the coordinates change
             S = np.concatenate(pair_signs[n])
@@ -192,8 +202,9 @@ def flexible_sheaves(scene: Scene, nodes: np.ndarray, first_extra: int) -> Flexi
         diameters += [0] * (n_axial + n_torsion) + [1] * (2 * n_lateral)
         prestress = unit_prestress(HarmonicSheave(section, 0, "cos", *cells)) if opts.model_diameters > 1 else None
         for n in range(2, opts.model_diameters + 1):  # own waves: modal coordinates only (the z mirror keeps them)
-            M, K, G, K2 = own_waves_model(section, n, n_modes, cells, prestress)
+            M, K, G, K2, Phi = own_waves_model(section, n, n_modes, cells, prestress)
             own = nxt + np.arange(M.shape[0])[None]
+            face_blocks += [(own[0, 0::2], Phi, n, False), (own[0, 1::2], Phi, n, True)]
             for family, X in ((mass, M), (stiffness, K), (gyroscopic, G), (spin_stiffness, K2)):
                 family.append((X[None], own))
             if opts.damping_ratio > 0.0:
@@ -202,8 +213,9 @@ def flexible_sheaves(scene: Scene, nodes: np.ndarray, first_extra: int) -> Flexi
             nxt += M.shape[0]
             kinds += [0, 1] * (M.shape[0] // 2)
             diameters += [n] * M.shape[0]
+        faces.append(face_modes(i, face_nodes(HarmonicSheave(section, 0, "cos", *cells)), face_blocks, facing))
     return FlexibleSheaves(mass, stiffness, gyroscopic, damping, spin_stiffness, np.array(kinds, dtype=np.int64),
-                           np.array(diameters, dtype=np.int64), tuple(sheave_indices(scene)))
+                           np.array(diameters, dtype=np.int64), tuple(sheave_indices(scene)), tuple(faces))
 
 
 def cvt_sheave_section(scene: Scene) -> SheaveSection:
