@@ -2,8 +2,8 @@
 
 Excitation sources (:mod:`cvtfem.modal.excitation`): pin entry of a (randomised) chain at the sheaves' contact arc,
 torque-ripple orders, user lines.  Responses by modal superposition on one basis for the whole sweep
-(:class:`~cvtfem.modal.forced.ModalBasis`, ``modes="sweep"``); ERP from the rigid sheaves' axial and tilt motion
-(:mod:`cvtfem.modal.radiation`).
+(:class:`~cvtfem.modal.forced.ModalBasis`, ``modes="sweep"``); ERP from the sheaves' axial and tilt motion
+(:mod:`cvtfem.modal.radiation`), and for flexible sheaves their own modes' face motion.
 """
 from __future__ import annotations
 
@@ -20,7 +20,7 @@ from cvtfem.modal import ModalProblem, campbell, shaft_orders
 from cvtfem.modal.campbell import Campbell
 from cvtfem.modal.excitation import Lines, a_weighting_db, pin_entry_lines
 from cvtfem.modal.forced import ModalBasis, OutputMap, displacement
-from cvtfem.modal.radiation import Face, erp, power_db, rigid_annulus
+from cvtfem.modal.radiation import Face, annulus_panels, erp, power_db, rigid_annulus
 from cvtfem.scene.loader import Scene
 
 #: Highest frequency of a map or an excitation line, rad/s (1 GHz: far above any structural mode).
@@ -202,12 +202,17 @@ def pin_entry_force(scene: Scene, model: RotorModel, pin: PinEntry) -> np.ndarra
 
 
 def sheave_faces(scene: Scene, model: RotorModel) -> Face:
-    """Both faces of every sheave as rigid annuli from the hub to the outer radius (projected on the radial plane)."""
+    """Both faces of every sheave as annuli from the hub to the outer radius (projected on the radial plane): the
+    rigid disc's motion, plus a flexible sheave's own modes (:attr:`RotorModel.sheave_faces`)."""
     faces = []
     for i in sheaves(scene):
         d = scene.disk[i]
         q = 6 * int(model.disks.nodes[i])
         face = rigid_annulus(model.n_dof, (q + 2, q + 3, q + 4), d.hub_diameter / 2, d.outer_diameter / 2)
+        own = [f for f in model.sheave_faces if f.disk == i]
+        if own:
+            r, a, _ = annulus_panels(d.hub_diameter / 2, d.outer_diameter / 2)
+            face = Face(face.area, (face.N + sum(f.rows(model.n_dof, r, a) for f in own)).tocsr())
         faces += [face, face]
     if not faces:
         raise InputError("SCENE", scene.source, "needs sheaves (disks with geometry = 'sheave') for the ERP")

@@ -36,8 +36,9 @@ def _pair(text: str, where: str, low: tuple[int, int], high: tuple[int, int]) ->
 
 
 def own_waves(scene, speeds):  # noqa: ANN001, ANN201 - Scene, array -> list of (label, array)
-    """Fixed-frame Hz over ``speeds`` (rad/s) of the own waves (n = 2..[sheave].diameters) of each flexible
-    sheave of a rotor scene, labelled ``"disk I sheave n=2 fw"``; none when the sheaves are rigid."""
+    """Fixed-frame Hz over ``speeds`` (rad/s) of the own waves (n = 2..[sheave].diameters, those beyond
+    ``model_diameters``: the rotor model solves the others) of each flexible sheave of a rotor scene, labelled
+    ``"disk I sheave n=2 fw"``; none when the sheaves are rigid."""
     if scene.sheave is None or scene.sheave.flexibility == "rigid":
         return []
     from cvtfem.machines.sheave import sheave_indices, sheave_section
@@ -45,7 +46,8 @@ def own_waves(scene, speeds):  # noqa: ANN001, ANN201 - Scene, array -> list of 
 
     opts, out = scene.sheave, []
     for i in sheave_indices(scene):
-        lines = sheave_waves(sheave_section(scene, i), opts.diameters, speeds, (opts.cells_radial, opts.cells_axial))
+        lines = sheave_waves(sheave_section(scene, i), opts.diameters, speeds, (opts.cells_radial, opts.cells_axial),
+                             first=opts.model_diameters + 1)
         out += [(f"disk {i} {label}", hz) for label, hz in lines]
     return out
 

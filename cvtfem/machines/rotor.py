@@ -60,6 +60,14 @@ class RotorModel(ModelBase):
         :func:`cvtfem.machines.sheave.flexible_sheaves`).
     tables : SpeedTables or None
         Bearing coefficients over speed; K and C hold them at ``speed``, :attr:`speed_terms` the rest.
+    extra_diameters : tuple of int
+        Nodal-diameter number of each flexible-sheave modal coordinate.
+    K2 : scipy.sparse.csr_matrix (n, n) or None
+        Flexible sheaves' stiffness per ``Omega^2`` (kg; spin stiffening and softening, fixed frame); K holds
+        ``speed^2 K2``, :attr:`speed_terms` the change with the speed.
+    sheave_faces : tuple of FaceModes
+        Flexible sheaves' contact faces as their modal coordinates move them (for the radiated power,
+        :class:`~cvtfem.machines.sheave_face_modes.FaceModes`).
     """
 
     M: sp.csr_matrix
@@ -75,11 +83,17 @@ class RotorModel(ModelBase):
     seats: tuple = ()
     extra_kinds: tuple = ()
     tables: SpeedTables | None = None
+    extra_diameters: tuple = ()
+    K2: sp.csr_matrix | None = None
+    sheave_faces: tuple = ()
 
     @property
     def speed_terms(self) -> SpeedTerms | None:
-        """What K and C gain away from the model's speed (speed-dependent bearings), or None."""
-        return None if self.tables is None else SpeedTerms(self.n_dof, self.tables, self.speed)
+        """What K and C gain away from the model's speed (speed-dependent bearings, spinning flexible sheaves), or
+        None."""
+        if self.tables is None and self.K2 is None:
+            return None
+        return SpeedTerms(self.n_dof, self.tables, self.speed, self.K2)
 
     @property
     def n_dof(self) -> int:
@@ -207,7 +221,7 @@ class RotorModel(ModelBase):
     def sheave_share(self, shapes: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Per mode shape (columns): the share of its strain energy ``x^H K x`` in the flexible sheaves (their
         fixed-interface modes ``q``: ``q^H K_qq q``, an exact split because Craig–Bampton leaves no stiffness
-        between them and the nodes), and the nodal-diameter number (0 or 1) of the sheave mode storing most;
+        between them and the nodes), and the nodal-diameter number of the sheave mode storing most;
         ``(0, -1)`` for rotors without flexible sheaves."""
         k = shapes.shape[1]
         if not self.extra_kinds:
@@ -216,8 +230,7 @@ class RotorModel(ModelBase):
         Kqq = self.K[self.n_node_dofs:, self.n_node_dofs:]
         energy = np.real(q.conj() * (Kqq @ q))
         share = energy.sum(axis=0) / np.real(np.sum(shapes.conj() * (self.K @ shapes), axis=0))
-        kinds = np.array(self.extra_kinds)
-        return share, np.where(np.isin(kinds[np.argmax(energy, axis=0)], (2, 5)), 0, 1)
+        return share, np.array(self.extra_diameters, dtype=np.int64)[np.argmax(energy, axis=0)]
 
     @property
     def n_node_dofs(self) -> int:
@@ -322,17 +335,24 @@ def _lateral(n: int, nodes: np.ndarray, blocks: np.ndarray) -> sp.csr_matrix:
 class SpeedTerms:
     """Speed-dependent part of a rotor's K and C: ``(K(speed) - K(speed0), C(speed) - C(speed0))``.
 
-    The model's own K and C hold the tabulated coefficients at ``speed0`` (``[rotor] speed``); solvers that follow
-    the speed (``ModalProblem``, ``unbalance_response``) add these differences. ``pattern``: where they can be non-zero.
+    The model's own K and C hold the tabulated coefficients (``tables``, or None) and the spinning sheaves'
+    ``speed0^2 K2`` (``K2``, or None) at ``speed0`` (``[rotor] speed``); solvers that follow the speed
+    (``ModalProblem``, ``unbalance_response``) add these differences. ``pattern``: where they can be non-zero.
     """
 
     n: int
-    tables: SpeedTables = field(repr=False)
+    tables: SpeedTables | None = field(repr=False)
     speed0: float = 0.0
+    K2: sp.csr_matrix | None = field(default=None, repr=False)
 
     @cached_property
     def pattern(self) -> sp.csr_matrix:
-        return _lateral(self.n, self.tables.nodes, np.ones((len(self.tables.nodes), 2, 2)))
+        out = sp.csr_matrix((self.n, self.n))
+        if self.tables is not None:
+            out = out + _lateral(self.n, self.tables.nodes, np.ones((len(self.tables.nodes), 2, 2)))
+        if self.K2 is not None:
+            out = out + abs(self.K2)
+        return out.tocsr()
 
     @cached_property
     def _base(self) -> tuple[np.ndarray, np.ndarray]:
@@ -340,11 +360,17 @@ class SpeedTerms:
 
     @property
     def damped(self) -> bool:
-        return bool(np.any([v[:, 4:] for v in self.tables.values]))
+        return self.tables is not None and bool(np.any([v[:, 4:] for v in self.tables.values]))
 
     def __call__(self, speed: float) -> tuple[sp.csr_matrix, sp.csr_matrix]:
-        k, c = self.tables.blocks(speed)
-        return _lateral(self.n, self.tables.nodes, k - self._base[0]), _lateral(self.n, self.tables.nodes, c - self._base[1])
+        dK, dC = sp.csr_matrix((self.n, self.n)), sp.csr_matrix((self.n, self.n))
+        if self.tables is not None:
+            k, c = self.tables.blocks(speed)
+            dK = _lateral(self.n, self.tables.nodes, k - self._base[0])
+            dC = _lateral(self.n, self.tables.nodes, c - self._base[1])
+        if self.K2 is not None:
+            dK = (dK + (speed ** 2 - self.speed0 ** 2) * self.K2).tocsr()
+        return dK, dC
 
 
 def build_model(scene: Scene) -> RotorModel:
@@ -406,17 +432,20 @@ def build_model(scene: Scene) -> RotorModel:
                      *(flexible.damping if flexible else ())])
     G = assemble(n, [(beam.gyroscopic(), beam.dofs), (disks.gyroscopic()[rigid], disks.dofs[rigid]),
                      (bearings.gyroscopic(), bearings.dofs), *(flexible.gyroscopic if flexible else ())])
+    K2 = assemble(n, flexible.spin_stiffness) if flexible else None
     z = np.concatenate([[0.0], np.cumsum(arrays["L"][~parallel]), np.zeros(n_support + len(elastic))])
     z[n_shaft + n_support:] = z[[scene.disk[i].node for i in elastic]]
     z[n_shaft:n_shaft + n_support] = _support_positions(scene, z, n_shaft, n_support)
     speed = opts.speed if opts else 0.0
+    if K2 is not None:  # K holds the spinning sheaves' stiffness at the model's speed
+        K = (K + speed ** 2 * K2).tocsr()
     tables = _speed_tables(scene)
     if tables is not None:  # M, K, C hold the tabulated coefficients at the model's speed
         Kb, Cb = (_lateral(n, tables.nodes, X) for X in tables.blocks(speed))
         K, C = (K + Kb).tocsr(), (C + Cb).tocsr()
     return RotorModel(M, K, C, G, z, beam, disks, bearings, profiles, speed,
                       tuple(d.node for d in scene.disk), tuple(flexible.kinds) if flexible else (),
-                      tables)
+                      tables, tuple(flexible.diameters) if flexible else (), K2, flexible.faces if flexible else ())
 
 
 def layout(scene: Scene) -> tuple[Layout, ...]:
@@ -432,11 +461,14 @@ def layout(scene: Scene) -> tuple[Layout, ...]:
     flexibility = scene.sheave.flexibility if scene.sheave is not None else "rigid"
     if flexibility != "rigid":
         count = sum(d.geometry == "sheave" for d in scene.disk)
-        size = 4 * scene.sheave.modes * count if flexibility == "reduced" else None
+        size = (4 + 2 * max(scene.sheave.model_diameters - 1, 0)) * scene.sheave.modes * count \
+            if flexibility == "reduced" else None
         parts.append(Layout("sheaves", f"craig-bampton-sheave ({flexibility})",
                             size if size is not None else build_model(scene).n_dof - 6 * nodes - 6 * sum(
                                 d.connection == "elastic" for d in scene.disk) - 6 * _support_nodes(scene, nodes),
-                            note=f"{count} sheaves: modal coordinates of n = 0 (axial, torsion) and n = 1 (x, y)"))
+                            note=f"{count} sheaves: modal coordinates of n = 0 (axial, torsion), n = 1 (x, y)"
+                                 + (f" and the waves of n = 2..{scene.sheave.model_diameters}"
+                                    if scene.sheave.model_diameters > 1 else "")))
     if scene.bearing:
         supports = _support_nodes(scene, nodes)
         parts.append(Layout("bearings", "bearing", 6 * supports, outputs=bearings,

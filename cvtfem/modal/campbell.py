@@ -108,6 +108,10 @@ CRITICALLY_DAMPED = 0.2
 def track(modes: list[Modes], n_modes: int) -> tuple[np.ndarray, np.ndarray]:
     """Column permutations that follow mode identity across speeds by MAC.
 
+    A mode whose frequency, extrapolated linearly from the two speeds before, passes through zero (a backward
+    wave at its critical speed: a flexible sheave's, a disc's) comes back as the complex conjugate of its shape,
+    seen with the positive frequency of the opposite sense: for that mode the MAC is also taken with the conjugate.
+
     Parameters
     ----------
     modes : list of Modes
@@ -127,6 +131,11 @@ def track(modes: list[Modes], n_modes: int) -> tuple[np.ndarray, np.ndarray]:
     for i in range(1, len(modes)):
         cand = modes[i].shapes
         m = mac(ref, cand)
+        if i >= 2:
+            wd = [modes[k].wd[index[k]] for k in (i - 2, i - 1)]
+            through = np.flatnonzero(2 * wd[1] - wd[0] < 0.0)        # heading through zero frequency
+            if through.size:
+                m[through] = np.maximum(m[through], mac(ref[:, through].conj(), cand))
         rows, col = linear_sum_assignment(1.0 - m)
         index[i], match[i] = col, m[rows, col]
         ref = cand[:, col]

@@ -68,8 +68,8 @@ def wedge_opening(section: SheaveSection, force: float,
 
 
 def sheave_waves(section: SheaveSection, diameters: int, speeds: np.ndarray,
-                 mesh: tuple[int, int] = (24, 2)) -> list[tuple[str, np.ndarray]]:
-    """Campbell lines of the sheave's own lowest waves of ``n = 2..diameters`` nodal diameters (bore clamped: they
+                 mesh: tuple[int, int] = (24, 2), first: int = 2) -> list[tuple[str, np.ndarray]]:
+    """Campbell lines of the sheave's own lowest waves of ``n = first..diameters`` nodal diameters (bore clamped: they
     do not move the shaft), as ``(label, fixed-frame Hz per speed)`` with labels ``"sheave n=2 fw"`` and
     ``"sheave n=2 bw"``.  Each wave follows ``f(Omega)^2 = f_0^2 + lambda Omega^2`` in the rotating frame
     (``lambda`` fitted to the Coriolis-coupled model at the highest speed, rad/s) and is seen at
@@ -77,13 +77,13 @@ def sheave_waves(section: SheaveSection, diameters: int, speeds: np.ndarray,
     speeds = np.asarray(speeds, float)
     top = float(speeds.max())
     lines = []
-    if diameters < 2:
+    if diameters < first:
         return lines
     prestress = None
     if top > 0.0:
         axisym = HarmonicSheave(section, 0, "cos", *mesh)
         prestress = axisym.stress(axisym.centrifugal_displacement(top))
-    for n in range(2, diameters + 1):
+    for n in range(max(first, 2), diameters + 1):
         model = HarmonicSheave(section, n, "cos", *mesh)
         f0 = model.modes(1)[0][0]
         if prestress is None:

@@ -4,8 +4,9 @@ For each sheave model: the driven clamping force F2 of the clamping schedule, th
 span angle of the target ratio in steady running (root of the span angle's acceleration), then the efficiency
 ``-M2 w2 / (M1 w1)``, the speed ratio, the faces' opening and the running radius along each arc (nominal radius
 plus the band's radial Ritz displacement).  Prints a table; ``--png`` draws the opening and radius change;
-``--bench`` times the right-hand side (median of 7 x 300 calls, interleaved), rigid and flexible, each compiled
-and as its numpy twin; ``--convergence`` repeats the flexible case with other harmonic counts and meshes;
+``--bench`` times the right-hand side (median of 7 rounds, each the median of 1000 calls, interleaved), rigid and
+flexible (face table, and the exact face systems at every call), each compiled and as its numpy twin, and the
+compiled Jacobian; ``--convergence`` repeats the flexible case with other harmonic counts and meshes;
 ``--ratios`` compares rigid and flexible over the ratio range (same torque and speed).
 
     .venv/bin/python studies/sheaves/band_on_flexible_sheaves.py [--png out.png] [--bench] [--convergence] [--ratios]
@@ -52,22 +53,33 @@ def running_radius(band, q):
 
 
 def bench() -> None:
-    """Median right-hand-side times, us: interleaved rounds of 300 calls at the steady start state."""
+    """Median right-hand-side times, us: interleaved rounds of 1000 calls at the steady start state; the compiled
+    Jacobian (rounds of 30 calls)."""
     import dataclasses
 
-    rigid = closed_loop(load_scene("band-6+2n"))
-    loops = {"rigid (numba)": rigid,
-             "rigid (numpy twin)": dataclasses.replace(rigid, model=dataclasses.replace(rigid.model, use_numba=False)),
-             "flexible (numba)": closed_loop(load_scene("band-6+2n-flexible"))}
-    loops["flexible (numpy twin)"] = dataclasses.replace(
-        loops["flexible (numba)"], model=dataclasses.replace(loops["flexible (numba)"].model, use_numba=False))
+    def variant(loop, **changes):
+        return dataclasses.replace(loop, model=dataclasses.replace(loop.model, **changes))
+
+    rigid, flexible = closed_loop(load_scene("band-6+2n")), closed_loop(load_scene("band-6+2n-flexible"))
+    loops = {"rigid (numba)": rigid, "rigid (numpy twin)": variant(rigid, use_numba=False),
+             "flexible (numba)": flexible, "flexible (numpy twin)": variant(flexible, use_numba=False),
+             "flexible exact (numba)": variant(flexible, face_intervals=0),
+             "flexible exact (numpy)": variant(flexible, face_intervals=0, use_numba=False)}
     x = rigid.initial_state()
+    print(f"machine: {machine()}")
     times = {name: [] for name in loops}
+    jac = {name: [] for name in ("rigid (numba)", "flexible (numba)", "flexible exact (numba)")}
     for _ in range(7):
         for name, loop in loops.items():
-            times[name].append(median_us(lambda: loop.rhs(0.0, x), 300, warm_up=True))
+            times[name].append(median_us(lambda: loop.rhs(0.0, x), 1000 if "numba" in name else 100, warm_up=True))
+            if name in jac:
+                jac[name].append(median_us(lambda: loop.jac(0.0, x), 30, warm_up=True))
+    base = np.median(times["rigid (numba)"])
     for name, t in times.items():
-        print(f"rhs {name:20s} {np.median(t):8.1f} us (rounds {min(t):.1f}..{max(t):.1f})")
+        print(f"rhs {name:24s} {np.median(t):8.1f} us (rounds {min(t):.1f}..{max(t):.1f}) "
+              f"{np.median(t) / base - 1:+7.0%} against rigid (numba)")
+    for name, t in jac.items():
+        print(f"jacobian {name:19s} {np.median(t):8.1f} us (rounds {min(t):.1f}..{max(t):.1f})")
 
 
 def convergence() -> None:

@@ -93,15 +93,20 @@ def test_rigid_sheaves_run_the_compiled_kernel_unchanged():
     assert np.array_equal(plain.rhs(0.01, x), marked.rhs(0.01, x))
 
 
-def test_compiled_flexible_faces_equal_the_numpy_twin(flexible_loop):
-    """The compiled kernel with flexible faces (Clenshaw for ``c_n(r)``, the Chebyshev recurrence for
-    ``cos n theta``, BLAS for ``K_f``, one complex LU for ``A``) against ``accel_numpy`` at random states:
-    accelerations, normal forces, slips and powers within 1e-12 relative or 10 x the strain's rounding sensitivity
-    (observed below 0.4 of that), energies to 1e-12."""
+@pytest.mark.parametrize("intervals", [256, 0])
+def test_compiled_flexible_faces_equal_the_numpy_twin(flexible_loop, intervals):
+    """The compiled kernel with flexible faces against ``accel_numpy`` at random states, with the face table (both
+    interpolate it) and without (the kernel: Clenshaw for ``c_n(r)``, the Chebyshev recurrence for ``cos n theta``,
+    one complex LU for ``A`` and the complex step through it; the twin: ``A^-1 E^T`` condensed and its derivative in
+    phi; both form ``eps_r = E^T x~`` with ``z - z0`` rounded once): accelerations, normal forces, slips and powers
+    within 1e-12 relative or 10 x the strain's rounding sensitivity (observed below 0.02 of that), energies to 1e-12
+    (observed 8e-15)."""
+    import dataclasses
+
     from tests.band.test_compressible_kernel import _random_states, _rounding_scale
 
     pytest.importorskip("numba")
-    m = flexible_loop.model
+    m = dataclasses.replace(flexible_loop.model, face_intervals=intervals)
     assert m.backend == "numba"
     for q, v, F, M in _random_states(m, np.random.default_rng(5), 3):
         a1, i1 = m.accel(q, v, F, M)

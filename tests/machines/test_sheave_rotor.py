@@ -181,7 +181,7 @@ def test_reduced_fixed_frame_sheave_on_a_clamped_bore_sees_its_waves_shifted_by_
     from cvtfem.scene.loader import load_scene
 
     section = sheave_section(load_scene("cvt_sheave_shaft"), 0)
-    reduced, gyro = reduced_harmonics(section, 8, (12, 2), 0.0)
+    reduced, gyro, _ = reduced_harmonics(section, 8, (12, 2), 0.0)
     red, omega = reduced[(1, "cos")], 6000 * np.pi / 30
     m = red.M.shape[0]
     own = np.r_[2:m, m + 2:2 * m]                               # the modes of the cos model and of its twin

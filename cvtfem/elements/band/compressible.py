@@ -22,6 +22,8 @@ sheave pair, components along i, j).
   between the Gauss nodes, :class:`~cvtfem.elements.sheave_face.FaceCompliance`, ``D`` the arc-length weights),
   so ``eps = A^-1 eps_r`` with ``A = I + c' K_f D``; the sheaves' strain energy joins the band's,
   ``V = c' int eps eps_r ds`` (the minimum over ``w``), whose gradient in ``x`` is ``2 c' int E eps ds``.
+  Condensed onto the arc functions ``E`` and tabulated in phi (:mod:`cvtfem.elements.band.face_table`):
+  ``eps = eps_r + dG x~``, ``V = c' int eps_r^2 ds + c' x~^T dK x~`` with ``x~ = x - z0 e_0``.
 """
 from __future__ import annotations
 
@@ -30,6 +32,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from cvtfem.elements.band import compressible_kernel as ker
+from cvtfem.elements.band.face_table import INTERVALS, face_table
 from cvtfem.elements.contact.friction import friction_vector
 from cvtfem.elements.band.geometry import radii
 from cvtfem.elements.band.inertia import band_inertia
@@ -52,13 +55,16 @@ class CompressibleBand:
     ``use_numba``: evaluate :meth:`accel` and :meth:`jacobian` with the compiled kernels of
     ``compressible_kernel`` (when numba is installed); :meth:`accel_numpy` is their reference twin.
     ``faces``: the face compliance of the driving and driven sheaves
-    (:class:`~cvtfem.elements.sheave_face.FaceCompliance`), or None for rigid faces.
+    (:class:`~cvtfem.elements.sheave_face.FaceCompliance`), or None for rigid faces; ``face_intervals``: grid
+    intervals of their table in phi (:mod:`~cvtfem.elements.band.face_table`), 0 for the exact face systems at
+    every call (the reference the table is checked against).
     """
 
     p: BandParams
     shaft_compliance: bool = False
     use_numba: bool = True
     faces: tuple | None = None
+    face_intervals: int = INTERVALS
     _c: dict = field(init=False, repr=False, default_factory=dict)
 
     def __post_init__(self) -> None:
@@ -77,6 +83,7 @@ class CompressibleBand:
         self._c.update(xi=xi, wq=wq, F=F, dF=dF, nx=nx, c_edge=c_edge, xidx=xidx, bidx=np.r_[0, 1, 6:6 + 2 * n],
                        ones=np.ones((2, 1, len(xi))), mdF=-dF[None],
                        beta=2 * p.damping_ratio / omega_z if p.damping else 0.0, alpha=ritz_alpha(n))
+        self._c["table"] = face_table(self, self.face_intervals) if self.faces and self.face_intervals else None
         self._c["packed"] = ker.pack(self)
 
     @property
@@ -138,10 +145,35 @@ class CompressibleBand:
             rows.append(np.stack([-tg[:, None] * cs, -tg[:, None] * sn, lev * sn, -lev * cs], axis=1))
             geo.update(a=a, cs=cs, sn=sn)
         geo["E"] = np.concatenate(rows, axis=1)  # (2, nx, g): d eps / d x_k at the nodes
-        if self.faces is not None:  # A = I + c' K_f D per arc (flexible sheaves)
-            geo["A"] = np.stack([np.eye(len(c["xi"])) + c["c_edge"] * self.faces[k].matrix(r[k], th[k]) * geo["ds"][k]
-                                 for k in range(2)])
         return geo
+
+    def face_systems(self, geo) -> np.ndarray:
+        """``A = I + c' K_f D`` of each arc (flexible sheaves), ``(2, g, g)``, from the geometry :meth:`arcs`."""
+        g = len(self._c["xi"])
+        return np.stack([np.eye(g) + self._c["c_edge"] * self.faces[k].matrix(geo["r"][k], geo["th"][k]) * geo["ds"][k]
+                         for k in range(2)])
+
+    def face_terms(self, phi: float) -> tuple[np.ndarray, np.ndarray]:
+        """``[dG; dK]`` of each arc and its phi-derivative, each ``(2, g + nx, nx)``
+        (:mod:`~cvtfem.elements.band.face_table`): from the table where it covers phi, else exactly (``A``
+        solved, complex step in phi)."""
+        table = self._c.get("table")
+        return table.at(phi) if table is not None and table.covers(phi) else self.exact_face_terms(phi)
+
+    def exact_face_terms(self, phi: float) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`face_terms` from the face systems ``A`` at ``phi + i h``."""
+        g = self.arcs(phi + 1j * H)
+        Et = np.swapaxes(g["E"], 1, 2)                                  # (2, g, nx)
+        dG = np.linalg.solve(self.face_systems(g), Et) - Et
+        dK = np.einsum("kxg,kg,kgy->kxy", g["E"], g["ds"], dG)
+        block = np.concatenate([dG, 0.5 * (dK + np.swapaxes(dK, 1, 2))], axis=1)
+        return block.real, block.imag / H
+
+    def _x_tilde(self, q, geo):
+        """``x~ = x - z0 e_0`` per arc, ``(2, nx)`` (complex with a complex geometry): ``eps_r = E^T x~``."""
+        X = q[self._c["xidx"]] + 0 * geo["z0"][:, None]
+        X[:, 0] -= geo["z0"]
+        return X
 
     def band_mass(self, phi, geo=None):
         """Band block of the mass matrix over ``[phi, sigma, h1, h2]`` (may be complex), kg-based units."""
@@ -167,9 +199,11 @@ class CompressibleBand:
     def face_opening(self, q, geo=None):
         """Axial opening ``w = eps - eps_r`` (m, ``(2, g)``) of each sheave face at the arc's Gauss nodes (zero on
         rigid faces); ``> 0`` where the face gives way under the band."""
+        if self.faces is None:
+            return np.zeros((2, len(self._c["xi"])))
         g = self.arcs(q[0]) if geo is None else geo
-        eps_r = self.strain(q, g)
-        return np.linalg.solve(g["A"], eps_r[..., None])[..., 0] - eps_r if "A" in g else np.zeros_like(eps_r)
+        gn = len(self._c["xi"])
+        return np.einsum("kgx,kx->kg", self.face_terms(q[0])[0][:, :gn], self._x_tilde(q, g))
 
     def accel(self, q, v, F, M):
         """Accelerations and diagnostics (``N`` (2, g) N/m, ``dissipation``, ``clamp_power`` W, slips)."""
@@ -215,20 +249,28 @@ class CompressibleBand:
         phi = q[0]
         gc = self.arcs(phi + 1j * H)
         g = {k: (val.real if val.dtype.kind == "c" else val) for k, val in gc.items()}
-        eps_c = self.strain(q, gc)
-        E_eps = g["E"]  # d eps / d x at the nodes
         if self.faces is None:
-            Pi_c = c["c_edge"] * np.sum(eps_c ** 2 * gc["ds"])
-        else:  # flexible faces: eps = A^-1 eps_r, V = c' int eps eps_r ds
-            eps_r_c, eps_c = eps_c, np.linalg.solve(gc["A"], eps_c[..., None])[..., 0]
-            Pi_c = c["c_edge"] * np.sum(eps_c * eps_r_c * gc["ds"])
-            E_eps = np.swapaxes(np.linalg.solve(g["A"], np.swapaxes(g["E"], 1, 2)), 1, 2)
+            eps_c = self.strain(q, gc)
+        else:  # eps_r = E^T x~ (z - z0 rounded once, as the compiled kernel)
+            xt_c = self._x_tilde(q, gc)
+            eps_c = np.einsum("kx,kxg->kg", xt_c, gc["E"])
+        Pi_c = c["c_edge"] * np.sum(eps_c ** 2 * gc["ds"])
         eps, deps = eps_c.real, eps_c.imag / H
+        E_eps = g["E"]  # d eps / d x at the nodes
         Q = np.zeros(n2)
         # elastic band energy and its generalized forces
         Q[0] -= Pi_c.imag / H
         xidx = c["xidx"]
         Q[xidx] -= 2 * c["c_edge"] * np.einsum("kxg,kg->kx", g["E"], eps * g["ds"])
+        if self.faces is not None:  # flexible faces: eps = eps_r + dG x~, V = c' int eps_r^2 ds + c' x~^T dK x~
+            gn = len(c["xi"])
+            (dG, dK), (dG_d, dK_d) = ((T[:, :gn], T[:, gn:]) for T in self.face_terms(phi))
+            xt, dxt = xt_c.real, xt_c.imag / H
+            eps = eps + np.einsum("kgx,kx->kg", dG, xt)
+            deps = deps + np.einsum("kgx,kx->kg", dG_d, xt) + np.einsum("kgx,kx->kg", dG, dxt)
+            E_eps = E_eps + np.swapaxes(dG, 1, 2)
+            Q[xidx] -= 2 * c["c_edge"] * np.einsum("kxy,ky->kx", dK, xt)
+            Q[0] -= c["c_edge"] * (np.einsum("kx,kxy,ky->", xt, dK_d, xt) + 2 * np.einsum("kx,kxy,ky->", dxt, dK, xt))
         Q[4:6] -= p.kappa * np.asarray(F)
         dissipation = 0.0
         if self.shaft_compliance:
@@ -361,11 +403,13 @@ class CompressibleBand:
         of :meth:`energies`."""
         p, n = self.p, self.p.n_ritz
         g = self.arcs(q[0])
-        eps = self.strain(q, g)
         if self.faces is None:
-            E = self._c["c_edge"] * np.sum(eps ** 2 * g["ds"])
-        else:  # the band's and the sheaves' strain energy, c' int eps eps_r ds
-            E = self._c["c_edge"] * np.sum((eps + self.face_opening(q, g)) * eps * g["ds"])
+            E = self._c["c_edge"] * np.sum(self.strain(q, g) ** 2 * g["ds"])
+        else:  # the band's strain energy and the sheaves', c' x~^T dK x~ (together c' int eps eps_r ds)
+            xt = self._x_tilde(q, g)
+            dK = self.face_terms(q[0])[0][:, len(g["ds"][0]):]
+            E = self._c["c_edge"] * (np.sum(np.einsum("kx,kxg->kg", xt, g["E"]) ** 2 * g["ds"])
+                                     + np.einsum("kx,kxy,ky->", xt, dK, xt))
         if self.shaft_compliance:
             b = 6 + 2 * n
             for k in range(2):
@@ -380,21 +424,18 @@ class CompressibleBand:
     def static_state(self, phi: float, F) -> np.ndarray:
         """Coordinates in static equilibrium of the elastic coordinates at span angle phi and forces F.
 
-        Solves ``(2 c' int E E^T ds + D) x = 2 c' int E z0 ds - kappa F e_z`` per arc (Pi is quadratic in x).
+        Solves ``(2 c' (int E E^T ds + dK) + D) x = 2 c' (int E E^T ds + dK) z0 e_0 - kappa F e_z`` per arc (Pi is
+        quadratic in x; ``dK`` the flexible faces' condensed stiffness, :meth:`face_terms`, else 0).
         """
         p, c, n = self.p, self._c, self.p.n_ritz
         g = self.arcs(phi)
         q = np.zeros(self.n2)
         q[0] = phi
+        dK = self.face_terms(phi)[0][:, len(c["xi"]):] if self.faces is not None else np.zeros((2, 1, 1))
         for k in range(2):
             E, ds = g["E"][k], g["ds"][k]
-            if "A" not in g:
-                K = 2 * c["c_edge"] * (E * ds) @ E.T
-                rhs = 2 * c["c_edge"] * (E @ (g["z0"][k] * ds))
-            else:  # flexible faces: V = c' eps_r^T W eps_r, W = D A^-1 = (D^-1 A^T)^-1 = (D^-1 + c' K_f)^-1
-                W = np.linalg.inv(np.diag(1.0 / ds) @ g["A"][k].T)
-                K = 2 * c["c_edge"] * E @ W @ E.T
-                rhs = 2 * c["c_edge"] * (E @ W @ np.full_like(ds, g["z0"][k]))
+            K = 2 * c["c_edge"] * ((E * ds) @ E.T + dK[k])
+            rhs = K[:, 0] * g["z0"][k]
             rhs[0] -= p.kappa * F[k]
             if self.shaft_compliance:
                 K[1 + n:, 1 + n:] += np.diag([p.c_U[k]] * 2 + [p.c_psi[k]] * 2)

@@ -10,7 +10,9 @@ Parameters are packed by :func:`pack`: ``s`` (scalars, index constants ``S_*``),
 faces ``[profile (0 conical, 1 toroidal), gamma, R, y, w]``, ``sf`` (2, 5) shafts
 ``[J, m_sheave, Theta, c_U, c_psi]``, ``xidx`` (2, nx) elastic-coordinate indices, the Ritz shapes, and the
 flexible sheave faces (issue 20): ``fc`` (2, H + 1, d + 1) Chebyshev coefficients of each pulley's face
-compliance ``c_n(r)`` and ``fr`` (2, 2) their radius ranges (``S_FLEX`` = 0: rigid faces, not read).
+compliance ``c_n(r)`` and ``fr`` (2, 2) their radius ranges (``S_FLEX`` = 0: rigid faces, not read), and their
+table in phi ``tab`` (:class:`~cvtfem.elements.band.face_table.FaceTable` values; grid start, step and intervals in
+``S_TLO``, ``S_TH``, ``S_TN``, ``S_TN`` = 0: no table), read where it covers phi, the exact face systems elsewhere.
 Complex powers are written as products: numba's complex ``z ** k`` goes through exp/log, whose
 rounding (~1e-16 |z|^k in the imaginary part) swamps a 1e-30 complex step.
 """
@@ -24,15 +26,18 @@ H = 1e-30  # complex step, as in compressible.py
 LAW_CODES = {"tanh": 0, "smoothed": 1, "linear-saturated": 2}
 # scalar slots of ``s``
 (S_LENGTH, S_L, S_MASS, S_RHO, S_CEDGE, S_C, S_KAPPA, S_BETA, S_F0, S_V0, S_LAW, S_FRICTION, S_SHAFT,
- S_DAMPING, S_GYRO, S_NU, S_FLEX) = range(17)
+ S_DAMPING, S_GYRO, S_NU, S_FLEX, S_TLO, S_TH, S_TN) = range(20)
 
 
 def pack(model) -> tuple:
     """Kernel arguments of a :class:`CompressibleBand` (arrays only, built once per model)."""
     p, c = model.p, model._c
+    table = c.get("table")
     s = np.array([p.length, p.L, p.mass, p.rho, c["c_edge"], p.c, p.kappa, c["beta"], p.f0, p.v0,
                   LAW_CODES[p.law], p.friction, model.shaft_compliance, p.damping, p.gyroscopic, p.damping_ratio,
-                  model.faces is not None], dtype=float)
+                  model.faces is not None, table.lo if table else 0.0, table.h if table else 1.0,
+                  table.values.shape[0] - 1 if table else 0], dtype=float)
+    tab = np.ascontiguousarray(table.values) if table else np.zeros((2, 2, 2, 1, 1))
     sh = np.array([[0.0 if f.profile == "conical" else 1.0, f.gamma, f.R, f.y, f.w] for f in p.sheaves])
     sf = np.array([[p.J[k], p.m_sheave[k], p.Theta[k], p.c_U[k], p.c_psi[k]] for k in range(2)])
     if model.faces is None:
@@ -40,7 +45,27 @@ def pack(model) -> tuple:
     else:
         fc = np.ascontiguousarray(np.stack([f.coef for f in model.faces]))
         fr = np.array([[f.r_lo, f.r_hi] for f in model.faces])
-    return s, sh, sf, np.ascontiguousarray(c["xidx"]), c["xi"], c["wq"], c["F"], c["dF"], fc, fr
+    return s, sh, sf, np.ascontiguousarray(c["xidx"]), c["xi"], c["wq"], c["F"], c["dF"], fc, fr, tab
+
+
+@njit(cache=True)
+def _table_at(tab, s, phi, k):
+    """Hermite interpolation of the face table (``FaceTable.at``) for arc ``k``: ``(on, value, d/dphi)`` of
+    ``[dG; dK]``, each ``(g + nx, nx)``; ``on`` false off the grid (the caller solves the exact face systems)."""
+    nint = int(s[S_TN])
+    h = s[S_TH]
+    u = (phi - s[S_TLO]) / h
+    if nint == 0 or u < 0.0 or u > nint:
+        return False, tab[0, k, 0], tab[0, k, 1]
+    i = min(int(u), nint - 1)
+    t = u - i
+    t2, t3 = t * t, t * t * t
+    w0, w1, w2, w3 = 2 * t3 - 3 * t2 + 1, (t3 - 2 * t2 + t) * h, 3 * t2 - 2 * t3, (t3 - t2) * h
+    d0, d1, d2, d3 = (6 * t2 - 6 * t) / h, 3 * t2 - 4 * t + 1, (6 * t - 6 * t2) / h, 3 * t2 - 2 * t
+    a, b = tab[i, k], tab[i + 1, k]
+    val = w0 * a[0] + w1 * a[1] + w2 * b[0] + w3 * b[1]
+    der = d0 * a[0] + d1 * a[1] + d2 * b[0] + d3 * b[1]
+    return True, val, der
 
 
 @njit(cache=True)
@@ -182,7 +207,7 @@ def _gain(x, law):
 
 
 @njit(cache=True)
-def accel_kernel(q, v, F, Mt, s, sh, sf, xidx, xi, wq, Fs, dF, fc, frng):
+def accel_kernel(q, v, F, Mt, s, sh, sf, xidx, xi, wq, Fs, dF, fc, frng, tab):
     """Accelerations ``a`` (n2,), normal force ``N`` (2, g) N/m, strain ``eps`` (2, g), circumferential slip
     at the arc middles and largest slip per arc (2,) m/s, dissipation and clamping power (W); the numpy
     ``CompressibleBand.accel`` statement by statement."""
@@ -198,15 +223,18 @@ def accel_kernel(q, v, F, Mt, s, sh, sf, xidx, xi, wq, Fs, dF, fc, frng):
     deps = np.empty((2, g))
     Pi_im = 0.0
     flex = s[S_FLEX] != 0.0
-    Ed = E  # d eps / d x at the nodes (flexible faces: A^-1 E^T)
+    Ed = E  # d eps / d x at the nodes (flexible faces: A^-1 E^T, or E + dG^T from the table)
     if flex:
         Ed = np.empty((2, nx, g))
     for k in range(2):
-        if flex:  # eps = A^-1 eps_r, V = c' int eps eps_r ds (as CompressibleBand.accel_numpy)
+        on, val, der = _table_at(tab, s, q[0], k)
+        on = on and flex
+        xt0 = q[xidx[k, 0]] - z0c[k]  # flexible faces: eps_r = E^T x~, x~ = x - z0 e_0 (z - z0 rounded once)
+        if flex and not on:  # exact face systems: eps = A^-1 eps_r, V = c' int eps eps_r ds
             er = np.empty(g, np.complex128)
             for j in range(g):
-                e = -z0c[k]
-                for x in range(nx):
+                e = xt0 * Ec[k, 0, j]
+                for x in range(1, nx):
                     e += q[xidx[k, x]] * Ec[k, x, j]
                 er[j] = e
             A = _face_system(fc[k], frng[k], ce, rc[k], thc[k], dsc[k])
@@ -222,9 +250,14 @@ def accel_kernel(q, v, F, Mt, s, sh, sf, xidx, xi, wq, Fs, dF, fc, frng):
                     Ed[k, x, j] = X[j, 1 + x].real
         else:
             for j in range(g):
-                e = -z0c[k]
-                for x in range(nx):
-                    e += q[xidx[k, x]] * Ec[k, x, j]
+                if on:
+                    e = xt0 * Ec[k, 0, j]
+                    for x in range(1, nx):
+                        e += q[xidx[k, x]] * Ec[k, x, j]
+                else:
+                    e = -z0c[k]
+                    for x in range(nx):
+                        e += q[xidx[k, x]] * Ec[k, x, j]
                 eps[k, j], deps[k, j] = e.real, e.imag / H
                 Pi_im += (ce * e * e * dsc[k, j]).imag
         for x in range(nx):
@@ -232,6 +265,29 @@ def accel_kernel(q, v, F, Mt, s, sh, sf, xidx, xi, wq, Fs, dF, fc, frng):
             for j in range(g):
                 acc += E[k, x, j] * eps[k, j] * ds[k, j]
             Q[xidx[k, x]] -= 2 * ce * acc
+        if on:  # the table (CompressibleBand.accel_numpy): eps = eps_r + dG x~, V += c' x~^T dK x~
+            xt = np.empty(nx)
+            for x in range(nx):
+                xt[x] = q[xidx[k, x]]
+            xt[0] = xt0.real
+            dxt0 = xt0.imag / H  # d x~ / d phi: only z0 moves
+            for j in range(g):
+                e, de = 0.0, val[j, 0] * dxt0
+                for x in range(nx):
+                    e += val[j, x] * xt[x]
+                    de += der[j, x] * xt[x]
+                    Ed[k, x, j] = E[k, x, j] + val[j, x]
+                eps[k, j] += e
+                deps[k, j] += de
+            for x in range(nx):
+                kx, kdx = 0.0, 0.0
+                for y in range(nx):
+                    kx += val[g + x, y] * xt[y]
+                    kdx += der[g + x, y] * xt[y]
+                Q[xidx[k, x]] -= 2 * ce * kx
+                Q[0] -= ce * xt[x] * kdx
+                if x == 0:
+                    Q[0] -= 2 * ce * dxt0 * kx
     Q[0] -= Pi_im / H
     Q[4] -= s[S_KAPPA] * F[0]
     Q[5] -= s[S_KAPPA] * F[1]
@@ -374,7 +430,7 @@ def _solve(q, v, Q, s, sf, rc, drc, thc, dsc, frc, Fs, phic, shaft):
 
 
 @njit(cache=True)
-def jacobian_kernel(q, v, F, Mt, s, sh, sf, xidx, xi, wq, Fs, dF, fc, frng):
+def jacobian_kernel(q, v, F, Mt, s, sh, sf, xidx, xi, wq, Fs, dF, fc, frng, tab):
     """Forward-difference Jacobian of ``y = [a, dissipation, clamp_power]`` (n2 + 2) with respect to
     ``[q, v, F, M]`` (2 n2 + 4 columns); the rotation angles q[1:4] never enter, their columns are 0.
 
@@ -382,7 +438,7 @@ def jacobian_kernel(q, v, F, Mt, s, sh, sf, xidx, xi, wq, Fs, dF, fc, frng):
     for velocities; ``y`` is affine in F and M, so their columns are exact to rounding.
     """
     n2 = q.size
-    a0, _, _, _, _, d0, c0 = accel_kernel(q, v, F, Mt, s, sh, sf, xidx, xi, wq, Fs, dF, fc, frng)
+    a0, _, _, _, _, d0, c0 = accel_kernel(q, v, F, Mt, s, sh, sf, xidx, xi, wq, Fs, dF, fc, frng, tab)
     Jm = np.zeros((n2 + 2, 2 * n2 + 4))
     for col in range(2 * n2 + 4):
         if 1 <= col <= 3:
@@ -400,7 +456,7 @@ def jacobian_kernel(q, v, F, Mt, s, sh, sf, xidx, xi, wq, Fs, dF, fc, frng):
         else:
             h = 1e-6 * max(1.0, abs(Mt[col - 2 * n2 - 2]))
             Mp[col - 2 * n2 - 2] += h
-        a1, _, _, _, _, d1, c1 = accel_kernel(qp, vp, Fp, Mp, s, sh, sf, xidx, xi, wq, Fs, dF, fc, frng)
+        a1, _, _, _, _, d1, c1 = accel_kernel(qp, vp, Fp, Mp, s, sh, sf, xidx, xi, wq, Fs, dF, fc, frng, tab)
         for i in range(n2):
             Jm[i, col] = (a1[i] - a0[i]) / h
         Jm[n2, col] = (d1 - d0) / h
@@ -409,7 +465,7 @@ def jacobian_kernel(q, v, F, Mt, s, sh, sf, xidx, xi, wq, Fs, dF, fc, frng):
 
 
 @njit(cache=True)
-def energy_kernel(q, v, s, sh, sf, xidx, xi, wq, Fs, dF, fc, frng):
+def energy_kernel(q, v, s, sh, sf, xidx, xi, wq, Fs, dF, fc, frng, tab):
     """Kinetic and elastic energy ``(T, V)``, J, as ``CompressibleBand.kinetic_energy`` and ``elastic_energy``
     (real geometry: the complex kernels at ``phi + 0j``; strain summed as the numpy twin's, ``E^T x - z0``)."""
     n, g = Fs.shape
@@ -445,13 +501,28 @@ def energy_kernel(q, v, s, sh, sf, xidx, xi, wq, Fs, dF, fc, frng):
     V = 0.0
     for k in range(2):
         er = np.empty(g)
+        xt = np.empty(nx)  # flexible faces: eps_r = E^T x~, x~ = x - z0 e_0 (as accel_kernel)
+        for x in range(nx):
+            xt[x] = q[xidx[k, x]]
+        xt[0] -= z0[k]
         for j in range(g):
             e = 0.0
-            for x in range(nx):
-                e += q[xidx[k, x]] * E[k, x, j]
-            e -= z0[k]
+            if s[S_FLEX] != 0.0:
+                for x in range(nx):
+                    e += xt[x] * E[k, x, j]
+            else:
+                for x in range(nx):
+                    e += q[xidx[k, x]] * E[k, x, j]
+                e -= z0[k]
             er[j] = e
-        if s[S_FLEX] != 0.0:  # the band's and the sheaves' strain energy, c' int eps eps_r ds
+        on, val, _ = _table_at(tab, s, q[0], k)
+        if on and s[S_FLEX] != 0.0:  # the band's strain energy and the sheaves', c' x~^T dK x~ (the table)
+            for j in range(g):
+                V += er[j] * er[j] * ds[k, j]
+            for x in range(nx):
+                for y in range(nx):
+                    V += xt[x] * val[g + x, y] * xt[y]
+        elif s[S_FLEX] != 0.0:  # the band's and the sheaves' strain energy, c' int eps eps_r ds (exact)
             A = _face_system(fc[k], frng[k], s[S_CEDGE], rc[k], thc[k], dsc[k]).real
             ef = np.linalg.solve(np.ascontiguousarray(A), er)
             for j in range(g):

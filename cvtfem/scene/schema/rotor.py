@@ -68,7 +68,11 @@ SHEAVE = Table("sheave", "Sheave disks (`[[disk]]` with geometry = 'sheave') as 
     Key("cells_radial", "int", "Section mesh: quadratic-triangle columns from bore to rim.", "-", 24, ge=4, le=400),
     Key("cells_axial", "int", "Section mesh: layers from the back face to the contact face.", "-", 2, ge=1, le=40),
     Key("diameters", "int", "The sheaves' own waves of n = 2..diameters nodal diameters drawn by `cvtfem campbell` "
-        "(forward and backward; they do not couple with the shaft).", "-", 4, ge=1, le=40),
+        "(forward and backward; they do not couple with the shaft); those in the model (`model_diameters`) are "
+        "not drawn again.", "-", 4, ge=1, le=40),
+    Key("model_diameters", "int", "Rotor scenes: the waves of n = 2..model_diameters nodal diameters join the rotor "
+        "model (bore clamped, Craig-Bampton with their twins, spin stiffening and Coriolis coupling): `modes` and "
+        "`campbell` solve and label them forward/backward; 1: only n = 0, 1.", "-", 1, ge=1, le=40),
     Key("damping_ratio", "float", "Rotor scenes: modal damping ratio of each fixed-interface mode of a reduced "
         "or full sheave (C = 2 zeta omega_k on its modal coordinate).", "-", 0.0, ge=0.0, lt=1.0),
     Key("harmonics", "int", "CVT scenes (band-6+2n models): nodal-diameter harmonics 0..harmonics of the sheave "
