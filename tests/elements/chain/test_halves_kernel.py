@@ -80,10 +80,11 @@ def column_differences(ref, f, x0, steps):
 
 def reference_jacobian(ref, q, v):
     """``dQ/dq``: differences of ``forces`` (step ``1e-7 max(|q|, l)``); ``dQ/dv``: of the dissipative forces
-    (linear in ``v``: unit steps, exact but for round-off) plus of the friction forces (step ``1e-3 max(|v|, v_0)``)."""
+    (linear in ``v``: unit steps, exact but for round-off) plus of the friction forces (step ``1e-2 v_0``: the
+    friction laws bend on the scale ``v_0`` of the slip, whatever the speed of the chain)."""
     K = column_differences(ref, lambda x: ref.forces(x, v), q, 1e-7 * np.maximum(np.abs(q), ref.l))
     C = column_differences(ref, lambda y: ref.dissipative_forces(q, y), v, np.ones(ref.n2))
-    C += column_differences(ref, lambda y: ref.friction_forces(q, y), v, 1e-3 * np.maximum(np.abs(v), ref.v0))
+    C += column_differences(ref, lambda y: ref.friction_forces(q, y), v, np.full(ref.n2, 1e-2 * ref.v0))
     return K, C
 
 
