@@ -523,26 +523,26 @@ def jacobian(q, v, gl, gp, L, c_twist, b_joint, cs, plate_w, plate_d, plate_c, p
         for j in range(22):
             x[j], xd[j], f_0[j] = q[gl[e, j]], v[gl[e, j]], 0.0
         Dv[:, :] = 0.0
-        P0 = pw[0]
+        pw[0] = 0.0                                               # each pass's power alone (no round-off of a sum)
         T[e] = _link(x, xd, e, L, c_twist, plate_w, plate_d, plate_c, plate_c1, plate_c2, par, kmodel, f_0, Dv,
                      True, wk)
-        P0 = pw[0] - P0
+        P0 = pw[0]
         for j in range(22):
             x0 = x[j]
             h = _step(x0, rel_link, floor)
             x[j] = x0 + h
             f_p[:] = 0.0
-            Pp = pw[0]
+            pw[0] = 0.0
             Tp = _link(x, xd, e, L, c_twist, plate_w, plate_d, plate_c, plate_c1, plate_c2, par, kmodel, f_p, Dx,
                        False, wk)
-            Pp = pw[0] - Pp
+            Pp = pw[0]
             if central_link:
                 x[j] = x0 - h
                 f_m[:] = 0.0
-                Pm = pw[0]
+                pw[0] = 0.0
                 Tm = _link(x, xd, e, L, c_twist, plate_w, plate_d, plate_c, plate_c1, plate_c2, par, kmodel, f_m,
                            Dx, False, wk)
-                Pm = pw[0] - Pm
+                Pm = pw[0]
                 h2 = 2 * h
             else:
                 f_m[:] = f_0
@@ -579,10 +579,10 @@ def jacobian(q, v, gl, gp, L, c_twist, b_joint, cs, plate_w, plate_d, plate_c, p
                         z[k] = z0 + h if sgn == 0 else z0 - h
                 g = g_p if sgn == 0 else g_m
                 g[:] = 0.0
-                P = ppw[0]
+                ppw[0] = 0.0
                 _pin(y, yd, p, T[p], T[pv], b_joint, cs, arc, idx, sig, cw, par, law, j < 29, lateral, j >= 29, g,
                      pk)
-                dP += (ppw[0] - P) if sgn == 0 else (P - ppw[0])
+                dP += ppw[0] if sgn == 0 else -ppw[0]
             for k in range(jj, 29):
                 if first[p, k] == jj:
                     z[k] = z0
