@@ -368,25 +368,57 @@ class ChainCVT(ModelBase):
             rows.append(np.ravel(r))
             cols.append(np.ravel(c))
             vals.append(np.ravel(d))
-        for Mx, off in ((Kc.tocoo(), 0), (Cc.tocoo(), n2)):
-            add(Mx.row, Mx.col + off, Mx.data)
+        acc = self._family_accelerations(Kc, Cc)
+        if acc is None:                                      # the family's blocks on another pattern
+            for Mx, off in ((Kc.tocoo(), 0), (Cc.tocoo(), n2)):
+                add(Mx.row, Mx.col + off, Mx.data)
         entries, dD_contact = self._contact_jacobian(q, v)
         add(*entries)
         add(np.repeat(iz, len(in_cols)), np.tile(in_cols, 2), -self.sheaves_per_z * G[:2].ravel())   # -2 F on z
         add(np.full(len(in_cols), iphi[1]), in_cols, G[2])                              # M2 on phi2
         dQ = sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))), shape=(n2, N))
-        acc = self._inv_mass @ dQ
+        acc = self._inv_mass @ dQ if acc is None else acc + self._inv_mass @ dQ
         # work rates: [M1 w1, -M2 w2, 2 Phi - P_fr, -2 F.z']
-        Wr = sp.lil_matrix((4, N))
+        Wr = np.zeros((4, N))
         Wr[0, n2 + iphi[0]] = M[0]
         Wr[1, in_cols] = -w[1] * G[2]
         Wr[1, n2 + iphi[1]] += -M[1]
-        dD = np.zeros(N)
-        dD[:2 * n2] = dD_contact
-        Wr[2, :] = dD + self._chain_dissipation_gradient(q, v)
+        Wr[2, :2 * n2] = dD_contact
+        Wr[2] += self._chain_dissipation_gradient(q, v)
         Wr[3, n2 + iz] = -self.sheaves_per_z * F
         Wr[3, in_cols] = -self.sheaves_per_z * (v[iz] @ G[:2])
-        return self._stacked_jacobian(acc, G, in_cols, Wr)
+        return self._stacked_jacobian(acc, G, in_cols, sp.csr_matrix(Wr))
+
+    @cached_property
+    def _family_acceleration_map(self) -> tuple:
+        """``(S, indices, indptr)``: the accelerations ``M^-1 [dQ/dq, dQ/dv]`` of the chain family's blocks as a
+        linear map ``S`` of their data (``dQ/dq`` then ``dQ/dv``, both on the family's sorted pattern) onto the data
+        of a fixed CSR structure ``(indices, indptr)`` of ``n2`` rows over the state (built once)."""
+        P = sp.csr_matrix(self.family.jac_sparsity, dtype=bool)
+        P.sort_indices()
+        nnz, n2, N = P.nnz, self.n2, self.size
+        row = np.repeat(np.arange(P.shape[0]), np.diff(P.indptr))
+        col = np.concatenate([P.indices, n2 + P.indices]).astype(np.int64)
+        row, label = np.concatenate([row, row]), np.arange(2 * nnz)
+        Mi = sp.csc_matrix(self._inv_mass)
+        count = np.diff(Mi.indptr)[row]                     # M^-1 entries in each source row's column
+        start = np.repeat(Mi.indptr[row], count) + (np.arange(count.sum()) - np.repeat(np.cumsum(count) - count, count))
+        keys = Mi.indices[start].astype(np.int64) * N + np.repeat(col, count)
+        uniq, pos = np.unique(keys, return_inverse=True)
+        S = sp.csr_matrix((Mi.data[start], (pos, np.repeat(label, count))), shape=(len(uniq), 2 * nnz))
+        indptr = np.searchsorted(uniq // N, np.arange(n2 + 1))
+        return S, P, (uniq % N).astype(np.int32), indptr.astype(np.int32)
+
+    def _family_accelerations(self, Kc, Cc) -> sp.csr_matrix | None:
+        """``M^-1 [dQ/dq, dQ/dv]`` of the chain family's blocks (``n2 x`` state, CSR) through
+        :attr:`_family_acceleration_map`, or None where the blocks are not on the family's sorted pattern."""
+        S, P, indices, indptr = self._family_acceleration_map
+        for B in (Kc, Cc):
+            if not (isinstance(B, sp.csr_matrix) and B.nnz == P.nnz and np.array_equal(B.indptr, P.indptr)
+                    and np.array_equal(B.indices, P.indices)):
+                return None
+        data = S @ np.concatenate([Kc.data, Cc.data])
+        return sp.csr_matrix((data, indices, indptr), shape=(self.n2, self.size))
 
     def _dissipation_gradient(self, q, v, cols, coef, Jl) -> np.ndarray:
         """``d D / d y`` (N,) of the chain's dissipated power ``D = 2 Phi - P_fr`` (its Rayleigh function and the
