@@ -35,6 +35,9 @@ from cvtfem.control.regimes import Regime
 from cvtfem.control.stabilisation import OpenLoop, Stabilisation, StabilisationParams
 from cvtfem.elements.band.geometry import Sheave
 from cvtfem.elements.base import Block
+from cvtfem.elements.jit import HAVE_NUMBA
+from cvtfem.elements.chain import sheave_contact_kernel as SK
+from cvtfem.elements.chain.end_contact import EndContact
 from cvtfem.elements.chain.placement import place_on_path
 from cvtfem.elements.chain.sheave_contact import SheaveContact, hertz_constant
 from cvtfem.elements.chain.symmetric import ChainS1, ChainS2, ChainS3, damping_from_ratio
@@ -227,23 +230,71 @@ class ChainCVT(ModelBase):
         keep = vals != 0
         return R[keep], C[keep], vals[keep]
 
-    def _forces(self, q, v, F, M, slip: bool = False):
-        """Generalized forces on all coordinates (N, N m) and the friction power (W); with ``slip`` also the
-        contact-force-weighted mean slip speed on each shaft (m/s, 0 without contact)."""
-        nc, iphi, iz, _ = self._idx
-        Q = np.zeros(self.n2)
-        Q[:nc] = self.family.forces(q[:nc], v[:nc])
+    @cached_property
+    def _compiled_contact(self) -> tuple | None:
+        """Constants of the compiled H1 contact path (:mod:`~cvtfem.elements.chain.sheave_contact_kernel`) for a
+        mirrored pair or single ends with :class:`SheaveContact`; None for the other kernels (H2, rigid, coupled
+        halves) or without numba: those take the numpy path."""
+        pair, scale = (self.contact.pair, 0.5) if isinstance(self.contact, EndContact) else (self.contact, 1.0)
+        if not HAVE_NUMBA or type(pair) is not SheaveContact:
+            return None
+        return SK.pack(pair, scale)
+
+    @cached_property
+    def _pair_table(self) -> tuple:
+        """``(cols, coef, shafts, rows, weights)`` of every ``(end, shaft)`` pair (contact map and output rows, built
+        once): the table the compiled contact path loops over."""
+        ends, shafts = self._all_pairs()
+        cols, coef = self._contact_map(ends, shafts)
+        rows, w = self._output_rows(cols, coef)
+        return (np.ascontiguousarray(cols, np.int64), np.ascontiguousarray(coef, float), shafts.astype(np.int64),
+                np.ascontiguousarray(rows, np.int64), np.ascontiguousarray(w, float))
+
+    def _contact_forces(self, q, v, Q, slip: bool = False, reference: bool = False):
+        """Add the contact forces to ``Q`` (n2,); return the friction power (W) and, with ``slip``, the
+        contact-force-weighted mean slip speed on each shaft (m/s, 0 without contact).  Compiled where
+        :attr:`_compiled_contact` offers it, unless ``reference`` (the numpy path, its tested twin)."""
+        ck = None if reference else self._compiled_contact
+        if ck is not None:
+            stats = np.zeros((2, 2))
+            Pf = SK.forces(np.concatenate([q, v, self._constants]), *self._pair_table, *ck, Q, stats)
+            return Pf, stats[:, 1] / np.maximum(stats[:, 0], 1e-300)
         _, shafts, cols, coef, _, Y = self._contact_set(q, v, details=slip)
+        mean_slip = None
         if slip:
             Y, det = Y
             N = np.bincount(shafts, det["N"], 2)
             mean_slip = np.bincount(shafts, det["N"] * np.linalg.norm(det["slip"], axis=1), 2) / np.maximum(N, 1e-300)
         rows, w = self._output_rows(cols, coef)
         Q += np.bincount(rows.ravel(), (w * Y[:, :-1, None]).ravel(), self.n2)
-        Pf = float(Y[:, -1].sum())
+        return float(Y[:, -1].sum()), mean_slip
+
+    def _forces(self, q, v, F, M, slip: bool = False):
+        """Generalized forces on all coordinates (N, N m) and the friction power (W); with ``slip`` also the
+        contact-force-weighted mean slip speed on each shaft (m/s, 0 without contact)."""
+        nc, iphi, iz, _ = self._idx
+        Q = np.zeros(self.n2)
+        Q[:nc] = self.family.forces(q[:nc], v[:nc])
+        Pf, mean_slip = self._contact_forces(q, v, Q, slip)
         Q[iphi] += M
         Q[iz] -= self.sheaves_per_z * F
         return (Q, Pf, mean_slip) if slip else (Q, Pf)
+
+    def _contact_jacobian(self, q, v, reference: bool = False):
+        """``(rows, cols, values)`` of ``dQ/dy`` of the contacts (``y = [q, v]``) and ``-d P_fr / dy`` (2 n2,)
+        (compiled where offered, else, or with ``reference``, the numpy path)."""
+        ck = None if reference else self._compiled_contact
+        if ck is not None:
+            table = self._pair_table
+            cols, rows = table[0], table[3]
+            size = cols.shape[0] * rows.shape[1] * cols.shape[1] * cols.shape[2] ** 2     # at most, all pairs near
+            r, c, d = np.empty(size, np.int64), np.empty(size, np.int64), np.empty(size)
+            dD = np.zeros(2 * self.n2)
+            k = SK.jacobian(np.concatenate([q, v, self._constants]), *table, *ck, SK.STEPS, 2 * self.n2, r, c, d, dD)
+            return (r[:k], c[:k], d[:k]), dD
+        _, shafts, ccols, coef, X, _ = self._contact_set(q, v)
+        Jl = self.contact.local_jacobian(X, shafts)            # (m, outputs, inputs)
+        return self._contact_entries(ccols, coef, Jl), self._contact_power_gradient(ccols, coef, Jl)
 
     def solve_mass(self, Q):
         nc, iphi, iz, _ = self._idx
@@ -317,36 +368,84 @@ class ChainCVT(ModelBase):
             rows.append(np.ravel(r))
             cols.append(np.ravel(c))
             vals.append(np.ravel(d))
-        for Mx, off in ((Kc.tocoo(), 0), (Cc.tocoo(), n2)):
-            add(Mx.row, Mx.col + off, Mx.data)
-        _, shafts, ccols, coef, X, _ = self._contact_set(q, v)
-        Jl = self.contact.local_jacobian(X, shafts)            # (m, outputs, inputs)
-        add(*self._contact_entries(ccols, coef, Jl))
+        acc = self._family_accelerations(Kc, Cc)
+        if acc is None:                                      # the family's blocks on another pattern
+            for Mx, off in ((Kc.tocoo(), 0), (Cc.tocoo(), n2)):
+                add(Mx.row, Mx.col + off, Mx.data)
+        entries, dD_contact = self._contact_jacobian(q, v)
+        add(*entries)
         add(np.repeat(iz, len(in_cols)), np.tile(in_cols, 2), -self.sheaves_per_z * G[:2].ravel())   # -2 F on z
         add(np.full(len(in_cols), iphi[1]), in_cols, G[2])                              # M2 on phi2
         dQ = sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))), shape=(n2, N))
-        acc = self._inv_mass @ dQ
+        acc = self._inv_mass @ dQ if acc is None else acc + self._inv_mass @ dQ
         # work rates: [M1 w1, -M2 w2, 2 Phi - P_fr, -2 F.z']
-        Wr = sp.lil_matrix((4, N))
+        Wr = np.zeros((4, N))
         Wr[0, n2 + iphi[0]] = M[0]
         Wr[1, in_cols] = -w[1] * G[2]
         Wr[1, n2 + iphi[1]] += -M[1]
-        Wr[2, :] = self._dissipation_gradient(q, v, ccols, coef, Jl)
+        Wr[2, :2 * n2] = dD_contact
+        Wr[2] += self._chain_dissipation_gradient(q, v)
         Wr[3, n2 + iz] = -self.sheaves_per_z * F
         Wr[3, in_cols] = -self.sheaves_per_z * (v[iz] @ G[:2])
-        return self._stacked_jacobian(acc, G, in_cols, Wr)
+        return self._stacked_jacobian(acc, G, in_cols, sp.csr_matrix(Wr))
+
+    @cached_property
+    def _family_acceleration_map(self) -> tuple:
+        """``(S, indices, indptr)``: the accelerations ``M^-1 [dQ/dq, dQ/dv]`` of the chain family's blocks as a
+        linear map ``S`` of their data (``dQ/dq`` then ``dQ/dv``, both on the family's sorted pattern) onto the data
+        of a fixed CSR structure ``(indices, indptr)`` of ``n2`` rows over the state (built once)."""
+        P = sp.csr_matrix(self.family.jac_sparsity, dtype=bool)
+        P.sort_indices()
+        nnz, n2, N = P.nnz, self.n2, self.size
+        row = np.repeat(np.arange(P.shape[0]), np.diff(P.indptr))
+        col = np.concatenate([P.indices, n2 + P.indices]).astype(np.int64)
+        row, label = np.concatenate([row, row]), np.arange(2 * nnz)
+        Mi = sp.csc_matrix(self._inv_mass)
+        count = np.diff(Mi.indptr)[row]                     # M^-1 entries in each source row's column
+        start = np.repeat(Mi.indptr[row], count) + (np.arange(count.sum()) - np.repeat(np.cumsum(count) - count, count))
+        keys = Mi.indices[start].astype(np.int64) * N + np.repeat(col, count)
+        uniq, pos = np.unique(keys, return_inverse=True)
+        S = sp.csr_matrix((Mi.data[start], (pos, np.repeat(label, count))), shape=(len(uniq), 2 * nnz))
+        indptr = np.searchsorted(uniq // N, np.arange(n2 + 1))
+        return S, P, (uniq % N).astype(np.int32), indptr.astype(np.int32)
+
+    def _family_accelerations(self, Kc, Cc) -> sp.csr_matrix | None:
+        """``M^-1 [dQ/dq, dQ/dv]`` of the chain family's blocks (``n2 x`` state, CSR) through
+        :attr:`_family_acceleration_map`, or None where the blocks are not on the family's sorted pattern."""
+        S, P, indices, indptr = self._family_acceleration_map
+        for B in (Kc, Cc):
+            if not (isinstance(B, sp.csr_matrix) and B.nnz == P.nnz and np.array_equal(B.indptr, P.indptr)
+                    and np.array_equal(B.indices, P.indices)):
+                return None
+        data = S @ np.concatenate([Kc.data, Cc.data])
+        return sp.csr_matrix((data, indices, indptr), shape=(self.n2, self.size))
 
     def _dissipation_gradient(self, q, v, cols, coef, Jl) -> np.ndarray:
         """``d D / d y`` (N,) of the chain's dissipated power ``D = 2 Phi - P_fr`` (its Rayleigh function and the
         contact friction power, whose local Jacobians ``Jl`` act through the contact map ``cols``, ``coef``)."""
-        nc, n2, N = self._idx[0], self.n2, self.size
-        dD = np.zeros(N)
-        cw = np.where(cols < 2 * n2, coef, 0.0)
+        dD = self._chain_dissipation_gradient(q, v)
+        dD[:2 * self.n2] += self._contact_power_gradient(cols, coef, Jl)
+        return dD
+
+    def _contact_power_gradient(self, cols, coef, Jl) -> np.ndarray:
+        """``-d P_fr / d y`` (2 n2,) of the contact friction power from the local Jacobians ``Jl``."""
+        dD = np.zeros(2 * self.n2)
+        cw = np.where(cols < 2 * self.n2, coef, 0.0)
         np.add.at(dD, np.where(cw != 0, cols, 0).ravel(), -(cw * Jl[:, -1, :, None]).ravel())
+        return dD
+
+    def _chain_dissipation_gradient(self, q, v) -> np.ndarray:
+        """``d (2 Phi) / d y`` (N,) of the chain family's dissipated power: the family's own gradient where it offers
+        one (``dissipation_gradient``, from its Jacobian pass), else ``-(dQ_d/dq)^T v`` and ``-2 Q_d``."""
+        nc, n2 = self._idx[0], self.n2
+        dD = np.zeros(self.size)
+        if hasattr(self.family, "dissipation_gradient"):
+            dD[:nc], dD[n2:n2 + nc] = self.family.dissipation_gradient(q[:nc], v[:nc])
+            return dD
         Qd = self.family.dissipative_forces(q[:nc], v[:nc])
         Kd = self.family.jacobian(q[:nc], v[:nc], part="dissipative", wrt=(0,))[0]
-        dD[:nc] += -(Kd.T @ v[:nc])
-        dD[n2:n2 + nc] += -2 * Qd
+        dD[:nc] = -(Kd.T @ v[:nc])
+        dD[n2:n2 + nc] = -2 * Qd
         return dD
 
     def _stacked_jacobian(self, acc, G, in_cols, Wr) -> sp.csr_matrix:

@@ -155,13 +155,30 @@ class HalvesFamily:
     def jacobian(self, q, v, part: str = "all", wrt: tuple = (0, 1)):
         """``(dQ/dq, dQ/dq')`` (CSR) of all forces, or with ``part="dissipative"`` of the damping and friction
         forces alone (their ``dQ/dq`` is the total's less the one at ``q' = 0``)."""
-        key = np.concatenate([q, v]).tobytes()
-        if self._last[0] != key:                      # ChainCVT.jac asks for both parts at one state
-            self._last = (key, *self.chain.jacobian(q, v))
-        dq, dv = self._last[1:]
+        dq, dv = self._blocks(q, v)[:2]
         if part == "dissipative":
             dq = dq - self.chain.jacobian(q, np.zeros_like(v), damping=False)[0]
         return tuple(dq if k == 0 else dv for k in wrt)
+
+    def _blocks(self, q, v) -> tuple:
+        """``(dQ/dq, dQ/dv, dD/dq, dD/dv)`` at ``(q, v)`` (the gradients None with the numpy backend), cached:
+        ChainCVT.jac asks for the matrices and the gradient at one state."""
+        key = np.concatenate([q, v]).tobytes()
+        if self._last[0] != key:
+            compiled = self.chain.backend == "numba"
+            blocks = self.chain.jacobian_and_power_gradient(q, v) if compiled else (*self.chain.jacobian(q, v),
+                                                                                    None, None)
+            self._last = (key, *blocks)
+        return self._last[1:]
+
+    def dissipation_gradient(self, q, v) -> tuple[np.ndarray, np.ndarray]:
+        """``(dD/dq, dD/dv)`` (W/m, W s/m) of the dissipated power ``D = 2`` :meth:`rayleigh`: from the compiled
+        Jacobian pass, or ``-(dQ_nc/dq)^T v`` and ``2`` :meth:`dissipative_forces` with the numpy backend."""
+        dDq, dDv = self._blocks(q, v)[2:]
+        if dDq is None:
+            Kd = self.jacobian(q, v, part="dissipative", wrt=(0,))[0]
+            return -(Kd.T @ v), -2 * self.dissipative_forces(q, v)
+        return dDq, dDv
 
     def outputs(self, q, v):
         return self.chain.outputs(q, v)

@@ -683,7 +683,8 @@ class ChainA5:
         Compiled backend: element by element (:func:`halves_kernel.jacobian`): each link's velocity block exact,
         its coordinate block by ``scheme`` ("central", step ``1e-7``, or "forward", step ``sqrt(eps)``, relative to
         ``max(|x|, l)``) differences of that link alone; each pin's blocks (bending, contacts, friction) central
-        differences of the pin alone (steps ``1e-7 max(|x|, l)``, ``1e-3 max(|v|, v_0)``);
+        differences of the pin alone (steps ``1e-7 max(|x|, l)`` and ``1e-2 v_0``: the friction laws bend on the scale
+        ``v_0`` of the slip, whatever the chain's speed);
         the axial friction's tension dependence by the chain rule.  Per element 45 (central) or 23 (forward) link
         passes and 116 pin passes: about 56 or 38 force evaluations in time for 84 pins (docs/chain.md).  Forward
         differences are one-sided at the kinks of the plate law and the contacts: Newton from the exact straight
@@ -694,15 +695,25 @@ class ChainA5:
             raise InputError("scheme", scheme, 'must be "forward" or "central"')
         if self.backend != "numba":
             return self.coloured_jacobian(q, v, damping=damping)
+        Jq, Jv, _, _ = self.jacobian_and_power_gradient(q, v, scheme)
+        return Jq, Jv if damping else None
+
+    def jacobian_and_power_gradient(self, q: np.ndarray, v: np.ndarray, scheme: str = "central") -> tuple:
+        """``(dQ/dq, dQ/dv, dD/dq, dD/dv)`` of the compiled backend: :meth:`jacobian`'s matrices and the gradient
+        (W/m, W s/m; arrays (21 n,)) of the dissipated power ``D`` of :meth:`forces_and_dissipation` from the same
+        element passes (:func:`halves_kernel.jacobian`)."""
+        if self.backend != "numba":
+            raise InputError("backend", self.backend, 'must be "numba" for the power gradient of the element passes')
         pat = self.jac_sparsity
         if self._positions is None:
             self._positions = HK.positions(self._kernel_args, self.dof_index, pat)
         Jq, Jv = np.zeros(pat.nnz + 1), np.zeros(pat.nnz + 1)
-        steps = np.array([np.sqrt(np.finfo(float).eps) if scheme == "forward" else 1e-7, 1e-7, 1e-3])
+        dDq, dDv = np.zeros(self.n2), np.zeros(self.n2)
+        steps = np.array([np.sqrt(np.finfo(float).eps) if scheme == "forward" else 1e-7, 1e-7, 1e-2])
         HK.jacobian(np.asarray(q, float), np.asarray(v, float), *self._kernel_args, *self._positions, steps,
-                    scheme == "central", Jq, Jv)
+                    scheme == "central", Jq, Jv, dDq, dDv)
         out = [sp.csr_matrix((d[:-1], pat.indices, pat.indptr), shape=pat.shape) for d in (Jq, Jv)]
-        return out[0], out[1] if damping else None
+        return out[0], out[1], dDq, dDv
 
     def coloured_jacobian(self, q: np.ndarray, v: np.ndarray, step: float = 1e-7,
                           damping: bool = True) -> tuple[sp.csr_matrix, sp.csr_matrix | None]:

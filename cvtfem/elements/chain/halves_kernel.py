@@ -492,7 +492,7 @@ def _step(x, rel, floor):
 
 @njit(cache=True)
 def jacobian(q, v, gl, gp, L, c_twist, b_joint, cs, plate_w, plate_d, plate_c, plate_c1, plate_c2, arc, idx, sig,
-             cw, par, ints, pos_l, pos_p, pos_t, first, steps, central_link, Jq, Jv):
+             cw, par, ints, pos_l, pos_p, pos_t, first, steps, central_link, Jq, Jv, dDq, dDv):
     """``dQ/dq``, ``dQ/dv`` of :func:`forces` added into the CSR data ``Jq``, ``Jv`` (positions ``pos_l (n, 22, 22)``
     of the link blocks, ``pos_p (n, 29, 29)`` of the pin blocks, ``pos_t (n, 2, 3, 22)`` of the axial friction
     rows against the tensions' link coordinates; ``first`` of :func:`positions`).
@@ -501,8 +501,13 @@ def jacobian(q, v, gl, gp, L, c_twist, b_joint, cs, plate_w, plate_d, plate_c, p
     coordinate block forward (``central_link`` false) or central differences of the link alone; a pin's blocks
     central differences of the pin alone (a coordinate and its copies at once); the axial friction's
     dependence on the link tensions by the chain rule with the tensions' differences.  ``steps = (link, pin
-    coordinate, pin velocity)`` relative steps, applied to ``max(|x|, l)`` and ``max(|v|, v_0)`` (smaller steps
-    drown in the round-off of the contact forces).
+    coordinate, pin velocity)`` relative steps, applied to ``max(|x|, l)`` (smaller steps drown in the round-off
+    of the contact forces) and to ``v_0`` (the friction laws bend on that scale of the slip, whatever the speed:
+    a step relative to ``|v|`` spans the law's knee at chain speed).
+
+    The gradient of the dissipated power ``D`` of :func:`forces_power` over ``q`` and ``v`` is added into ``dDq``,
+    ``dDv`` (21 n,) from the same element passes: the elements' power differences (a link's ``dD/dv`` exact,
+    ``-2 Q_d``: its damping forces are linear in the velocities) and the axial friction's tension dependence.
     """
     n = L.shape[0]
     l, f0, v0 = par[0], par[13], par[14]
@@ -513,35 +518,45 @@ def jacobian(q, v, gl, gp, L, c_twist, b_joint, cs, plate_w, plate_d, plate_c, p
     x, xd, f_0, f_p, f_m = np.zeros(22), np.zeros(22), np.zeros(22), np.zeros(22), np.zeros(22)
     Dv, Dx = np.zeros((22, 22)), np.zeros((1, 1))
     wk = _link_work()
+    pw = wk[-1]
     for e in range(n):
         for j in range(22):
             x[j], xd[j], f_0[j] = q[gl[e, j]], v[gl[e, j]], 0.0
         Dv[:, :] = 0.0
+        pw[0] = 0.0                                               # each pass's power alone (no round-off of a sum)
         T[e] = _link(x, xd, e, L, c_twist, plate_w, plate_d, plate_c, plate_c1, plate_c2, par, kmodel, f_0, Dv,
                      True, wk)
+        P0 = pw[0]
         for j in range(22):
             x0 = x[j]
             h = _step(x0, rel_link, floor)
             x[j] = x0 + h
             f_p[:] = 0.0
+            pw[0] = 0.0
             Tp = _link(x, xd, e, L, c_twist, plate_w, plate_d, plate_c, plate_c1, plate_c2, par, kmodel, f_p, Dx,
                        False, wk)
+            Pp = pw[0]
             if central_link:
                 x[j] = x0 - h
                 f_m[:] = 0.0
+                pw[0] = 0.0
                 Tm = _link(x, xd, e, L, c_twist, plate_w, plate_d, plate_c, plate_c1, plate_c2, par, kmodel, f_m,
                            Dx, False, wk)
+                Pm = pw[0]
                 h2 = 2 * h
             else:
                 f_m[:] = f_0
-                Tm, h2 = T[e], h
+                Tm, Pm, h2 = T[e], P0, h
             x[j] = x0
             dT[e, j] = (Tp - Tm) / h2
+            dDq[gl[e, j]] -= (Pp - Pm) / h2
             for r in range(22):
                 Jq[pos_l[e, r, j]] += (f_p[r] - f_m[r]) / h2
                 Jv[pos_l[e, r, j]] += Dv[r, j]
+                dDv[gl[e, r]] -= 2 * Dv[r, j] * xd[j]
     y, yd, g_p, g_m = np.zeros(29), np.zeros(29), np.zeros(29), np.zeros(29)
     pk = _pin_work()
+    ppw = pk[-1]
     slopes = np.zeros((2, 3))
     for p in range(n):
         pv = (p - 1) % n
@@ -556,25 +571,32 @@ def jacobian(q, v, gl, gp, L, c_twist, b_joint, cs, plate_w, plate_d, plate_c, p
                 _pin(y, yd, p, T[p], T[pv], b_joint, cs, arc, idx, sig, cw, par, law, False, True, False, g_p, pk)
             lateral = jj < 8 or 9 < jj < 18 or jj > 20                # w, q_p reach the axial terms only
             z0 = z[jj]
-            h = _step(z0, steps[1], floor) if j < 29 else _step(z0, steps[2], v0)
+            h = _step(z0, steps[1], floor) if j < 29 else (z0 + steps[2] * v0) - z0
+            dP = 0.0
             for sgn in range(2):
                 for k in range(jj, 29):
                     if first[p, k] == jj:
                         z[k] = z0 + h if sgn == 0 else z0 - h
                 g = g_p if sgn == 0 else g_m
                 g[:] = 0.0
+                ppw[0] = 0.0
                 _pin(y, yd, p, T[p], T[pv], b_joint, cs, arc, idx, sig, cw, par, law, j < 29, lateral, j >= 29, g,
                      pk)
+                dP += ppw[0] if sgn == 0 else -ppw[0]
             for k in range(jj, 29):
                 if first[p, k] == jj:
                     z[k] = z0
             Jx = Jq if j < 29 else Jv
+            (dDq if j < 29 else dDv)[gp[p, jj]] -= dP / (2 * h)
             for r in range(29):
                 Jx[pos_p[p, r, jj]] += (g_p[r] - g_m[r]) / (2 * h)
         if f0 != 0.0:
             _axial_friction_slopes(yd, p, T[p], T[pv], f0, v0, law, slopes)
             for j in range(2):
                 e = p if j == 0 else pv
+                dP_dT = slopes[j, 0] * yd[8] + slopes[j, 1] * yd[18] + slopes[j, 2] * yd[20]
+                for c in range(22):
+                    dDq[gl[e, c]] -= dP_dT * dT[e, c]
                 for r in range(3):
                     for c in range(22):
                         Jq[pos_t[p, j, r, c]] += slopes[j, r] * dT[e, c]
