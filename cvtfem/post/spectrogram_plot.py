@@ -7,7 +7,7 @@ import numpy as np
 
 from cvtfem.post.campbell import spread
 from cvtfem.post.figures import pyplot, save
-from cvtfem.post.spectrogram import OrderIntensity, Spectrogram
+from cvtfem.post.spectrogram import OrderIntensity, OrderSpectrum, Spectrogram
 
 #: Dynamic range shown in the spectrogram, dB below its largest value.
 DB_RANGE = 80.0
@@ -68,4 +68,26 @@ def plot_order_intensity(intensity: OrderIntensity, path: str | Path, title: str
     ax.set_ylabel(f"mean PSD, dB re 1 {unit}$^2$/Hz" if unit else "mean PSD, dB")
     ax.set_title(title or "time-averaged intensity over f / f_chain", fontsize=10)
     ax.grid(alpha=0.3)
+    return save(fig, path)
+
+
+def plot_order_spectrum(spec: OrderSpectrum, n_pins: int, path: str | Path, title: str = "", unit: str = "",
+                        top: float | None = None) -> Path:
+    """Order spectrum in dB over ``f / f_chain`` up to ``top`` (default ``1.2 n_pins``): the whole orders
+    (``k f_chain``) as a faint grid, the pin-entry orders ``k n_pins / 3`` dashed and ``k n_pins`` red."""
+    plt = pyplot()
+    top = float(top or 1.2 * n_pins)
+    keep = spec.order <= top
+    fig, ax = plt.subplots(figsize=(9.0, 4.2), layout="constrained")
+    for k in range(1, int(top) + 1):
+        ax.axvline(k, color="0.85", lw=0.4, zorder=0)
+    for k in range(1, int(3 * top / n_pins) + 1):
+        ax.axvline(k * n_pins / 3, color="0.4" if k % 3 else "tab:red", ls="--" if k % 3 else "-", lw=0.8)
+    ax.plot(spec.order[keep], spec.db()[keep], color="tab:blue", lw=0.8)
+    ax.set_xlim(0.0, top)
+    ax.set_xlabel(r"order $f / f_{chain}$ (grey: whole orders; dashed: $k\,n_{pins}/3$; red: $k\,n_{pins}$, "
+                  f"n_pins = {n_pins})")
+    ax.set_ylabel(f"PSD, dB re 1 {unit}$^2$ per order" if unit else "PSD, dB per order")
+    ax.set_title(title or f"order spectrum over {spec.revolutions:.3g} chain revolutions "
+                          f"(resolution {1 / spec.revolutions:.2g} order)", fontsize=10)
     return save(fig, path)
