@@ -101,3 +101,26 @@ def test_a_run_without_states_is_refused_with_the_fix(tmp_path, capsys):
     run_scene(scene, until=2e-3, results=path, show_progress=False)
     assert main(["jacobian", str(path), "--at", "0"]) == 2
     assert "output.state = true" in capsys.readouterr().err
+
+
+def test_spectrogram_draws_the_tracked_modes_of_the_same_run(stored, tmp_path, capsys):
+    """`cvtfem spectrogram --campbell` reads back the tracked modes of `cvtfem runcampbell --csv` (times and Hz as
+    written) and draws them; a file that is not such a CSV is refused by name."""
+    from cvtfem.commands.spectrogram import campbell_modes
+
+    table = tmp_path / "c.csv"
+    assert main(["runcampbell", str(stored), "--modes", "6", "--csv", str(table)]) == 0
+    t, f = campbell_modes(str(table))
+    header, rows = _read(table)
+    assert f.shape == (11, 6)
+    np.testing.assert_allclose(t, [float(r[0]) for r in rows])
+    np.testing.assert_allclose(f[:, 2], [float(r[header.index("mode2_Hz")]) for r in rows])
+    png = tmp_path / "s.png"
+    assert main(["spectrogram", str(stored), "--series", "driving.support_force", "--window", "8e-5", "--fmax",
+                 "5e4", "--overlap", "0.9", "--campbell", str(table), "--png", str(png)]) == 0
+    assert png.stat().st_size > 10_000
+    bad = tmp_path / "bad.csv"
+    bad.write_text("a,b\n1,2\n")
+    assert main(["spectrogram", str(stored), "--series", "driving.support_force", "--window", "8e-5", "--fmax", "5e4",
+                 "--campbell", str(bad), "--png", str(png)]) == 2
+    assert "`--campbell`" in capsys.readouterr().err

@@ -26,6 +26,8 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--f-chain", type=float, default=None, metavar="HZ",
                    help="chain revolution frequency, Hz, instead of omega_1 r_1 / l_chain (e.g. the measured "
                         "pin-entry line / n_pins)")
+    p.add_argument("--campbell", metavar="CSV", help="draw the tracked modes of a `cvtfem runcampbell --csv` file "
+                                                     "of the same run over the spectrogram")
     p.add_argument("--no-lines", action="store_true", help="draw no excitation lines (a run without a chain)")
     p.add_argument("--png", metavar="OUT", help="write the spectrogram as PNG")
     p.add_argument("--intensity-png", metavar="OUT", help="write the intensity over f / f_chain as PNG")
@@ -93,7 +95,8 @@ def _run(args: argparse.Namespace, orders: tuple[int, ...]) -> int:
         from cvtfem.post.spectrogram_plot import plot_spectrogram
 
         lines = () if freqs is None else sg.excitation_lines(freqs, spec.f[-1], orders)
-        plot_spectrogram(spec, args.png, lines, None if freqs is None else freqs.t, label=label)
+        modes = None if args.campbell is None else campbell_modes(args.campbell)
+        plot_spectrogram(spec, args.png, lines, None if freqs is None else freqs.t, label=label, modes=modes)
         print(f"wrote {args.png}")
     if (args.intensity_png or args.intensity_csv or args.order_png or args.order_csv) and freqs is None:
         raise InputError("--no-lines", True, "cannot be combined with --intensity-*/--order-* (the intensity and "
@@ -136,6 +139,26 @@ def _orders(args: argparse.Namespace, t, y, freqs, label: str, unit: str) -> Non
         plot_order_spectrum(spec, freqs.n_pins, args.order_png, title=f"{label}: order spectrum over "
                             f"{spec.revolutions:.3g} chain revolutions", unit=unit)
         print(f"wrote {args.order_png}")
+
+
+def campbell_modes(path: str):
+    """``(t (s,) s, f (s, k) Hz)``: the tracked modes of a ``cvtfem runcampbell --csv`` file."""
+    import csv
+
+    import numpy as np
+
+    from cvtfem.errors import InputError
+
+    try:
+        with open(path, newline="") as fh:
+            rows = list(csv.reader(fh))
+    except OSError as err:
+        raise InputError("--campbell", path, f"must be a readable CSV file ({err.strerror})") from None
+    cols = [i for i, name in enumerate(rows[0] if rows else []) if name.startswith("mode") and name.endswith("_Hz")]
+    if not cols or rows[0][0] != "t_s" or len(rows) < 3:
+        raise InputError("--campbell", path, "must be a CSV of `cvtfem runcampbell --csv` with at least 2 times")
+    data = np.array([[float(r[0])] + [float(r[i]) for i in cols] for r in rows[1:]])
+    return data[:, 0], data[:, 1:]
 
 
 def chain_of(results) -> tuple[int, float, float]:

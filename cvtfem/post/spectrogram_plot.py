@@ -14,9 +14,11 @@ DB_RANGE = 80.0
 
 
 def plot_spectrogram(spec: Spectrogram, path: str | Path, lines=(), line_times=None, title: str = "",
-                     label: str = "") -> Path:
+                     label: str = "", modes=None) -> Path:
     """Spectrogram in dB (time on x in ms, frequency on y in Hz up to the last kept frequency) with excitation
-    lines ``(label, f(t))`` sampled at ``line_times`` (s) drawn over it and labelled at the right edge."""
+    lines ``(label, f(t))`` sampled at ``line_times`` (s) drawn over it and labelled at the right edge, and
+    ``modes = (t (s,) s, f (s, k) Hz)``, tracked natural frequencies along the run (a Campbell diagram), as thin
+    green lines."""
     plt = pyplot()
     db = spec.db()
     top = float(db.max())
@@ -46,6 +48,13 @@ def plot_spectrogram(spec: Spectrogram, path: str | Path, lines=(), line_times=N
                 ax.annotate(name, (edges_t[-1], y0), xytext=(edges_t[-1] + 0.01 * (edges_t[-1] - edges_t[0]), y),
                             textcoords="data", fontsize=7, va="center", annotation_clip=False,
                             arrowprops={"arrowstyle": "-", "lw": 0.4, "color": "0.5"})
+    if modes is not None:
+        tm, fm = modes
+        inside = (1e3 * np.asarray(tm) >= edges_t[0]) & (1e3 * np.asarray(tm) <= edges_t[-1])
+        for j in range(np.shape(fm)[1]):
+            ax.plot(1e3 * np.asarray(tm)[inside], np.asarray(fm)[inside, j], color="lime", lw=0.8,
+                    label="modes of J11" if j == 0 else None)
+        ax.legend(loc="upper left", fontsize=7, framealpha=0.8)
     ax.set_xlim(edges_t[0], edges_t[-1])
     ax.set_ylim(0.0, fmax)
     ax.set_xlabel("time, ms")
