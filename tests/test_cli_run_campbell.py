@@ -25,19 +25,27 @@ def stored(tmp_path_factory):
     return path
 
 
+@pytest.fixture(scope="module")
+def campbell_csv(stored, tmp_path_factory):
+    """``cvtfem runcampbell`` of the stored run, 10 modes at every stored time: (PNG, CSV)."""
+    folder = tmp_path_factory.mktemp("rc_out")
+    png, out = folder / "c.png", folder / "c.csv"
+    assert main(["runcampbell", str(stored), "--modes", "10", "--png", str(png), "--csv", str(out)]) == 0
+    return png, out
+
+
 def _read(path):
     with open(path, newline="") as fh:
         rows = list(csv.reader(fh))
     return rows[0], rows[1:]
 
 
-def test_runcampbell_tracks_continuously_and_draws_the_run_lines(stored, tmp_path):
+def test_runcampbell_tracks_continuously_and_draws_the_run_lines(stored, campbell_csv):
     """From stored state to stored state (10 us apart) each tracked mode below 2.5 kHz keeps a MAC above 0.9 with
     its predecessor and moves by less than half the gap to the nearest other curve (continuous curves); the first row's modes are J11's at the first stored state; the lines in the
     CSV are k f_chain with f_chain = omega_1 r_1 / l_chain from the stored speeds and contact radii, and k/3 f_link
     with f_link = n_pins f_chain."""
-    png, out = tmp_path / "c.png", tmp_path / "c.csv"
-    assert main(["runcampbell", str(stored), "--modes", "10", "--png", str(png), "--csv", str(out)]) == 0
+    png, out = campbell_csv
     assert png.stat().st_size > 10_000
     header, rows = _read(out)
     assert len(rows) == 11
@@ -103,16 +111,15 @@ def test_a_run_without_states_is_refused_with_the_fix(tmp_path, capsys):
     assert "output.state = true" in capsys.readouterr().err
 
 
-def test_spectrogram_draws_the_tracked_modes_of_the_same_run(stored, tmp_path, capsys):
+def test_spectrogram_draws_the_tracked_modes_of_the_same_run(stored, campbell_csv, tmp_path, capsys):
     """`cvtfem spectrogram --campbell` reads back the tracked modes of `cvtfem runcampbell --csv` (times and Hz as
     written) and draws them; a file that is not such a CSV is refused by name."""
     from cvtfem.commands.spectrogram import campbell_modes
 
-    table = tmp_path / "c.csv"
-    assert main(["runcampbell", str(stored), "--modes", "6", "--csv", str(table)]) == 0
+    table = campbell_csv[1]
     t, f = campbell_modes(str(table))
     header, rows = _read(table)
-    assert f.shape == (11, 6)
+    assert f.shape == (11, 10)
     np.testing.assert_allclose(t, [float(r[0]) for r in rows])
     np.testing.assert_allclose(f[:, 2], [float(r[header.index("mode2_Hz")]) for r in rows])
     png = tmp_path / "s.png"

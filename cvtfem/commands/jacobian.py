@@ -32,11 +32,13 @@ def run(args: argparse.Namespace) -> int:
     if not 1 <= len(times) <= 4:
         raise InputError("--at", args.at, "must name 1 to 4 times")
     results = read_results(args.results)
+    t = results.time
+    rows = rows_at(t, times)
     model = stored_model(results)
-    t, x = stored_states(results, model)
+    _, x = stored_states(results, model)
     spectra = {}
     with single_thread_blas():
-        for i in rows_at(t, times):
+        for i in rows:
             lam = jacobian_spectrum(model, x[i], float(t[i]))
             if not np.all(np.isfinite(lam)):
                 raise InputError("--at", float(t[i]), "must name a state whose Jacobian is finite")

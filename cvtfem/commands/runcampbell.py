@@ -44,8 +44,7 @@ def run(args: argparse.Namespace) -> int:
     if args.modes < 1:
         raise InputError("--modes", args.modes, "must be a positive number of modes")
     results = read_results(args.results)
-    model = stored_model(results)
-    t, x = stored_states(results, model)
+    t = results.time
     start = t[0] if args.start is None else args.start
     end = t[-1] if args.end is None else args.end
     chosen = np.flatnonzero((t >= start - 1e-12) & (t <= end + 1e-12))
@@ -53,6 +52,8 @@ def run(args: argparse.Namespace) -> int:
         raise InputError("--start/--end", (start, end), f"must hold at least 2 stored times of the run "
                          f"({t[0]:.6g} .. {t[-1]:.6g} s)")
     chosen = np.unique(chosen[np.linspace(0, chosen.size - 1, min(args.points, chosen.size)).round().astype(int)])
+    model = stored_model(results)
+    _, x = stored_states(results, model)
     result = run_campbell(model, t[chosen], x[chosen], args.modes)
     freqs = sg.chain_frequencies(results, *chain_of(results))
     fmax = args.fmax or 1.05 * float(result.wd.max()) / (2 * np.pi)
