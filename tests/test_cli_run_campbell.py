@@ -42,9 +42,10 @@ def _read(path):
 
 def test_runcampbell_tracks_continuously_and_draws_the_run_lines(stored, campbell_csv):
     """From stored state to stored state (10 us apart) each tracked mode below 2.5 kHz keeps a MAC above 0.9 with
-    its predecessor and moves by less than half the gap to the nearest other curve (continuous curves); the first row's modes are J11's at the first stored state; the lines in the
-    CSV are k f_chain with f_chain = omega_1 r_1 / l_chain from the stored speeds and contact radii, and k/3 f_link
-    with f_link = n_pins f_chain."""
+    its predecessor and moves by less than half the gap to the nearest other curve (continuous curves); the first
+    row's modes are J11's at the first stored state; the lines in the CSV are k f_chain with
+    f_chain = omega_1 r_1 / l_chain from the stored speeds and contact radii, and k/3 f_link with
+    f_link = n_pins f_chain."""
     png, out = campbell_csv
     assert png.stat().st_size > 10_000
     header, rows = _read(out)

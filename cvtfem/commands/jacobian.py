@@ -55,7 +55,8 @@ def run(args: argparse.Namespace) -> int:
     if args.png:
         from cvtfem.post.accuracy_cost import plot_spectra
 
-        plot_spectra({f"t = {ti:.6g} s": lam for ti, lam in spectra.items()}, args.png, title=f"{results.path.name}: eigenvalues of the full Jacobian "
-                                              f"({model.size} states)")
+        labelled = {f"t = {ti:.6g} s": lam for ti, lam in spectra.items()}
+        plot_spectra(labelled, args.png, title=f"{results.path.name}: eigenvalues of the full Jacobian "
+                                               f"({model.size} states)")
         print(f"wrote {args.png}")
     return 0
