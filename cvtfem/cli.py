@@ -19,7 +19,7 @@ from cvtfem.errors import CvtfemError
 #: Command modules in ``cvtfem.commands``, in the order ``--help`` lists them.
 COMMANDS = ("scenes", "describe", "docs", "show", "run", "modes", "campbell", "response", "spectrum", "render", "sheave",
             "periodic", "sweep", "report", "study", "bench", "demo", "spectrogram", "history", "revolution",
-            "rotormaps")
+            "rotormaps", "runcampbell", "jacobian")
 
 
 class _Parser(argparse.ArgumentParser):

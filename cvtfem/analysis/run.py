@@ -21,6 +21,7 @@ from cvtfem.analysis.steppers import make_stepper
 from cvtfem.analysis.summary import EFFICIENCY_WINDOW, RunSummary, summarise
 from cvtfem.blas import single_thread_blas
 from cvtfem.errors import InputError, NumericalError
+from cvtfem.outputs import OutputSpec
 
 #: Stall guard: a run fails when STALL_STEPS consecutive accepted steps each advance time by less than
 #: STALL_FRACTION * t_end (1e-10 s for a 0.1 s run; the band models' fastest time scales are ~1e-5 s).
@@ -157,6 +158,8 @@ class _Run:
         self.scene, self.t_end = scene, t_end
         self.loop = closed_loop(scene)
         self.specs = list(self.loop.output_specs)
+        if scene.output.state:
+            self.specs.append(OutputSpec("state", "SI", "Full state vector x (the model's layout).", self.loop.size))
         dt = scene.output.step
         rows = t_end / dt + 1
         if rows > MAX_SAMPLES:
@@ -366,7 +369,7 @@ class _Run:
             if k == self.j_window:
                 x_window = np.array(x)
             if writer is not None:
-                writer.append(t, loop.outputs(t, x))
+                writer.append(t, loop.outputs(t, x) | ({"state": x} if scene.output.state else {}))
             k += 1
 
         def save() -> None:

@@ -26,11 +26,16 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--f-chain", type=float, default=None, metavar="HZ",
                    help="chain revolution frequency, Hz, instead of omega_1 r_1 / l_chain (e.g. the measured "
                         "pin-entry line / n_pins)")
+    p.add_argument("--campbell", metavar="CSV", help="draw the tracked modes of a `cvtfem runcampbell --csv` file "
+                                                     "of the same run over the spectrogram")
     p.add_argument("--no-lines", action="store_true", help="draw no excitation lines (a run without a chain)")
     p.add_argument("--png", metavar="OUT", help="write the spectrogram as PNG")
     p.add_argument("--intensity-png", metavar="OUT", help="write the intensity over f / f_chain as PNG")
     p.add_argument("--csv", metavar="OUT", help="write the spectrogram (dB, one row per frequency) as CSV")
     p.add_argument("--intensity-csv", metavar="OUT", help="write the intensity over f / f_chain as CSV")
+    p.add_argument("--order-png", metavar="OUT", help="write the order spectrum (the signal resampled in chain "
+                                                      "revolutions, one periodogram) as PNG")
+    p.add_argument("--order-csv", metavar="OUT", help="write the order spectrum as CSV")
     p.set_defaults(func=run)
 
 
@@ -38,12 +43,14 @@ def run(args: argparse.Namespace) -> int:
     from cvtfem.commands.paths import check_output_file
     from cvtfem.errors import InputError
 
-    for dest in ("intensity_png", "intensity_csv"):
+    for dest in ("intensity_png", "intensity_csv", "order_png", "order_csv"):
         value = getattr(args, dest)
         if value is not None:
             check_output_file(f"--{dest.replace('_', '-')}", value)
-    if args.intensity_png is not None and not args.intensity_png.lower().endswith(".png"):
-        raise InputError("--intensity-png", args.intensity_png, "must name a .png file")
+    for dest in ("intensity_png", "order_png"):
+        value = getattr(args, dest)
+        if value is not None and not value.lower().endswith(".png"):
+            raise InputError(f"--{dest.replace('_', '-')}", value, "must name a .png file")
     try:
         orders = tuple(int(k) for k in args.chain_orders.split(",") if k.strip())
     except ValueError:
@@ -88,12 +95,15 @@ def _run(args: argparse.Namespace, orders: tuple[int, ...]) -> int:
         from cvtfem.post.spectrogram_plot import plot_spectrogram
 
         lines = () if freqs is None else sg.excitation_lines(freqs, spec.f[-1], orders)
-        plot_spectrogram(spec, args.png, lines, None if freqs is None else freqs.t, label=label)
+        modes = None if args.campbell is None else campbell_modes(args.campbell)
+        plot_spectrogram(spec, args.png, lines, None if freqs is None else freqs.t, label=label, modes=modes)
         print(f"wrote {args.png}")
+    if (args.intensity_png or args.intensity_csv or args.order_png or args.order_csv) and freqs is None:
+        raise InputError("--no-lines", True, "cannot be combined with --intensity-*/--order-* (the intensity and "
+                         "the order spectrum over f / f_chain need the chain frequency)")
+    if args.order_png or args.order_csv:
+        _orders(args, t, y, freqs, label, spec.unit)
     if args.intensity_png or args.intensity_csv:
-        if freqs is None:
-            raise InputError("--no-lines", True, "cannot be combined with --intensity-png/--intensity-csv (the "
-                             "intensity over f / f_chain needs the chain frequency)")
         intensity = sg.order_intensity(spec, freqs)
         if args.intensity_csv:
             sg.write_intensity_csv(intensity, args.intensity_csv)
@@ -105,6 +115,50 @@ def _run(args: argparse.Namespace, orders: tuple[int, ...]) -> int:
                                  unit=spec.unit)
             print(f"wrote {args.intensity_png}")
     return 0
+
+
+def _orders(args: argparse.Namespace, t, y, freqs, label: str, unit: str) -> None:
+    """The order spectrum of the analysed signal: written, and how far whole orders stand above half orders."""
+    import numpy as np
+
+    from cvtfem.post import spectrogram as sg
+
+    spec = sg.order_spectrum(t, y, freqs)
+    k = np.arange(1, freqs.n_pins)
+    contrast = spec.band_contrast(k)
+    print(f"order spectrum over {spec.revolutions:.4g} chain revolutions (resolution {1 / spec.revolutions:.3g}): "
+          f"whole orders 1..{freqs.n_pins - 1} stand {contrast.mean():+.2f} dB (median {np.median(contrast):+.2f} dB) "
+          f"above the half orders; peak at order {spec.order[np.argmax(spec.psd[1:]) + 1]:.4g}")
+    if args.order_csv:
+        np.savetxt(args.order_csv, np.column_stack([spec.order, spec.psd, spec.db()]), delimiter=",",
+                   header="order,psd,dB", comments="", fmt="%.6g")
+        print(f"wrote {args.order_csv}")
+    if args.order_png:
+        from cvtfem.post.spectrogram_plot import plot_order_spectrum
+
+        plot_order_spectrum(spec, freqs.n_pins, args.order_png, title=f"{label}: order spectrum over "
+                            f"{spec.revolutions:.3g} chain revolutions", unit=unit)
+        print(f"wrote {args.order_png}")
+
+
+def campbell_modes(path: str):
+    """``(t (s,) s, f (s, k) Hz)``: the tracked modes of a ``cvtfem runcampbell --csv`` file."""
+    import csv
+
+    import numpy as np
+
+    from cvtfem.errors import InputError
+
+    try:
+        with open(path, newline="") as fh:
+            rows = list(csv.reader(fh))
+    except OSError as err:
+        raise InputError("--campbell", path, f"must be a readable CSV file ({err.strerror})") from None
+    cols = [i for i, name in enumerate(rows[0] if rows else []) if name.startswith("mode") and name.endswith("_Hz")]
+    if not cols or rows[0][0] != "t_s" or len(rows) < 3:
+        raise InputError("--campbell", path, "must be a CSV of `cvtfem runcampbell --csv` with at least 2 times")
+    data = np.array([[float(r[0])] + [float(r[i]) for i in cols] for r in rows[1:]])
+    return data[:, 0], data[:, 1:]
 
 
 def chain_of(results) -> tuple[int, float, float]:

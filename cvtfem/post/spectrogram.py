@@ -255,3 +255,53 @@ def write_intensity_csv(intensity: OrderIntensity, path: str | Path) -> None:
     """The order intensity as CSV: ``f_over_f_chain, psd, dB``."""
     np.savetxt(path, np.column_stack([intensity.order, intensity.psd, intensity.db()]), delimiter=",",
                header="f_over_f_chain,psd,dB", comments="", fmt="%.6g")
+
+
+@dataclass(frozen=True)
+class OrderSpectrum:
+    """One-sided PSD of a signal resampled uniformly in chain revolutions (computed order tracking).
+
+    Attributes
+    ----------
+    order : (m,) -
+        Cycles per chain revolution (``f / f_chain`` at every instant).
+    psd : (m,) unit^2 per order
+    revolutions : float
+        Chain revolutions analysed (the order resolution is ``1 / revolutions``).
+    """
+
+    order: np.ndarray
+    psd: np.ndarray
+    revolutions: float
+
+    def db(self) -> np.ndarray:
+        """``10 log10(psd)``, dB re 1 unit^2 per order (floored at 1e-30 of the largest value)."""
+        return 10.0 * np.log10(np.maximum(self.psd, 1e-30 * max(float(self.psd.max()), 1e-300)))
+
+    def band_contrast(self, orders) -> np.ndarray:
+        """Per order ``k`` of ``orders`` the level (dB) at ``k`` less the mean level at ``k - 1/2`` and
+        ``k + 1/2`` (interpolated): how far lines at whole multiples of ``f_chain`` stand out."""
+        db = self.db()
+        k = np.asarray(orders, float)
+        at = np.interp(k, self.order, db)
+        between = 0.5 * (np.interp(k - 0.5, self.order, db) + np.interp(k + 0.5, self.order, db))
+        return at - between
+
+
+def order_spectrum(t, y, freqs: ChainFrequencies, samples_per_revolution: int = 1024) -> OrderSpectrum:
+    """Resample ``y(t)`` at equal steps of the chain's revolutions ``theta(t) = int f_chain dt`` (trapezoidal rule on
+    ``freqs``), then take one Hann-windowed periodogram over all of it: a line at a fixed multiple ``k`` of a
+    varying ``f_chain`` stays at order ``k`` (it smears over ``k df`` in a spectrogram)."""
+    t, y = np.asarray(t, float), np.asarray(y, float)
+    fc = freqs.at(t)
+    if not (fc > 0).all():
+        raise InputError("f_chain", float(fc.min()), "must be positive over the signal (the chain must run)")
+    theta = np.concatenate([[0.0], np.cumsum(0.5 * (fc[1:] + fc[:-1]) * np.diff(t))])
+    if not theta[-1] >= 1.0:
+        raise InputError("t", float(t[-1] - t[0]), f"must span at least one chain revolution (it spans "
+                         f"{theta[-1]:.3g})", "analyse a longer stretch of the run")
+    n = int(theta[-1] * samples_per_revolution)
+    grid = np.arange(n) / samples_per_revolution
+    f, psd = scipy.signal.periodogram(np.interp(grid, theta, y), fs=samples_per_revolution, window="hann",
+                                      detrend="constant", scaling="density")
+    return OrderSpectrum(f, psd, float(n / samples_per_revolution))

@@ -7,16 +7,18 @@ import numpy as np
 
 from cvtfem.post.campbell import spread
 from cvtfem.post.figures import pyplot, save
-from cvtfem.post.spectrogram import OrderIntensity, Spectrogram
+from cvtfem.post.spectrogram import OrderIntensity, OrderSpectrum, Spectrogram
 
 #: Dynamic range shown in the spectrogram, dB below its largest value.
 DB_RANGE = 80.0
 
 
 def plot_spectrogram(spec: Spectrogram, path: str | Path, lines=(), line_times=None, title: str = "",
-                     label: str = "") -> Path:
+                     label: str = "", modes=None) -> Path:
     """Spectrogram in dB (time on x in ms, frequency on y in Hz up to the last kept frequency) with excitation
-    lines ``(label, f(t))`` sampled at ``line_times`` (s) drawn over it and labelled at the right edge."""
+    lines ``(label, f(t))`` sampled at ``line_times`` (s) drawn over it and labelled at the right edge, and
+    ``modes = (t (s,) s, f (s, k) Hz)``, tracked natural frequencies along the run (a Campbell diagram), as thin
+    green lines."""
     plt = pyplot()
     db = spec.db()
     top = float(db.max())
@@ -46,6 +48,13 @@ def plot_spectrogram(spec: Spectrogram, path: str | Path, lines=(), line_times=N
                 ax.annotate(name, (edges_t[-1], y0), xytext=(edges_t[-1] + 0.01 * (edges_t[-1] - edges_t[0]), y),
                             textcoords="data", fontsize=7, va="center", annotation_clip=False,
                             arrowprops={"arrowstyle": "-", "lw": 0.4, "color": "0.5"})
+    if modes is not None:
+        tm, fm = modes
+        inside = (1e3 * np.asarray(tm) >= edges_t[0]) & (1e3 * np.asarray(tm) <= edges_t[-1])
+        for j in range(np.shape(fm)[1]):
+            ax.plot(1e3 * np.asarray(tm)[inside], np.asarray(fm)[inside, j], color="lime", lw=0.8,
+                    label="modes of J11" if j == 0 else None)
+        ax.legend(loc="upper left", fontsize=7, framealpha=0.8)
     ax.set_xlim(edges_t[0], edges_t[-1])
     ax.set_ylim(0.0, fmax)
     ax.set_xlabel("time, ms")
@@ -68,4 +77,26 @@ def plot_order_intensity(intensity: OrderIntensity, path: str | Path, title: str
     ax.set_ylabel(f"mean PSD, dB re 1 {unit}$^2$/Hz" if unit else "mean PSD, dB")
     ax.set_title(title or "time-averaged intensity over f / f_chain", fontsize=10)
     ax.grid(alpha=0.3)
+    return save(fig, path)
+
+
+def plot_order_spectrum(spec: OrderSpectrum, n_pins: int, path: str | Path, title: str = "", unit: str = "",
+                        top: float | None = None) -> Path:
+    """Order spectrum in dB over ``f / f_chain`` up to ``top`` (default ``1.2 n_pins``): the whole orders
+    (``k f_chain``) as a faint grid, the pin-entry orders ``k n_pins / 3`` dashed and ``k n_pins`` red."""
+    plt = pyplot()
+    top = float(top or 1.2 * n_pins)
+    keep = spec.order <= top
+    fig, ax = plt.subplots(figsize=(9.0, 4.2), layout="constrained")
+    for k in range(1, int(top) + 1):
+        ax.axvline(k, color="0.85", lw=0.4, zorder=0)
+    for k in range(1, int(3 * top / n_pins) + 1):
+        ax.axvline(k * n_pins / 3, color="0.4" if k % 3 else "tab:red", ls="--" if k % 3 else "-", lw=0.8)
+    ax.plot(spec.order[keep], spec.db()[keep], color="tab:blue", lw=0.8)
+    ax.set_xlim(0.0, top)
+    ax.set_xlabel(r"order $f / f_{chain}$ (grey: whole orders; dashed: $k\,n_{pins}/3$; red: $k\,n_{pins}$, "
+                  f"n_pins = {n_pins})")
+    ax.set_ylabel(f"PSD, dB re 1 {unit}$^2$ per order" if unit else "PSD, dB per order")
+    ax.set_title(title or f"order spectrum over {spec.revolutions:.3g} chain revolutions "
+                          f"(resolution {1 / spec.revolutions:.2g} order)", fontsize=10)
     return save(fig, path)

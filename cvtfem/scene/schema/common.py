@@ -40,6 +40,8 @@ OUTPUT = Table("output", "What a run writes and how often.", (
     Key("names", "str[]", "Outputs to record (empty: all the model offers; see `cvtfem describe`).", "", ()),
     Key("flush_interval", "float", "Wall time between flushes of the results file.", "s", 2.0, gt=0.0),
     Key("checkpoint_interval", "float", "Simulated time between full-state checkpoints (0: none).", "s", 0.0, ge=0.0),
+    Key("state", "bool", "Also record the full state vector x as the series `state` (to linearise the model at "
+        "stored times: `cvtfem campbell-run`, `cvtfem jacobian-spectrum`).", "", False),
 ))
 
 IDENTITY = (
