@@ -39,18 +39,16 @@ from scipy.optimize import least_squares
 from cvtfem.assembly.model import StateLayout
 from cvtfem.elements.base import Block
 from cvtfem.elements.chain.sheave_contact import central_local_jacobian
+from cvtfem.elements.chain.symmetric import END_SLOPE_FACTOR
 from cvtfem.errors import NumericalError
 from cvtfem.machines.chain_a_cvt import ChainACVT
 from cvtfem.machines.chain_cvt import ChainCVT
 from cvtfem.machines.shaft_structure import ShaftParameters, ShaftStructure, build_structure
 from cvtfem.outputs import OutputSpec
 
-#: Inputs of a mapped contact: pin end (3), sheave translation (3) and tilt (2), the other sheave's axial
-#: position (1), their rates (9), the spin rate.
-N_MAPPED_IN = 19
-#: Outputs: forces on those 9 positions and on the spin; the friction power.
-N_MAPPED_OUT = 11
-_STEPS = np.array([1e-9] * 9 + [1e-6] * 9 + [1e-5])
+
+#: Chain positions of an H2 contact (ChainACVT's map without ``z``): pins ``p-1, p, p+1`` (2 each), ``x3``, slope (2).
+N_REFINED_CHAIN = 9
 
 
 def _tilt(th):
@@ -141,26 +139,27 @@ class ElasticChainCVT(ChainCVT):
         return (e, k, j) + self._mapped_map(dof3[:, :, None], np.ones(dof3.shape + (1,)), k, j)
 
     def _mapped_map(self, end_cols, end_coef, k, j):
-        """The mapped inputs' ``(cols, coef)`` (m, 19, K) from the pin-end position's (m, 3, K) in the mirrored
-        frame of its sheave (``x3 -> s x3``) and the sheave's structure columns."""
+        """The mapped inputs' ``(cols, coef)`` (m, 2 (P + 6) + 1, K) from the chain positions' (m, P, K) in the
+        mirrored frame of the sheave (``x3 -> s x3``; H1: the pin end, P = 3; H2: the kernel's nine) and the
+        sheave's structure columns: positions, their rates, the spin rate."""
         nc, n2 = self._idx[0], self.n2
         sd = nc + self.structure.sheave_dofs[k, j]                 # (m, 6)
         other = nc + self.structure.sheave_dofs[k, 1 - j, 2]
         own = np.column_stack([sd[:, :5], other])                  # (m, 6)
-        m, K = len(k), end_cols.shape[2]
-        cols = np.zeros((m, N_MAPPED_IN, K), np.int64)
-        coef = np.zeros((m, N_MAPPED_IN, K))
-        for off in (0, 9):
-            cols[:, off:off + 3] = end_cols + (n2 if off else 0)
-            coef[:, off:off + 3] = end_coef
-            cols[:, off + 3:off + 9, 0] = own + (n2 if off else 0)
-            coef[:, off + 3:off + 9, 0] = 1.0
-        cols[:, 18, 0] = n2 + sd[:, 5]
-        coef[:, 18, 0] = 1.0
+        (m, P, K), n_pos = end_cols.shape, end_cols.shape[1] + 6
+        cols = np.zeros((m, 2 * n_pos + 1, K), np.int64)
+        coef = np.zeros((m, 2 * n_pos + 1, K))
+        for off in (0, n_pos):
+            cols[:, off:off + P] = end_cols + (n2 if off else 0)
+            coef[:, off:off + P] = end_coef
+            cols[:, off + P:off + n_pos, 0] = own + (n2 if off else 0)
+            coef[:, off + P:off + n_pos, 0] = 1.0
+        cols[:, -1, 0] = n2 + sd[:, 5]
+        coef[:, -1, 0] = 1.0
         return cols, coef
 
     def mapped_local(self, Z, k, j, details: bool = False):
-        """Outputs (m, 11) of mapped contacts with inputs ``Z`` (m, 19, :data:`N_MAPPED_IN`) on shafts ``k``, sheaves
+        """Outputs (m, 11) of mapped H1 contacts with inputs ``Z`` (m, 19) on shafts ``k``, sheaves
         ``j``: generalized forces on the pin-end coordinates (3), the sheave's translation (3) and tilt (2), the other
         sheave's axial position (1) and the spin (1), and the friction power (W); with ``details`` also the kernel's
         per-contact dict (for one end and one sheave) with the mapped position ``X`` (kernel frame), tilt, side."""
@@ -229,7 +228,7 @@ class ElasticChainCVT(ChainCVT):
         side = self._sides[:, 1]
         Q[iz] -= side * F
         Q[self._movable_node_u3] += side * F
-        Pf = float(Y[:, 10].sum())
+        Pf = float(Y[:, -1].sum())
         return (Q, Pf, mean_slip) if slip else (Q, Pf)
 
     @cached_property
@@ -263,7 +262,9 @@ class ElasticChainCVT(ChainCVT):
     def _mapped_jacobian(self, q, v):
         """``(cols, coef, Jl)``: the contact map and the local Jacobians (m, 11, 19) of the mapped contacts."""
         e, k, j, cols, coef, Z, _ = self._mapped_set(q, v)
-        Jl = central_local_jacobian(lambda Zp, kk: self.mapped_local(Zp, kk, j), Z, k, _STEPS, N_MAPPED_OUT)
+        n_pos = (Z.shape[1] - 1) // 2
+        steps = np.concatenate([np.full(n_pos, 1e-9), np.full(n_pos, 1e-6), [1e-5]])
+        Jl = central_local_jacobian(lambda Zp, kk: self.mapped_local(Zp, kk, j), Z, k, steps, n_pos + 2)
         return cols, coef, Jl
 
     @cached_property
@@ -326,7 +327,7 @@ class ElasticChainCVT(ChainCVT):
         P = sp.csr_matrix(self.family.jac_sparsity, dtype=float).tocoo()
         rows, cols = [P.row, P.row], [P.col, P.col + n2]
         mc, mw = self._all_mapped()
-        r, c, _ = self._contact_entries(mc, mw, np.ones((len(mc), N_MAPPED_OUT, N_MAPPED_IN)))
+        r, c, _ = self._contact_entries(mc, mw, np.ones((len(mc), (mc.shape[1] + 3) // 2, mc.shape[1])))
         rows.append(r)
         cols.append(c)
         S = (abs(self.structure.K) + abs(self.structure.C) + abs(self.structure.G[0]) + abs(self.structure.G[1]))
@@ -398,7 +399,7 @@ class ElasticChainCVT(ChainCVT):
                     "contact.radius": per(np.where(on, c["radius"], 0.0)),
                     "contact.slip_speed": per(np.where(on, np.linalg.norm(c["slip"], axis=1), 0.0)),
                     "contact.friction_force": per(c["F_fr"], 3),
-                    "contact.friction_power": np.bincount(k, Y[:, 10], 2),
+                    "contact.friction_power": np.bincount(k, Y[:, -1], 2),
                     **self._axial_outputs(k, j, c),
                     "driving.speed": w[0], "driven.speed": w[1], "driving.torque": M[0], "driven.torque": M[1],
                     "driving.clamping_force": F[0], "driven.clamping_force": F[1],
@@ -553,7 +554,60 @@ class ElasticChainACVT(ElasticChainCVT, ChainACVT):
     def _pairs_map(self, ends, shafts):
         j = self._sheave_of(ends, shafts)
         cols, coef = ChainACVT._contact_map(self, ends, shafts)
-        return (ends, shafts, j) + self._mapped_map(cols[:, :3], coef[:, :3], shafts, j)
+        n_chain = N_REFINED_CHAIN if self.contact.refined else 3        # the kernel's chain positions (no z)
+        return (ends, shafts, j) + self._mapped_map(cols[:, :n_chain], coef[:, :n_chain], shafts, j)
+
+    def mapped_local(self, Z, k, j, details: bool = False):
+        """H1: :meth:`ElasticChainCVT.mapped_local`.  H2 (variant (b)): outputs (m, 17) of the mapped contacts with
+        inputs ``Z`` (m, 31): the generalized forces on the kernel's nine chain positions (mirrored frame), the
+        sheave's translation (3), tilt (2), the other sheave's axial position (1, unused: absolute axial motion),
+        on the spin, and the friction power (W); ``details`` as there."""
+        if not self.contact.refined:
+            return super().mapped_local(Z, k, j, details)
+        n = N_REFINED_CHAIN + 6
+        P, V = Z[:, :n], Z[:, n:2 * n]
+        K, dK = self._refined_frame(P, k, j)
+        kin = np.column_stack([K, np.einsum("mij,mj->mi", dK, V), Z[:, -1]])
+        out = self.contact.local(kin, k, details)
+        Y, det = out if details else (out, None)
+        Q = np.einsum("mij,mi->mj", dK[:, :N_REFINED_CHAIN], Y[:, :N_REFINED_CHAIN])   # z_ref is a constant
+        res = np.column_stack([Q, Y[:, -2], Y[:, -1]])
+        if not details:
+            return res
+        return res, dict(det, X=K[:, [2, 3, 6]], tilt=_tilt(P[:, 12:14]), side=self._sides[k, j].astype(float))
+
+    def _refined_frame(self, P, k, j):
+        """``(K, dK/dP)``: the H2 kernel's position inputs (m, 10) in the frame of the displaced, tilted sheave ``j``
+        of shaft ``k`` and their derivative (m, 10, 15) in the mapped positions ``P`` (m, 15): pins ``p-1, p, p+1``
+        at the end's offset (2 each), the end's ``x3``, its slope coordinates (2), all mirrored (``x3 -> s x3``), then
+        the sheave's translation ``a`` (3), tilt (2) and the other sheave's axial position.  Every point goes
+        through ``X = o + (I - theta x)(x - o - a)`` at the end's ``x3`` (the end's own ``X_3`` is the kernel's
+        ``x3``); the end slope, a direction ``(gamma, 1)``, through ``I - theta x`` to first order:
+        ``gamma' = gamma + s (-theta_2, theta_1)``; the face stays at its reference ``z_ref``.  The map is bilinear
+        in (tilt, position), so ``dK/dP`` is exact and ``K' = dK/dP P'``."""
+        m = len(P)
+        s = self._sides[k, j].astype(float)
+        c, o3 = self.contact.centres[k], self.structure.sheave_x3[k, j]
+        a, t1, t2 = P[:, 9:12], P[:, 12], P[:, 13]
+        d3 = s * P[:, 6] - o3 - a[:, 2]
+        K, dK = np.zeros((m, 10)), np.zeros((m, 10, 15))
+        one = np.ones(m)
+        for i in range(3):
+            d1, d2 = P[:, 2 * i] - c[:, 0] - a[:, 0], P[:, 2 * i + 1] - c[:, 1] - a[:, 1]
+            K[:, 2 * i] = c[:, 0] + d1 - t2 * d3
+            K[:, 2 * i + 1] = c[:, 1] + d2 + t1 * d3
+            dK[:, 2 * i, [2 * i, 6, 9, 11, 13]] = np.column_stack([one, -s * t2, -one, t2, -d3])
+            dK[:, 2 * i + 1, [2 * i + 1, 6, 10, 11, 12]] = np.column_stack([one, s * t1, -one, -t1, d3])
+            if i == 1:                                                  # the end itself: its axial position
+                K[:, 6] = s * (o3 + d3 - t1 * d2 + t2 * d1)
+                dK[:, 6, [2, 3, 6, 9, 10, 11, 12, 13]] = s[:, None] * np.column_stack(
+                    [t2, -t1, s, -t2, t1, -one, -d2, d1])
+        K[:, 7] = P[:, 7] - s * t2 / END_SLOPE_FACTOR
+        K[:, 8] = P[:, 8] + s * t1 / END_SLOPE_FACTOR
+        dK[:, 7, [7, 13]] = np.column_stack([one, -s / END_SLOPE_FACTOR])
+        dK[:, 8, [8, 12]] = np.column_stack([one, s / END_SLOPE_FACTOR])
+        K[:, 9] = self.z_ref[k, j]
+        return K, dK
 
     def _mapped_pairs(self, q):
         return self._pairs_map(*self._candidates(q))

@@ -1,0 +1,250 @@
+"""Variant (b) (issue 14, Table 1.1): the whole-pin chain A1 with the refined contact H2 on elastic shafts.  Each H2
+contact is evaluated in the frame of its displaced, tilted sheave: a rigid motion of the whole transmission leaves the
+contacts unchanged, the mapped forces are the Hertz gradient with the kernel's friction power, the Jacobian is that
+of the right-hand side, stiff shafts give the rigid variant (a), the start balances the pins axially and a short run
+closes its energy balance."""
+from dataclasses import replace
+
+import numpy as np
+import pytest
+from scipy.spatial.transform import Rotation
+
+from cvtfem.control.clamping import Clamping
+from cvtfem.elements.chain.sheave_contact import central_local_jacobian
+from cvtfem.elements.contact.hertz import hertz_potential
+from cvtfem.machines.chain_cvt import from_scene as rigid_from_scene
+from cvtfem.machines.chain_cvt_elastic import ElasticChainACVT, elastic, shaft_parameters
+from cvtfem.machines.cvt import band_params, chain_geometry
+from cvtfem.machines.shaft_structure import build_structure
+from cvtfem.scene.loader import load_scene
+from tests.machines.chain_checks import assert_energy_balance, assert_jacobian_columns
+
+SCENE = "variant-b,regime-stationary"
+N_POS = 15          # mapped positions of an H2 contact: 9 chain, sheave translation (3), tilt (2), other axial (1)
+
+
+@pytest.fixture(scope="module")
+def scene():
+    return load_scene(SCENE)
+
+
+@pytest.fixture(scope="module")
+def rigid(scene):
+    """Variant (a): A1 with H2 on rigid shafts (the tanh law, as the running presets)."""
+    rg = scene.cvt.regime
+    F = Clamping(band_params(scene), rg.clamping_safety, rg.clamping_split, rg.min_clamping_force).forces(rg.torque,
+                                                                                                          rg.ratio)
+    return rigid_from_scene(scene, chain_geometry(scene), F, model="chain-A1", law="tanh", contact="hertz-refined")
+
+
+@pytest.fixture(scope="module")
+def rigid_start(rigid):
+    w1, _, i = rigid.regime.targets(0.0)
+    return (i, w1) + rigid.static_state(i, w1)
+
+
+def _elastic(scene, rigid, rigid_start, stiffer: float = 1.0) -> ElasticChainACVT:
+    """Variant (b) on the scene's shafts with Young's modulus and bearing stiffness ``stiffer`` times the scene's."""
+    params = tuple(replace(p, bearing_stiffness=stiffer * p.bearing_stiffness) for p in shaft_parameters(scene))
+    return replace(elastic(rigid, build_structure(params, stiffer * scene.cvt.young_modulus)), rigid_start=rigid_start)
+
+
+@pytest.fixture(scope="module")
+def static(scene, rigid, rigid_start):
+    x0, rep = _elastic(scene, rigid, rigid_start).static_state(*rigid_start[:2])
+    return rep["model"], x0, rep
+
+
+def _running(model, x0, seed: int):
+    """A running state off balance: random chain offsets (1 um) and velocities (0.05 m/s), sheave tilts (0.2 mrad)
+    and structure rates."""
+    rng = np.random.default_rng(seed)
+    x = x0.copy()
+    nc, n2, s = model.family.size, model.n2, model.structure
+    x[:nc] += rng.normal(0.0, 1e-6, nc)
+    tilt = nc + s.sheave_dofs[:, :, 3:5].ravel()
+    x[tilt] += rng.normal(0.0, 2e-4, tilt.size)
+    x[n2:2 * n2] += rng.normal(0.0, 0.05, n2)
+    return x
+
+
+def _rigid_motion(model, x, shift, rotvec, pivot):
+    """``x`` moved as one rigid body: rotated by ``rotvec`` (rad, about an in-plane axis) about ``pivot`` (m), then
+    shifted by ``shift`` (m); velocities rotated, tilts increased by the rotation (first order, as the model's)."""
+    R = Rotation.from_rotvec(rotvec).as_matrix()
+    fam, s = model.family, model.structure
+    nc, n2 = fam.size, model.n2
+    x = x.copy()
+    (u, w), (vu, vw) = fam.split(x[:nc]), fam.split(x[n2:n2 + nc])
+    ends = [np.column_stack([u[0] + sg * u[1], w[0] + sg * w[1]]) for sg in (-1, 1)]
+    rates = [np.column_stack([vu[0] + sg * vu[1], vw[0] + sg * vw[1]]) for sg in (-1, 1)]
+    ends = [pivot + (E - pivot) @ R.T + shift for E in ends]
+    rates = [V @ R.T for V in rates]
+    for arr, (far, near) in ((u, ends), (vu, rates)):
+        arr[0], arr[1] = 0.5 * (near[:, :2] + far[:, :2]), 0.5 * (near[:, :2] - far[:, :2])
+    w[0], w[1] = 0.5 * (ends[1][:, 2] + ends[0][:, 2]), 0.5 * (ends[1][:, 2] - ends[0][:, 2])
+    vw[0], vw[1] = 0.5 * (rates[1][:, 2] + rates[0][:, 2]), 0.5 * (rates[1][:, 2] - rates[0][:, 2])
+    x[:nc], x[n2:n2 + nc] = fam.join(u, w), fam.join(vu, vw)
+    old = x.copy()
+    for k in range(2):
+        centre = model.contact.centres[k]
+        for i, xi in enumerate(s.x[k]):
+            d = nc + s.offset[k] + 6 * i + np.arange(6)
+            X = np.array([*centre, xi - s.params[k].length / 2])
+            x[d[:3]] = pivot + (X + old[d[:3]] - pivot) @ R.T + shift - X
+            x[n2 + d[:3]] = R @ old[n2 + d[:3]]
+            x[d[3:5]] += rotvec[:2]
+        node, zeta = nc + s.node_of_sheave[k, 1], nc + s.sheave_dofs[k, 1, 2]   # the movable sheave: node laterally
+        X = np.array([*centre, s.sheave_x3[k, 1]])
+        x[zeta] = (pivot + (X + np.array([*old[node:node + 2], old[zeta]]) - pivot) @ R.T + shift - X)[2]
+        x[n2 + zeta] = (R @ np.array([*old[n2 + node:n2 + node + 2], old[n2 + zeta]]))[2]
+    return x
+
+
+def _contacts(model, x):
+    n2 = model.n2
+    e, k, j, _, _, _, (_, det) = model._mapped_set(x[:n2], x[n2:2 * n2], details=True)
+    order = np.lexsort((j, k, e))
+    return (e[order], k[order], j[order]), {key: det[key][order] for key in ("delta", "N", "F_fr")}
+
+
+def _untilted(model, rigid_start, seed: int):
+    """The rigid start's chain on undeformed shafts (no tilt), turning with them, plus random velocities (0.05 m/s)."""
+    x0r = rigid_start[2]
+    nc, n2, rn2 = model.family.size, model.n2, model.rigid().n2
+    x = np.zeros(model.size)
+    x[:nc], x[n2:n2 + nc] = x0r[:nc], x0r[rn2:rn2 + nc]
+    x[n2 + model._idx[1]] = rigid_start[1] * np.array([1.0, 1.0 / rigid_start[0]])
+    x[n2:2 * n2] += np.random.default_rng(seed).normal(0.0, 0.05, n2)
+    return x
+
+
+def _change(model, x, moved, ref_pairs, ref):
+    """Largest change of the normal and friction forces of the contacts (N) between ``x`` and ``moved``, over the
+    largest normal force; the same contacts must be found."""
+    pairs, new = _contacts(model, moved)
+    assert all(np.array_equal(a, b) for a, b in zip(pairs, ref_pairs))
+    return np.array([np.abs(new[key] - ref[key]).max() for key in ("N", "F_fr")]) / ref["N"].max()
+
+
+def test_a_rigid_motion_of_shafts_sheaves_and_chain_leaves_the_contacts_unchanged(static, rigid_start):
+    """Frame consistency.  Translating the whole transmission (chain, shafts, sheaves) changes no contact (1e-9).
+    Rotating it by a small tilt about an in-plane axis: on untilted shafts the normal and friction forces change at
+    second order (10x smaller tilt, ~100x smaller change: the map is first order in the tilt); on the loaded, tilted
+    shafts of a running state the change is of order rotation x sheave tilt, a few thousandths of what rotating the
+    shafts and sheaves alone under the chain does."""
+    model, x0, _ = static
+    pivot = np.array([*model.contact.centres.mean(axis=0), 0.0])
+    axis = np.array([0.6, 0.8, 0.0])
+    x = _untilted(model, rigid_start, seed=1)
+    ref_pairs, ref = _contacts(model, x)
+    assert (ref["delta"] > 0).sum() > 60
+    shifted = _rigid_motion(model, x, np.array([3e-6, -2e-6, 4e-6]), np.zeros(3), pivot)
+    assert np.all(_change(model, x, shifted, ref_pairs, ref) < 1e-9)
+    errs = np.array([_change(model, x, _rigid_motion(model, x, np.zeros(3), angle * axis, pivot), ref_pairs, ref)
+                     for angle in (1e-3, 1e-4)])
+    assert np.all(errs[1] < 0.03 * errs[0]) and np.all(errs[1] < 1e-4), errs
+    x = _running(model, x0, seed=1)
+    ref_pairs, ref = _contacts(model, x)
+    assert (ref["delta"] > 0).sum() > 40
+    rigid_motion = _rigid_motion(model, x, np.zeros(3), 1e-4 * axis, pivot)
+    shafts_alone = x.copy()
+    nc, n2 = model.family.size, model.n2
+    shafts_alone[nc:n2] = rigid_motion[nc:n2]
+    shafts_alone[n2 + nc:2 * n2] = rigid_motion[n2 + nc:2 * n2]
+    err = _change(model, x, rigid_motion, ref_pairs, ref)
+    assert np.all(err < 5e-3 * _change(model, x, shafts_alone, ref_pairs, ref)[0]), err
+
+
+def test_mapped_forces_are_the_hertz_gradient_and_friction_has_the_kernel_power(static):
+    """Per mapped H2 contact: the forces on all 15 positions (pins p-1, p, p+1, x3, end slope, sheave translation and
+    tilt) are minus the gradient of the Hertz potential of the mapped closed form (central differences, friction off);
+    with friction the power of the generalized forces on the input rates is minus the potential's rate plus the
+    kernel's friction power (the velocity map is the exact time derivative of the bilinear position map)."""
+    model, x0, _ = static
+    x = _running(model, x0, seed=3)
+    n2 = model.n2
+    e, k, j, _, _, Z, Y = model._mapped_set(x[:n2], x[n2:2 * n2])
+    delta = model.mapped_local(Z, k, j, details=True)[1]["delta"]
+    on = delta > 0
+    assert on.sum() > 40 and np.unique(j[on]).size == 2 and np.abs(Z[:, 12:14]).max() > 1e-4
+
+    def potential(Zp):
+        return hertz_potential(model.mapped_local(Zp, k, j, details=True)[1]["delta"], model.contact.c[k])
+    grad = central_local_jacobian(lambda Zp, kk: potential(Zp)[:, None], Z, k, np.full(Z.shape[1], 1e-9), 1)[:, 0]
+    grad = grad[:, :N_POS]
+    pair = model.contact.pair
+    frictionless = replace(model, contact=replace(model.contact, pair=replace(pair, f0=0.0)))
+    Y0 = frictionless.mapped_local(Z, k, j)
+    scale = np.abs(Y0[:, :N_POS]).max(axis=1, keepdims=True)
+    np.testing.assert_allclose(Y0[on, :N_POS], -grad[on], atol=1e-5 * scale.max())
+    assert np.abs(Y0[on, 9:14]).max() > 100.0            # the sheave translation and tilt are loaded
+    rates = np.column_stack([Z[:, N_POS:2 * N_POS], Z[:, -1]])
+    terms = Y[:, :N_POS + 1] * rates
+    np.testing.assert_array_less(np.abs(terms.sum(axis=1) + np.sum(grad * Z[:, N_POS:2 * N_POS], axis=1) - Y[:, -1]),
+                                 1e-5 * np.abs(terms).sum(axis=1) + 1e-9)
+    assert Y[:, -1].min() < -1.0
+
+
+def test_jacobian_against_differences_and_on_its_pattern(static):
+    model, x0, _ = static
+    x = _running(model, x0, seed=2)
+    J = model.jac(0.0, x).toarray()
+    assert not np.any(J[~model.jac_sparsity.toarray()])
+    rng = np.random.default_rng(5)
+    n2, nc = model.n2, model.family.size
+    sheave = nc + model.structure.sheave_dofs.ravel()
+    cols = np.concatenate([rng.choice(nc, 10, replace=False), n2 + rng.choice(nc, 10, replace=False), sheave,
+                           n2 + sheave, np.arange(2 * n2, 2 * n2 + 4)])
+    assert_jacobian_columns(model, x, J, np.unique(cols))
+
+
+def test_start_balances_the_pins_axially(static, rigid_start):
+    """The quasi-static start on elastic shafts with H2 (residual 1e-8 of F2): the pins push the movable sheaves with
+    the clamping forces (F2 given, F1 the reaction; along the tilted axes, 1e-3) and the fixed ones with nearly the
+    same; each shaft's bearings carry the resultant of the pins' forces on its two sheaves, the locating bearings the
+    difference of the axial ones, which the chain carries from one pulley to the other (the two cancel); the sheaves
+    of a pulley tilt opposite ways."""
+    model, x0, rep = static
+    assert rep["residual"] < 1e-8 and rep["nfev_elastic"] < 50
+    o = model.outputs(0.0, x0)
+    F = np.array([rep["F1"], rep["F2"]])
+    np.testing.assert_allclose(o["contact.sheave_axial_force"], F, rtol=1e-3)      # along the tilted axes
+    np.testing.assert_allclose(o["contact.fixed_sheave_axial_force"], o["contact.sheave_axial_force"], rtol=2e-3)
+    n2 = model.n2
+    _, k, _, _, _, _, Y = model._mapped_set(x0[:n2], np.zeros(n2))                 # friction unloaded
+    axial = []
+    for i, name in enumerate(("driving", "driven")):
+        b = o[f"{name}.bearing_force"].reshape(2, 3)
+        np.testing.assert_allclose(b.sum(axis=0), Y[k == i, 9:12].sum(axis=0), rtol=1e-6, atol=1e-7 * F[1])
+        axial.append(b[0, 2])
+        tilt = o[f"{name}.sheave_tilt"].reshape(2, 2)
+        assert 1e-5 < abs(tilt).max() < 1e-2 and np.all(tilt[0] * tilt[1] < 0)
+    assert abs(sum(axial)) < 1e-7 * F[1] and abs(axial[0]) < 5e-3 * F[1]      # the chain carries it across
+    assert abs(rep["F1"] / rigid_start[3]["F1"] - 1) < 0.02
+
+
+@pytest.mark.slow
+def test_energy_balance_over_a_short_run(static):
+    """Radau over 50 us from the start (driving clamping force its reaction): chain, shaft, sheave and contact energy
+    changes by input - output + clamping - dissipated work to 1e-6 of the input work."""
+    model, x0, rep = static
+    assert_energy_balance(model.with_clamping([rep["F1"], rep["F2"]]), x0, 5e-5)
+
+
+@pytest.mark.slow
+def test_stiff_shafts_converge_to_the_rigid_variant_a(scene, rigid, rigid_start):
+    """Shafts and bearings k times stiffer: the start's driving clamping force, mean link tension and support forces
+    approach those of variant (a) on rigid shafts, the difference falling about tenfold per tenfold stiffness."""
+    x0r, rep_r = rigid_start[2:]
+    o_r = rigid.outputs(0.0, x0r)
+    errs = []
+    for stiffer in (1.0, 10.0, 100.0):
+        x0, rep = _elastic(scene, rigid, rigid_start, stiffer).static_state(*rigid_start[:2])
+        o = rep["model"].outputs(0.0, x0)
+        errs.append([abs(rep["F1"] / rep_r["F1"] - 1), abs(rep["tension"] / rep_r["tension"] - 1)]
+                    + [np.linalg.norm(o[f"{n}.support_force"] - o_r[f"{n}.support_force"])
+                       / np.linalg.norm(o_r[f"{n}.support_force"]) for n in ("driving", "driven")])
+    errs = np.array(errs)
+    assert np.all(errs[-1] < 2e-3), errs
+    assert np.all(errs[1:] < 0.2 * errs[:-1] + 1e-6), errs
