@@ -582,9 +582,9 @@ class ElasticChainACVT(ElasticChainCVT, ChainACVT):
         at the end's offset (2 each), the end's ``x3``, its slope coordinates (2), all mirrored (``x3 -> s x3``), then
         the sheave's translation ``a`` (3), tilt (2) and the other sheave's axial position.  Every point goes
         through ``X = o + (I - theta x)(x - o - a)`` at the end's ``x3`` (the end's own ``X_3`` is the kernel's
-        ``x3``); the end slope, a direction ``(gamma, 1)``, through ``I - theta x`` to first order:
-        ``gamma' = gamma + s (-theta_2, theta_1)``; the face stays at its reference ``z_ref``.  The map is bilinear
-        in (tilt, position), so ``dK/dP`` is exact and ``K' = dK/dP P'``."""
+        ``x3``); the end slope, the direction ``(gamma, 1)`` (true frame), through the same ``I - theta x``:
+        ``gamma' = (gamma_1 - theta_2, gamma_2 + theta_1) / (1 + theta_2 gamma_1 - theta_1 gamma_2)``; the face stays
+        at its reference ``z_ref``.  ``dK/dP`` is exact, so the rates are ``K' = dK/dP P'``."""
         m = len(P)
         s = self._sides[k, j].astype(float)
         c, o3 = self.contact.centres[k], self.structure.sheave_x3[k, j]
@@ -602,10 +602,14 @@ class ElasticChainACVT(ElasticChainCVT, ChainACVT):
                 K[:, 6] = s * (o3 + d3 - t1 * d2 + t2 * d1)
                 dK[:, 6, [2, 3, 6, 9, 10, 11, 12, 13]] = s[:, None] * np.column_stack(
                     [t2, -t1, s, -t2, t1, -one, -d2, d1])
-        K[:, 7] = P[:, 7] - s * t2 / END_SLOPE_FACTOR
-        K[:, 8] = P[:, 8] + s * t1 / END_SLOPE_FACTOR
-        dK[:, 7, [7, 13]] = np.column_stack([one, -s / END_SLOPE_FACTOR])
-        dK[:, 8, [8, 12]] = np.column_stack([one, s / END_SLOPE_FACTOR])
+        e, g = END_SLOPE_FACTOR, s * END_SLOPE_FACTOR                  # slope coordinates: gamma_true = g sigma
+        sg1, sg2 = P[:, 7], P[:, 8]
+        n1, n2 = sg1 - s * t2 / e, sg2 + s * t1 / e
+        den = 1.0 + g * (t2 * sg1 - t1 * sg2)
+        K[:, 7], K[:, 8] = n1 / den, n2 / den
+        dden = (g * t2, -g * t1, -g * sg2, g * sg1)                      # d(den)/d(sigma1, sigma2, theta1, theta2)
+        for row, num, dnum in ((7, n1, (one, 0 * one, 0 * one, -s / e)), (8, n2, (0 * one, one, s / e, 0 * one))):
+            dK[:, row, [7, 8, 12, 13]] = np.column_stack([(dn - num * dd / den) / den for dn, dd in zip(dnum, dden)])
         K[:, 9] = self.z_ref[k, j]
         return K, dK
 

@@ -80,8 +80,16 @@ def _rigid_motion(model, x, shift, rotvec, pivot):
     rates = [np.column_stack([vu[0] + sg * vu[1], vw[0] + sg * vw[1]]) for sg in (-1, 1)]
     ends = [pivot + (E - pivot) @ R.T + shift for E in ends]
     rates = [V @ R.T for V in rates]
+    slopes = [2 / fam.geom.l * u[1] + u[b] for b in (2, 3)]           # end slopes (far, near), true frame
+    dslopes = [2 / fam.geom.l * vu[1] + vu[b] for b in (2, 3)]
     for arr, (far, near) in ((u, ends), (vu, rates)):
         arr[0], arr[1] = 0.5 * (near[:, :2] + far[:, :2]), 0.5 * (near[:, :2] - far[:, :2])
+    for b, g, dg in zip((2, 3), slopes, dslopes):                               # the directions (g, 1) turn with R
+        t = np.column_stack([g, np.ones(len(g))]) @ R.T
+        g_new = t[:, :2] / t[:, 2:]
+        dt = np.column_stack([dg, np.zeros(len(g))]) @ R.T
+        u[b] = g_new - 2 / fam.geom.l * u[1]
+        vu[b] = (dt[:, :2] - g_new * dt[:, 2:]) / t[:, 2:] - 2 / fam.geom.l * vu[1]
     w[0], w[1] = 0.5 * (ends[1][:, 2] + ends[0][:, 2]), 0.5 * (ends[1][:, 2] - ends[0][:, 2])
     vw[0], vw[1] = 0.5 * (rates[1][:, 2] + rates[0][:, 2]), 0.5 * (rates[1][:, 2] - rates[0][:, 2])
     x[:nc], x[n2:n2 + nc] = fam.join(u, w), fam.join(vu, vw)
@@ -109,14 +117,20 @@ def _contacts(model, x):
 
 
 def _untilted(model, rigid_start, seed: int):
-    """The rigid start's chain on undeformed shafts (no tilt), turning with them, plus random velocities (0.05 m/s)."""
+    """The rigid start's chain on undeformed shafts (no tilt), turning with them, plus random velocities (0.05 m/s;
+    none along the pins)."""
     x0r = rigid_start[2]
     nc, n2, rn2 = model.family.size, model.n2, model.rigid().n2
     x = np.zeros(model.size)
     x[:nc], x[n2:n2 + nc] = x0r[:nc], x0r[rn2:rn2 + nc]
     x[n2 + model._idx[1]] = rigid_start[1] * np.array([1.0, 1.0 / rigid_start[0]])
-    x[n2:2 * n2] += np.random.default_rng(seed).normal(0.0, 0.05, n2)
-    return x
+    noise = np.random.default_rng(seed).normal(0.0, 0.05, n2)
+    ru, rw = model.family.split(noise[:nc])
+    noise[:nc] = model.family.join(ru, 0 * rw)     # no axial rates: the H2 chords of the neighbours ride on the end's
+    x[n2:2 * n2] += noise                           # axial rate, which a rotation would mix into the in-plane ones
+    s = model.structure
+    x[n2 + nc + s.node_of_sheave[:, 1] + 2] = x[n2 + nc + s.sheave_dofs[:, 1, 2]]   # movable sheaves move with
+    return x                                                                       # their nodes (a rigid body)
 
 
 def _change(model, x, moved, ref_pairs, ref):
@@ -130,7 +144,7 @@ def _change(model, x, moved, ref_pairs, ref):
 def test_a_rigid_motion_of_shafts_sheaves_and_chain_leaves_the_contacts_unchanged(static, rigid_start):
     """Frame consistency.  Translating the whole transmission (chain, shafts, sheaves) changes no contact (1e-9).
     Rotating it by a small tilt about an in-plane axis: on untilted shafts the normal and friction forces change at
-    second order (10x smaller tilt, ~100x smaller change: the map is first order in the tilt); on the loaded, tilted
+    second order (10x smaller tilt, 100x smaller change; the map is first order in the tilt); on the loaded, tilted
     shafts of a running state the change is of order rotation x sheave tilt, a few thousandths of what rotating the
     shafts and sheaves alone under the chain does."""
     model, x0, _ = static
@@ -143,7 +157,7 @@ def test_a_rigid_motion_of_shafts_sheaves_and_chain_leaves_the_contacts_unchange
     assert np.all(_change(model, x, shifted, ref_pairs, ref) < 1e-9)
     errs = np.array([_change(model, x, _rigid_motion(model, x, np.zeros(3), angle * axis, pivot), ref_pairs, ref)
                      for angle in (1e-3, 1e-4)])
-    assert np.all(errs[1] < 0.03 * errs[0]) and np.all(errs[1] < 1e-4), errs
+    assert np.all(errs[1] < 0.02 * errs[0]) and np.all(errs[1] < 1e-5), errs
     x = _running(model, x0, seed=1)
     ref_pairs, ref = _contacts(model, x)
     assert (ref["delta"] > 0).sum() > 40
@@ -235,9 +249,13 @@ def test_energy_balance_over_a_short_run(static):
 @pytest.mark.slow
 def test_stiff_shafts_converge_to_the_rigid_variant_a(scene, rigid, rigid_start):
     """Shafts and bearings k times stiffer: the start's driving clamping force, mean link tension and support forces
-    approach those of variant (a) on rigid shafts, the difference falling about tenfold per tenfold stiffness."""
+    (the bearings' reaction against the resultant of the frictionless contact forces of the balance) approach those of
+    variant (a) on rigid shafts, the difference falling tenfold per tenfold stiffness from 10x the scene's on (the
+    support forces fall only 3x from 1x to 10x)."""
     x0r, rep_r = rigid_start[2:]
-    o_r = rigid.outputs(0.0, x0r)
+    at_rest = x0r.copy()
+    at_rest[rigid.n2:2 * rigid.n2] = 0.0             # the balance's forces: no slip, no friction (as the bearings')
+    o_r = rigid.outputs(0.0, at_rest)
     errs = []
     for stiffer in (1.0, 10.0, 100.0):
         x0, rep = _elastic(scene, rigid, rigid_start, stiffer).static_state(*rigid_start[:2])
@@ -247,4 +265,4 @@ def test_stiff_shafts_converge_to_the_rigid_variant_a(scene, rigid, rigid_start)
                        / np.linalg.norm(o_r[f"{n}.support_force"]) for n in ("driving", "driven")])
     errs = np.array(errs)
     assert np.all(errs[-1] < 2e-3), errs
-    assert np.all(errs[1:] < 0.2 * errs[:-1] + 1e-6), errs
+    assert np.all(errs[1] < 0.5 * errs[0]) and np.all(errs[2] < 0.15 * errs[1]), errs   # tenfold from k = 10 on
