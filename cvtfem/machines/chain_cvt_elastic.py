@@ -41,6 +41,7 @@ from cvtfem.elements.base import Block
 from cvtfem.elements.chain.sheave_contact import central_local_jacobian
 from cvtfem.elements.chain.symmetric import END_SLOPE_FACTOR
 from cvtfem.errors import NumericalError
+from cvtfem.machines.chain_a2_cvt import ChainA2CVT
 from cvtfem.machines.chain_a_cvt import ChainACVT
 from cvtfem.machines.chain_cvt import ChainCVT
 from cvtfem.machines.shaft_structure import ShaftParameters, ShaftStructure, build_structure
@@ -198,10 +199,14 @@ class ElasticChainCVT(ChainCVT):
         res = np.column_stack([Qpin, Qa, -np.cross(d, F)[:, :2], Qo, share * Y[:, 4], share * Y[:, 5]])
         return (res, det) if details else res
 
+    def _local_constants(self, ends) -> dict:
+        """Per-contact constants :meth:`mapped_local` takes besides its inputs (none; A2: the half signs)."""
+        return {}
+
     def _mapped_set(self, q, v, details: bool = False):
         e, k, j, cols, coef = self._mapped_pairs(q)
         Z = (coef * np.concatenate([q, v])[cols]).sum(axis=2)
-        return e, k, j, cols, coef, Z, self.mapped_local(Z, k, j, details)
+        return e, k, j, cols, coef, Z, self.mapped_local(Z, k, j, details, **self._local_constants(e))
 
     def _contacts(self, q, v, details=False):
         e, k, j, cols, coef, Z, Y = self._mapped_set(q, v, details)
@@ -264,7 +269,8 @@ class ElasticChainCVT(ChainCVT):
         e, k, j, cols, coef, Z, _ = self._mapped_set(q, v)
         n_pos = (Z.shape[1] - 1) // 2
         steps = np.concatenate([np.full(n_pos, 1e-9), np.full(n_pos, 1e-6), [1e-5]])
-        Jl = central_local_jacobian(lambda Zp, kk: self.mapped_local(Zp, kk, j), Z, k, steps, n_pos + 2)
+        const = self._local_constants(e)
+        Jl = central_local_jacobian(lambda Zp, kk: self.mapped_local(Zp, kk, j, **const), Z, k, steps, n_pos + 2)
         return cols, coef, Jl
 
     @cached_property
@@ -557,17 +563,19 @@ class ElasticChainACVT(ElasticChainCVT, ChainACVT):
         n_chain = N_REFINED_CHAIN if self.contact.refined else 3        # the kernel's chain positions (no z)
         return (ends, shafts, j) + self._mapped_map(cols[:, :n_chain], coef[:, :n_chain], shafts, j)
 
-    def mapped_local(self, Z, k, j, details: bool = False):
+    def mapped_local(self, Z, k, j, details: bool = False, sign=None):
         """H1: :meth:`ElasticChainCVT.mapped_local`.  H2 (variant (b)): outputs (m, 17) of the mapped contacts with
         inputs ``Z`` (m, 31): the generalized forces on the kernel's nine chain positions (mirrored frame), the
         sheave's translation (3), tilt (2), the other sheave's axial position (1, unused: absolute axial motion),
-        on the spin, and the friction power (W); ``details`` as there."""
+        on the spin, and the friction power (W); ``details`` as there.  ``sign`` (m,): the half signs of A2's
+        coupled-halves kernel (variant (v)), an input of it before the spin rate."""
         if not self.contact.refined:
             return super().mapped_local(Z, k, j, details)
         n = N_REFINED_CHAIN + 6
         P, V = Z[:, :n], Z[:, n:2 * n]
         K, dK = self._refined_frame(P, k, j)
-        kin = np.column_stack([K, np.einsum("mij,mj->mi", dK, V), Z[:, -1]])
+        extra = [] if sign is None else [sign]
+        kin = np.column_stack([K, np.einsum("mij,mj->mi", dK, V)] + extra + [Z[:, -1]])
         out = self.contact.local(kin, k, details)
         Y, det = out if details else (out, None)
         Q = np.einsum("mij,mi->mj", dK[:, :N_REFINED_CHAIN], Y[:, :N_REFINED_CHAIN])   # z_ref is a constant
@@ -643,6 +651,20 @@ class ElasticChainACVT(ElasticChainCVT, ChainACVT):
             ChainACVT._turn_with_sheave(self, q[:nc], v[:nc], pins, v[iphi[kk]], centre)
 
 
+@dataclass(frozen=True, eq=False)
+class ElasticChainA2CVT(ElasticChainACVT, ChainA2CVT):
+    """Variant (v): the whole-pin chain with coupled pin halves (A2, :class:`~cvtfem.machines.chain_a2_cvt.ChainA2CVT`)
+    on elastic shafts; each half end's H2 contact in the frame of its sheave as :class:`ElasticChainACVT`'s (the
+    half offset ``sigma h_pin tau_p`` is formed from the mapped chords, in the sheave frame)."""
+
+    def _local_constants(self, ends) -> dict:
+        return {"sign": self.half_of(ends)}
+
+    def rigid(self) -> ChainA2CVT:
+        return ChainA2CVT(self.family, self.contact, self.J, self.m_sheave, self.regime, self.F_appl, self.control,
+                          self.movable_side, self.fixed_z, self.start_chain)
+
+
 def shaft_parameters(scene) -> tuple[ShaftParameters, ShaftParameters]:
     """The two shafts of a CVT scene's ``[cvt.driving]``, ``[cvt.driven]`` (movable sheaves on opposite sides)."""
     cvt = scene.cvt
@@ -657,7 +679,8 @@ def elastic(rigid: ChainCVT, structure: ShaftStructure) -> ElasticChainCVT:
     (``z_ref`` set by :meth:`ElasticChainCVT.static_state`)."""
     args = (rigid.family, rigid.contact, rigid.J, rigid.m_sheave, rigid.regime, rigid.F_appl, rigid.control)
     if isinstance(rigid, ChainACVT):
-        return ElasticChainACVT(*args, movable_side=rigid.movable_side, fixed_z=rigid.fixed_z,
+        cls = ElasticChainA2CVT if isinstance(rigid, ChainA2CVT) else ElasticChainACVT
+        return cls(*args, movable_side=rigid.movable_side, fixed_z=rigid.fixed_z,
                                 start_chain=rigid.start_chain, structure=structure, z_ref=np.zeros((2, 2)))
     return ElasticChainCVT(*args, structure=structure, z_ref=np.zeros((2, 2)))
 
