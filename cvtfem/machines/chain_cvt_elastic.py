@@ -63,15 +63,33 @@ class ElasticChainCVT(ChainCVT):
 
     Attributes (besides ChainCVT's; ``J`` and ``m_sheave`` are the structure's, kept for the loops)
     structure : ShaftStructure
-    z_ref : (2, 2) m
+    z_ref : (2, 2) m or None
         Reference position of each shaft's (fixed, movable) sheave face (the rigid model's at the quasi-static
-        start), counted outwards from the chain mid-plane.
+        start), counted outwards from the chain mid-plane; None: that of the rigid start at the regime's ratio and
+        driving speed at ``t = 0``, solved when first needed (:attr:`face_ref`), so that building the model for
+        its layout (``cvtfem describe``) solves no start.
     """
 
     structure: Any = None
     z_ref: np.ndarray = None
     #: ``(ratio, w1, x0, report)`` of the rigid model's quasi-static start that set ``z_ref`` (reused).
     rigid_start: tuple = None
+
+    @cached_property
+    def _reference(self) -> tuple:
+        """``(z_ref, rigid_start)``: the given ones, or those of the rigid start at the regime's start targets."""
+        if self.z_ref is not None:
+            return np.asarray(self.z_ref, float), self.rigid_start
+        rs = self.rigid_start
+        if rs is None:
+            w1, _, i = self.regime.targets(0.0)
+            rs = (i, w1) + tuple(self.rigid().static_state(i, w1))
+        return self._face_reference(rs[2]), rs
+
+    @property
+    def face_ref(self) -> np.ndarray:
+        """The faces' reference positions (2, 2) m the contacts use (``z_ref``, or the rigid start's)."""
+        return self._reference[0]
 
     # ----- layout ------------------------------------------------------------------------------
     @cached_property
@@ -180,7 +198,7 @@ class ElasticChainCVT(ChainCVT):
         Xd = dd - np.cross(th, dd) - np.cross(vth, d)
         X[:, 2] *= s
         Xd[:, 2] *= s
-        kin = np.column_stack([X, self.z_ref[k, j], Xd, np.zeros(len(Z)), Z[:, 18]])
+        kin = np.column_stack([X, self.face_ref[k, j], Xd, np.zeros(len(Z)), Z[:, 18]])
         out = self.contact.local(kin, k, details)
         Y, det = out if details else (out, None)
         if details:
@@ -432,20 +450,13 @@ class ElasticChainCVT(ChainCVT):
         clamping force and the chain's centrifugal forces; the spins and the driving movable sheave held (its
         clamping force is the reaction, ``report["F1"]``).  Returns ``(x0, report)`` as ChainCVT's, and
         ``report["model"]``: the model with ``z_ref`` set (use it for the run)."""
-        rs = self.rigid_start
+        rs = self.rigid_start if self.z_ref is not None else self._reference[1]
         if rs is not None and tension is None and (rs[0], rs[1]) == (ratio, w1):
             x0r, rep = rs[2], rs[3]
         else:
             x0r, rep = self.rigid().static_state(ratio, w1, tension, tol)
         model = replace(self, z_ref=self._face_reference(x0r), rigid_start=(ratio, w1, x0r, rep))
         return model._elastic_static(x0r, rep, w1, tol)
-
-    def referenced(self) -> "ElasticChainCVT":
-        """The model with the faces' reference positions ``z_ref`` of the rigid quasi-static start at the regime's
-        ratio and driving speed at ``t = 0`` (what :meth:`start` starts from)."""
-        w1, _, i = self.regime.targets(0.0)
-        x0r, rep = self.rigid().static_state(i, w1)
-        return replace(self, z_ref=self._face_reference(x0r), rigid_start=(i, w1, x0r, rep))
 
     def _face_reference(self, x0r) -> np.ndarray:
         """``z_ref`` (2, 2) from the rigid start ``x0r``: both faces of a pair at its ``z``."""
@@ -533,9 +544,9 @@ class ElasticChainCVT(ChainCVT):
     def start(self):
         w1, _, i = self.regime.targets(0.0)
         x0, rep = self.static_state(i, w1)
-        if not np.array_equal(rep["model"].z_ref, self.z_ref):
-            raise NumericalError("the model's face reference positions are not those of its start: build it with "
-                                 "`referenced()`", component="ElasticChainCVT.start")
+        if not np.array_equal(rep["model"].z_ref, self.face_ref):
+            raise NumericalError("the model's face reference positions z_ref are not those of its start: leave them "
+                                 "None (the rigid start's)", component="ElasticChainCVT.start")
         return x0, {"kind": f"quasi-static on elastic shafts (residual {rep['residual']:.1e} of F2, largest "
                             f"penetration {1e6 * rep['max_penetration']:.1f} um)", "model": rep["model"]}
 
@@ -618,7 +629,7 @@ class ElasticChainACVT(ElasticChainCVT, ChainACVT):
         dden = (g * t2, -g * t1, -g * sg2, g * sg1)                      # d(den)/d(sigma1, sigma2, theta1, theta2)
         for row, num, dnum in ((7, n1, (one, 0 * one, 0 * one, -s / e)), (8, n2, (0 * one, one, s / e, 0 * one))):
             dK[:, row, [7, 8, 12, 13]] = np.column_stack([(dn - num * dd / den) / den for dn, dd in zip(dnum, dden)])
-        K[:, 9] = self.z_ref[k, j]
+        K[:, 9] = self.face_ref[k, j]
         return K, dK
 
     def _mapped_pairs(self, q):
@@ -687,10 +698,10 @@ def elastic(rigid: ChainCVT, structure: ShaftStructure) -> ElasticChainCVT:
 
 def from_scene(scene, geom, F_appl, **overrides) -> ElasticChainCVT:
     """:func:`cvtfem.machines.chain_cvt.from_scene` on the scene's elastic shafts (its ``effects.gyroscopic``,
-    ``effects.damping``)."""
+    ``effects.damping``); the faces' references are the rigid start's, solved when first needed."""
     from cvtfem.machines.chain_cvt import from_scene as rigid_from_scene
 
     eff = scene.cvt.effects
     structure = build_structure(shaft_parameters(scene), scene.cvt.young_modulus, gyroscopic=eff.gyroscopic,
                                 damping=eff.damping)
-    return elastic(rigid_from_scene(scene, geom, F_appl, **overrides), structure).referenced()
+    return replace(elastic(rigid_from_scene(scene, geom, F_appl, **overrides), structure), z_ref=None)

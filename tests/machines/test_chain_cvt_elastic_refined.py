@@ -300,12 +300,11 @@ def test_stiff_shafts_converge_to_the_rigid_variant_a(scene, rigid, rigid_start)
 @pytest.mark.slow
 def test_cvtfem_run_variant_b_keeps_the_stationary_regime_and_balances_energy(cli, tmp_path):
     """`cvtfem run` of the variant-b preset (the stationary regime, Radau rtol 1e-3, tanh law; output every 10 us)
-    over 0.2 ms from the
-    quasi-static start: every output finite, the input speed within 1 % of 3500 rpm throughout, the speed ratio
-    starting at 2.4 and rising as the pins' creep builds up (2.46 at 0.2 ms: the ratio acceptance needs the loops'
-    settling, docs/transmission.md), the work integrals close the energy balance (input = output + losses + change of energy) to 1e-5 of
-    the input work, and over the second 0.1 ms the pins' axial forces on the movable sheaves balance the clamping
-    forces on average to 1 %."""
+    over 0.2 ms from the quasi-static start: every output finite, the input speed within 1 % of 3500 rpm throughout,
+    the speed ratio starting at 2.4 and rising as the pins' creep builds up (2.46 at 0.2 ms: the ratio acceptance
+    needs the loops' settling, docs/transmission.md), the work integrals close the energy balance (input = output +
+    losses + change of energy) to 1e-5 of the input work, and over the second 0.1 ms the pins' axial forces on the
+    movable sheaves balance the clamping forces on average to 1 %."""
     import json
 
     import h5py
