@@ -300,10 +300,10 @@ def test_stiff_shafts_converge_to_the_rigid_variant_a(scene, rigid, rigid_start)
 @pytest.mark.slow
 def test_cvtfem_run_variant_b_keeps_the_stationary_regime_and_balances_energy(cli, tmp_path):
     """`cvtfem run` of the variant-b preset (the stationary regime, Radau rtol 1e-3, tanh law; output every 10 us)
-    over 0.1 ms from the quasi-static start: every output finite, the input speed within 1 % of 3500 rpm throughout,
-    the speed ratio starting at 2.4 and rising in the start's transient (2.44 at 0.1 ms: the ratio acceptance
+    over 0.2 ms from the quasi-static start: every output finite, the input speed within 1 % of 3500 rpm throughout,
+    the speed ratio starting at 2.4 and rising in the start's transient (2.46 at 0.2 ms: the ratio acceptance
     needs the loops' settling, docs/transmission.md), the work integrals close the energy balance (input = output +
-    losses + change of energy) to 1e-5 of the input work, and over the second 50 us the pins' axial forces on the
+    losses + change of energy) to 1e-5 of the input work, and over the second 0.1 ms the pins' axial forces on the
     movable sheaves balance the clamping forces on average to 1 %."""
     import json
 
@@ -312,7 +312,7 @@ def test_cvtfem_run_variant_b_keeps_the_stationary_regime_and_balances_energy(cl
     scene = tmp_path / "variant-b.toml"
     scene.write_text('preset = "variant-b"\n[output]\nstep = 1e-5\n')
     h5, js = tmp_path / "b.h5", tmp_path / "s.json"
-    r = cli("run", str(scene), "--until", "1e-4", "--results", str(h5), "--summary-json", str(js), timeout=900)
+    r = cli("run", str(scene), "--until", "2e-4", "--results", str(h5), "--summary-json", str(js), timeout=900)
     assert r.returncode == 0, r.stderr
     assert json.loads(js.read_text())["n_coordinates"] == 950
     with h5py.File(h5) as f:
@@ -321,10 +321,10 @@ def test_cvtfem_run_variant_b_keeps_the_stationary_regime_and_balances_energy(cl
             assert np.isfinite(s[name][:]).all(), name
         t, W, E = s["time"][:], s["work"][-1], s["energy"][:]
         ratio, speed = s["ratio"][:], s["driving.speed"][:]
-        late = t >= 5e-5
+        late = t >= 1e-4
         axial = s["contact.sheave_axial_force"][late].mean(axis=0)
         F = np.array([s["driving.clamping_force"][late].mean(), s["driven.clamping_force"][late].mean()])
-    assert len(t) > 10 and t[-1] == pytest.approx(1e-4)
+    assert len(t) > 10 and t[-1] == pytest.approx(2e-4)
     assert np.abs(speed / (3500 * np.pi / 30) - 1).max() < 0.01
     assert ratio[0] == pytest.approx(2.4, rel=1e-9) and np.all(np.diff(ratio[:, 0]) > 0)   # the start's transient
     assert W[0] > 1.0 and abs(W[0] - W[1] - W[2] + W[3] - (E[-1] - E[0])) < 1e-5 * W[0]
