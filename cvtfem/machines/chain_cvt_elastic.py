@@ -1,7 +1,8 @@
-"""The symmetric chain (S2, S3) on elastic shafts: :class:`ElasticChainCVT`, the transmission of
+"""Chains on elastic shafts: the symmetric chain (S2, S3) as :class:`ElasticChainCVT`, the transmission of
 :class:`~cvtfem.machines.chain_cvt.ChainCVT` with the rigid shafts of model 1 replaced by the structure block
 of :mod:`~cvtfem.machines.shaft_structure` (beam FE shafts, rigid sheaves, linear bearings; Table 1.1 (b)'s
-structure).
+structure); the whole-pin chains as :class:`ElasticChainACVT` (A1 with H1, or with the refined contact H2:
+variant (b)) and :class:`ElasticChainA2CVT` (A2's coupled halves with H2: variant (v)).
 
 State ``x = [q_chain, q_structure, velocities, control states, W]``.  Each pin end touches each of the two
 sheaves of a shaft: the end at ``x = (u1, u2, s u3)`` on the sheave on side ``s`` (the mirror end of the
@@ -22,8 +23,8 @@ energy added and its bearing damping dissipating.  The clamping force ``F_k`` ac
 sheave (``zeta_k``) and its node; the torques act on the fixed sheave's node, whose spin rate the loops read.
 
 Jacobian: the chain family's blocks, the structure's ``-K``, ``-(C + Omega G)`` and ``-G v`` on the spin
-rates, per-contact central differences of the mapped kernel (19 inputs, 11 outputs, all contacts at once)
-scattered on both sides, and the loops' forward differences, as in ChainCVT.
+rates, per-contact central differences of the mapped kernel (H1: 19 inputs, 11 outputs; H2: 31, 17; all contacts
+at once) scattered on both sides, and the loops' forward differences, as in ChainCVT.
 """
 from __future__ import annotations
 
