@@ -1,7 +1,8 @@
-"""The symmetric chain (S2, S3) on elastic shafts: :class:`ElasticChainCVT`, the transmission of
+"""Chains on elastic shafts: the symmetric chain (S2, S3) as :class:`ElasticChainCVT`, the transmission of
 :class:`~cvtfem.machines.chain_cvt.ChainCVT` with the rigid shafts of model 1 replaced by the structure block
 of :mod:`~cvtfem.machines.shaft_structure` (beam FE shafts, rigid sheaves, linear bearings; Table 1.1 (b)'s
-structure).
+structure); the whole-pin chains as :class:`ElasticChainACVT` (A1 with H1, or with the refined contact H2:
+variant (b)) and :class:`ElasticChainA2CVT` (A2's coupled halves with H2: variant (v)).
 
 State ``x = [q_chain, q_structure, velocities, control states, W]``.  Each pin end touches each of the two
 sheaves of a shaft: the end at ``x = (u1, u2, s u3)`` on the sheave on side ``s`` (the mirror end of the
@@ -22,8 +23,8 @@ energy added and its bearing damping dissipating.  The clamping force ``F_k`` ac
 sheave (``zeta_k``) and its node; the torques act on the fixed sheave's node, whose spin rate the loops read.
 
 Jacobian: the chain family's blocks, the structure's ``-K``, ``-(C + Omega G)`` and ``-G v`` on the spin
-rates, per-contact central differences of the mapped kernel (19 inputs, 11 outputs, all contacts at once)
-scattered on both sides, and the loops' forward differences, as in ChainCVT.
+rates, per-contact central differences of the mapped kernel (H1: 19 inputs, 11 outputs; H2: 31, 17; all contacts
+at once) scattered on both sides, and the loops' forward differences, as in ChainCVT.
 """
 from __future__ import annotations
 
@@ -39,18 +40,17 @@ from scipy.optimize import least_squares
 from cvtfem.assembly.model import StateLayout
 from cvtfem.elements.base import Block
 from cvtfem.elements.chain.sheave_contact import central_local_jacobian
+from cvtfem.elements.chain.symmetric import END_SLOPE_FACTOR
 from cvtfem.errors import NumericalError
+from cvtfem.machines.chain_a2_cvt import ChainA2CVT
 from cvtfem.machines.chain_a_cvt import ChainACVT
 from cvtfem.machines.chain_cvt import ChainCVT
 from cvtfem.machines.shaft_structure import ShaftParameters, ShaftStructure, build_structure
 from cvtfem.outputs import OutputSpec
 
-#: Inputs of a mapped contact: pin end (3), sheave translation (3) and tilt (2), the other sheave's axial
-#: position (1), their rates (9), the spin rate.
-N_MAPPED_IN = 19
-#: Outputs: forces on those 9 positions and on the spin; the friction power.
-N_MAPPED_OUT = 11
-_STEPS = np.array([1e-9] * 9 + [1e-6] * 9 + [1e-5])
+
+#: Chain positions of an H2 contact (ChainACVT's map without ``z``): pins ``p-1, p, p+1`` (2 each), ``x3``, slope (2).
+N_REFINED_CHAIN = 9
 
 
 def _tilt(th):
@@ -64,15 +64,33 @@ class ElasticChainCVT(ChainCVT):
 
     Attributes (besides ChainCVT's; ``J`` and ``m_sheave`` are the structure's, kept for the loops)
     structure : ShaftStructure
-    z_ref : (2, 2) m
+    z_ref : (2, 2) m or None
         Reference position of each shaft's (fixed, movable) sheave face (the rigid model's at the quasi-static
-        start), counted outwards from the chain mid-plane.
+        start), counted outwards from the chain mid-plane; None: that of the rigid start at the regime's ratio and
+        driving speed at ``t = 0``, solved when first needed (:attr:`face_ref`), so that building the model for
+        its layout (``cvtfem describe``) solves no start.
     """
 
     structure: Any = None
     z_ref: np.ndarray = None
     #: ``(ratio, w1, x0, report)`` of the rigid model's quasi-static start that set ``z_ref`` (reused).
     rigid_start: tuple = None
+
+    @cached_property
+    def _reference(self) -> tuple:
+        """``(z_ref, rigid_start)``: the given ones, or those of the rigid start at the regime's start targets."""
+        if self.z_ref is not None:
+            return np.asarray(self.z_ref, float), self.rigid_start
+        rs = self.rigid_start
+        if rs is None:
+            w1, _, i = self.regime.targets(0.0)
+            rs = (i, w1) + tuple(self.rigid().static_state(i, w1))
+        return self._face_reference(rs[2]), rs
+
+    @property
+    def face_ref(self) -> np.ndarray:
+        """The faces' reference positions (2, 2) m the contacts use (``z_ref``, or the rigid start's)."""
+        return self._reference[0]
 
     # ----- layout ------------------------------------------------------------------------------
     @cached_property
@@ -141,26 +159,27 @@ class ElasticChainCVT(ChainCVT):
         return (e, k, j) + self._mapped_map(dof3[:, :, None], np.ones(dof3.shape + (1,)), k, j)
 
     def _mapped_map(self, end_cols, end_coef, k, j):
-        """The mapped inputs' ``(cols, coef)`` (m, 19, K) from the pin-end position's (m, 3, K) in the mirrored
-        frame of its sheave (``x3 -> s x3``) and the sheave's structure columns."""
+        """The mapped inputs' ``(cols, coef)`` (m, 2 (P + 6) + 1, K) from the chain positions' (m, P, K) in the
+        mirrored frame of the sheave (``x3 -> s x3``; H1: the pin end, P = 3; H2: the kernel's nine) and the
+        sheave's structure columns: positions, their rates, the spin rate."""
         nc, n2 = self._idx[0], self.n2
         sd = nc + self.structure.sheave_dofs[k, j]                 # (m, 6)
         other = nc + self.structure.sheave_dofs[k, 1 - j, 2]
         own = np.column_stack([sd[:, :5], other])                  # (m, 6)
-        m, K = len(k), end_cols.shape[2]
-        cols = np.zeros((m, N_MAPPED_IN, K), np.int64)
-        coef = np.zeros((m, N_MAPPED_IN, K))
-        for off in (0, 9):
-            cols[:, off:off + 3] = end_cols + (n2 if off else 0)
-            coef[:, off:off + 3] = end_coef
-            cols[:, off + 3:off + 9, 0] = own + (n2 if off else 0)
-            coef[:, off + 3:off + 9, 0] = 1.0
-        cols[:, 18, 0] = n2 + sd[:, 5]
-        coef[:, 18, 0] = 1.0
+        (m, P, K), n_pos = end_cols.shape, end_cols.shape[1] + 6
+        cols = np.zeros((m, 2 * n_pos + 1, K), np.int64)
+        coef = np.zeros((m, 2 * n_pos + 1, K))
+        for off in (0, n_pos):
+            cols[:, off:off + P] = end_cols + (n2 if off else 0)
+            coef[:, off:off + P] = end_coef
+            cols[:, off + P:off + n_pos, 0] = own + (n2 if off else 0)
+            coef[:, off + P:off + n_pos, 0] = 1.0
+        cols[:, -1, 0] = n2 + sd[:, 5]
+        coef[:, -1, 0] = 1.0
         return cols, coef
 
     def mapped_local(self, Z, k, j, details: bool = False):
-        """Outputs (m, 11) of mapped contacts with inputs ``Z`` (m, 19, :data:`N_MAPPED_IN`) on shafts ``k``, sheaves
+        """Outputs (m, 11) of mapped H1 contacts with inputs ``Z`` (m, 19) on shafts ``k``, sheaves
         ``j``: generalized forces on the pin-end coordinates (3), the sheave's translation (3) and tilt (2), the other
         sheave's axial position (1) and the spin (1), and the friction power (W); with ``details`` also the kernel's
         per-contact dict (for one end and one sheave) with the mapped position ``X`` (kernel frame), tilt, side."""
@@ -180,7 +199,7 @@ class ElasticChainCVT(ChainCVT):
         Xd = dd - np.cross(th, dd) - np.cross(vth, d)
         X[:, 2] *= s
         Xd[:, 2] *= s
-        kin = np.column_stack([X, self.z_ref[k, j], Xd, np.zeros(len(Z)), Z[:, 18]])
+        kin = np.column_stack([X, self.face_ref[k, j], Xd, np.zeros(len(Z)), Z[:, 18]])
         out = self.contact.local(kin, k, details)
         Y, det = out if details else (out, None)
         if details:
@@ -199,10 +218,14 @@ class ElasticChainCVT(ChainCVT):
         res = np.column_stack([Qpin, Qa, -np.cross(d, F)[:, :2], Qo, share * Y[:, 4], share * Y[:, 5]])
         return (res, det) if details else res
 
+    def _local_constants(self, ends) -> dict:
+        """Per-contact constants :meth:`mapped_local` takes besides its inputs (none; A2: the half signs)."""
+        return {}
+
     def _mapped_set(self, q, v, details: bool = False):
         e, k, j, cols, coef = self._mapped_pairs(q)
         Z = (coef * np.concatenate([q, v])[cols]).sum(axis=2)
-        return e, k, j, cols, coef, Z, self.mapped_local(Z, k, j, details)
+        return e, k, j, cols, coef, Z, self.mapped_local(Z, k, j, details, **self._local_constants(e))
 
     def _contacts(self, q, v, details=False):
         e, k, j, cols, coef, Z, Y = self._mapped_set(q, v, details)
@@ -229,7 +252,7 @@ class ElasticChainCVT(ChainCVT):
         side = self._sides[:, 1]
         Q[iz] -= side * F
         Q[self._movable_node_u3] += side * F
-        Pf = float(Y[:, 10].sum())
+        Pf = float(Y[:, -1].sum())
         return (Q, Pf, mean_slip) if slip else (Q, Pf)
 
     @cached_property
@@ -263,7 +286,10 @@ class ElasticChainCVT(ChainCVT):
     def _mapped_jacobian(self, q, v):
         """``(cols, coef, Jl)``: the contact map and the local Jacobians (m, 11, 19) of the mapped contacts."""
         e, k, j, cols, coef, Z, _ = self._mapped_set(q, v)
-        Jl = central_local_jacobian(lambda Zp, kk: self.mapped_local(Zp, kk, j), Z, k, _STEPS, N_MAPPED_OUT)
+        n_pos = (Z.shape[1] - 1) // 2
+        steps = np.concatenate([np.full(n_pos, 1e-9), np.full(n_pos, 1e-6), [1e-5]])
+        const = self._local_constants(e)
+        Jl = central_local_jacobian(lambda Zp, kk: self.mapped_local(Zp, kk, j, **const), Z, k, steps, n_pos + 2)
         return cols, coef, Jl
 
     @cached_property
@@ -326,7 +352,7 @@ class ElasticChainCVT(ChainCVT):
         P = sp.csr_matrix(self.family.jac_sparsity, dtype=float).tocoo()
         rows, cols = [P.row, P.row], [P.col, P.col + n2]
         mc, mw = self._all_mapped()
-        r, c, _ = self._contact_entries(mc, mw, np.ones((len(mc), N_MAPPED_OUT, N_MAPPED_IN)))
+        r, c, _ = self._contact_entries(mc, mw, np.ones((len(mc), (mc.shape[1] + 3) // 2, mc.shape[1])))
         rows.append(r)
         cols.append(c)
         S = (abs(self.structure.K) + abs(self.structure.C) + abs(self.structure.G[0]) + abs(self.structure.G[1]))
@@ -398,7 +424,7 @@ class ElasticChainCVT(ChainCVT):
                     "contact.radius": per(np.where(on, c["radius"], 0.0)),
                     "contact.slip_speed": per(np.where(on, np.linalg.norm(c["slip"], axis=1), 0.0)),
                     "contact.friction_force": per(c["F_fr"], 3),
-                    "contact.friction_power": np.bincount(k, Y[:, 10], 2),
+                    "contact.friction_power": np.bincount(k, Y[:, -1], 2),
                     **self._axial_outputs(k, j, c),
                     "driving.speed": w[0], "driven.speed": w[1], "driving.torque": M[0], "driven.torque": M[1],
                     "driving.clamping_force": F[0], "driven.clamping_force": F[1],
@@ -425,20 +451,13 @@ class ElasticChainCVT(ChainCVT):
         clamping force and the chain's centrifugal forces; the spins and the driving movable sheave held (its
         clamping force is the reaction, ``report["F1"]``).  Returns ``(x0, report)`` as ChainCVT's, and
         ``report["model"]``: the model with ``z_ref`` set (use it for the run)."""
-        rs = self.rigid_start
+        rs = self.rigid_start if self.z_ref is not None else self._reference[1]
         if rs is not None and tension is None and (rs[0], rs[1]) == (ratio, w1):
             x0r, rep = rs[2], rs[3]
         else:
             x0r, rep = self.rigid().static_state(ratio, w1, tension, tol)
         model = replace(self, z_ref=self._face_reference(x0r), rigid_start=(ratio, w1, x0r, rep))
         return model._elastic_static(x0r, rep, w1, tol)
-
-    def referenced(self) -> "ElasticChainCVT":
-        """The model with the faces' reference positions ``z_ref`` of the rigid quasi-static start at the regime's
-        ratio and driving speed at ``t = 0`` (what :meth:`start` starts from)."""
-        w1, _, i = self.regime.targets(0.0)
-        x0r, rep = self.rigid().static_state(i, w1)
-        return replace(self, z_ref=self._face_reference(x0r), rigid_start=(i, w1, x0r, rep))
 
     def _face_reference(self, x0r) -> np.ndarray:
         """``z_ref`` (2, 2) from the rigid start ``x0r``: both faces of a pair at its ``z``."""
@@ -526,9 +545,9 @@ class ElasticChainCVT(ChainCVT):
     def start(self):
         w1, _, i = self.regime.targets(0.0)
         x0, rep = self.static_state(i, w1)
-        if not np.array_equal(rep["model"].z_ref, self.z_ref):
-            raise NumericalError("the model's face reference positions are not those of its start: build it with "
-                                 "`referenced()`", component="ElasticChainCVT.start")
+        if not np.array_equal(rep["model"].z_ref, self.face_ref):
+            raise NumericalError("the model's face reference positions z_ref are not those of its start: leave them "
+                                 "None (the rigid start's)", component="ElasticChainCVT.start")
         return x0, {"kind": f"quasi-static on elastic shafts (residual {rep['residual']:.1e} of F2, largest "
                             f"penetration {1e6 * rep['max_penetration']:.1f} um)", "model": rep["model"]}
 
@@ -553,7 +572,66 @@ class ElasticChainACVT(ElasticChainCVT, ChainACVT):
     def _pairs_map(self, ends, shafts):
         j = self._sheave_of(ends, shafts)
         cols, coef = ChainACVT._contact_map(self, ends, shafts)
-        return (ends, shafts, j) + self._mapped_map(cols[:, :3], coef[:, :3], shafts, j)
+        n_chain = N_REFINED_CHAIN if self.contact.refined else 3        # the kernel's chain positions (no z)
+        return (ends, shafts, j) + self._mapped_map(cols[:, :n_chain], coef[:, :n_chain], shafts, j)
+
+    def mapped_local(self, Z, k, j, details: bool = False, sign=None):
+        """H1: :meth:`ElasticChainCVT.mapped_local`.  H2 (variant (b)): outputs (m, 17) of the mapped contacts with
+        inputs ``Z`` (m, 31): the generalized forces on the kernel's nine chain positions (mirrored frame), the
+        sheave's translation (3), tilt (2), the other sheave's axial position (1, unused: absolute axial motion),
+        on the spin, and the friction power (W); ``details`` as there.  ``sign`` (m,): the half signs of A2's
+        coupled-halves kernel (variant (v)), an input of it before the spin rate."""
+        if not self.contact.refined:
+            return super().mapped_local(Z, k, j, details)
+        n = N_REFINED_CHAIN + 6
+        P, V = Z[:, :n], Z[:, n:2 * n]
+        K, dK = self._refined_frame(P, k, j)
+        extra = [] if sign is None else [sign]
+        kin = np.column_stack([K, np.einsum("mij,mj->mi", dK, V)] + extra + [Z[:, -1]])
+        out = self.contact.local(kin, k, details)
+        Y, det = out if details else (out, None)
+        Q = np.einsum("mij,mi->mj", dK[:, :N_REFINED_CHAIN], Y[:, :N_REFINED_CHAIN])   # z_ref is a constant
+        res = np.column_stack([Q, Y[:, -2], Y[:, -1]])
+        if not details:
+            return res
+        return res, dict(det, X=K[:, [2, 3, 6]], tilt=_tilt(P[:, 12:14]), side=self._sides[k, j].astype(float))
+
+    def _refined_frame(self, P, k, j):
+        """``(K, dK/dP)``: the H2 kernel's position inputs (m, 10) in the frame of the displaced, tilted sheave ``j``
+        of shaft ``k`` and their derivative (m, 10, 15) in the mapped positions ``P`` (m, 15): pins ``p-1, p, p+1``
+        at the end's offset (2 each), the end's ``x3``, its slope coordinates (2), all mirrored (``x3 -> s x3``), then
+        the sheave's translation ``a`` (3), tilt (2) and the other sheave's axial position.  Every point goes
+        through ``X = o + (I - theta x)(x - o - a)`` at the end's ``x3`` (the end's own ``X_3`` is the kernel's
+        ``x3``); the end slope, the direction ``(gamma, 1)`` (true frame), through the same ``I - theta x``:
+        ``gamma' = (gamma_1 - theta_2, gamma_2 + theta_1) / (1 + theta_2 gamma_1 - theta_1 gamma_2)``; the face stays
+        at its reference ``z_ref``.  ``dK/dP`` is exact, so the rates are ``K' = dK/dP P'``."""
+        m = len(P)
+        s = self._sides[k, j].astype(float)
+        c, o3 = self.contact.centres[k], self.structure.sheave_x3[k, j]
+        a, t1, t2 = P[:, 9:12], P[:, 12], P[:, 13]
+        d3 = s * P[:, 6] - o3 - a[:, 2]
+        K, dK = np.zeros((m, 10)), np.zeros((m, 10, 15))
+        one = np.ones(m)
+        for i in range(3):
+            d1, d2 = P[:, 2 * i] - c[:, 0] - a[:, 0], P[:, 2 * i + 1] - c[:, 1] - a[:, 1]
+            K[:, 2 * i] = c[:, 0] + d1 - t2 * d3
+            K[:, 2 * i + 1] = c[:, 1] + d2 + t1 * d3
+            dK[:, 2 * i, [2 * i, 6, 9, 11, 13]] = np.column_stack([one, -s * t2, -one, t2, -d3])
+            dK[:, 2 * i + 1, [2 * i + 1, 6, 10, 11, 12]] = np.column_stack([one, s * t1, -one, -t1, d3])
+            if i == 1:                                                  # the end itself: its axial position
+                K[:, 6] = s * (o3 + d3 - t1 * d2 + t2 * d1)
+                dK[:, 6, [2, 3, 6, 9, 10, 11, 12, 13]] = s[:, None] * np.column_stack(
+                    [t2, -t1, s, -t2, t1, -one, -d2, d1])
+        e, g = END_SLOPE_FACTOR, s * END_SLOPE_FACTOR                  # slope coordinates: gamma_true = g sigma
+        sg1, sg2 = P[:, 7], P[:, 8]
+        n1, n2 = sg1 - s * t2 / e, sg2 + s * t1 / e
+        den = 1.0 + g * (t2 * sg1 - t1 * sg2)
+        K[:, 7], K[:, 8] = n1 / den, n2 / den
+        dden = (g * t2, -g * t1, -g * sg2, g * sg1)                      # d(den)/d(sigma1, sigma2, theta1, theta2)
+        for row, num, dnum in ((7, n1, (one, 0 * one, 0 * one, -s / e)), (8, n2, (0 * one, one, s / e, 0 * one))):
+            dK[:, row, [7, 8, 12, 13]] = np.column_stack([(dn - num * dd / den) / den for dn, dd in zip(dnum, dden)])
+        K[:, 9] = self.face_ref[k, j]
+        return K, dK
 
     def _mapped_pairs(self, q):
         return self._pairs_map(*self._candidates(q))
@@ -585,6 +663,20 @@ class ElasticChainACVT(ElasticChainCVT, ChainACVT):
             ChainACVT._turn_with_sheave(self, q[:nc], v[:nc], pins, v[iphi[kk]], centre)
 
 
+@dataclass(frozen=True, eq=False)
+class ElasticChainA2CVT(ElasticChainACVT, ChainA2CVT):
+    """Variant (v): the whole-pin chain with coupled pin halves (A2, :class:`~cvtfem.machines.chain_a2_cvt.ChainA2CVT`)
+    on elastic shafts; each half end's H2 contact in the frame of its sheave as :class:`ElasticChainACVT`'s (the
+    half offset ``sigma h_pin tau_p`` is formed from the mapped chords, in the sheave frame)."""
+
+    def _local_constants(self, ends) -> dict:
+        return {"sign": self.half_of(ends)}
+
+    def rigid(self) -> ChainA2CVT:
+        return ChainA2CVT(self.family, self.contact, self.J, self.m_sheave, self.regime, self.F_appl, self.control,
+                          self.movable_side, self.fixed_z, self.start_chain)
+
+
 def shaft_parameters(scene) -> tuple[ShaftParameters, ShaftParameters]:
     """The two shafts of a CVT scene's ``[cvt.driving]``, ``[cvt.driven]`` (movable sheaves on opposite sides)."""
     cvt = scene.cvt
@@ -599,17 +691,18 @@ def elastic(rigid: ChainCVT, structure: ShaftStructure) -> ElasticChainCVT:
     (``z_ref`` set by :meth:`ElasticChainCVT.static_state`)."""
     args = (rigid.family, rigid.contact, rigid.J, rigid.m_sheave, rigid.regime, rigid.F_appl, rigid.control)
     if isinstance(rigid, ChainACVT):
-        return ElasticChainACVT(*args, movable_side=rigid.movable_side, fixed_z=rigid.fixed_z,
+        cls = ElasticChainA2CVT if isinstance(rigid, ChainA2CVT) else ElasticChainACVT
+        return cls(*args, movable_side=rigid.movable_side, fixed_z=rigid.fixed_z,
                                 start_chain=rigid.start_chain, structure=structure, z_ref=np.zeros((2, 2)))
     return ElasticChainCVT(*args, structure=structure, z_ref=np.zeros((2, 2)))
 
 
 def from_scene(scene, geom, F_appl, **overrides) -> ElasticChainCVT:
     """:func:`cvtfem.machines.chain_cvt.from_scene` on the scene's elastic shafts (its ``effects.gyroscopic``,
-    ``effects.damping``)."""
+    ``effects.damping``); the faces' references are the rigid start's, solved when first needed."""
     from cvtfem.machines.chain_cvt import from_scene as rigid_from_scene
 
     eff = scene.cvt.effects
     structure = build_structure(shaft_parameters(scene), scene.cvt.young_modulus, gyroscopic=eff.gyroscopic,
                                 damping=eff.damping)
-    return elastic(rigid_from_scene(scene, geom, F_appl, **overrides), structure).referenced()
+    return replace(elastic(rigid_from_scene(scene, geom, F_appl, **overrides), structure), z_ref=None)
