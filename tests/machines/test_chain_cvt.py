@@ -126,7 +126,7 @@ def test_energy_balance_over_a_short_run(model, static):
 def test_stationary_regime_against_the_band_model(scene):
     """Acceptance of issue 13: 3500 rpm, 200 N m, ratio 2.4, the chain from its quasi-static state with the
     band model's stationary clamping forces, 10 ms (means over the last 6 ms, every 25 us)."""
-    F, T_band = band_reference(scene)
+    F, T_band, _ = band_reference(scene)
     m = from_scene(scene, reference_geometry(), F)
     x0, rep = m.static_state(RATIO, scene.cvt.regime.input_speed)
     T, axial, clamp = stationary_means(m, x0)

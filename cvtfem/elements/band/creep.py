@@ -24,7 +24,8 @@ import numpy as np
 from scipy.integrate import solve_ivp
 from scipy.optimize import root
 
-from cvtfem.elements.contact.friction import friction_coefficient
+from cvtfem.elements.band.geometry import radii
+from cvtfem.elements.contact.friction import friction_coefficient, friction_vector
 from cvtfem.errors import InputError, NumericalError
 
 
@@ -79,3 +80,29 @@ def creep_arc(r: float, tan_gamma: float, wrap: float, v: float, rho: float, F: 
     w_theta = slip(T, T_in, w_in)
     return {"T": np.array([T[-1], T_in]), "slip": w_theta[[0, -1]], "theta": theta, "T_theta": T,
             "f_theta": friction_coefficient(np.abs(w_theta), f0, v0, law)}
+
+
+def driven_arc(band, q, v) -> dict:
+    """The driven arc of the 6+2n band ``band`` (:class:`~cvtfem.elements.band.compressible.CompressibleBand`) at
+    ``(q, v)``: ``args``, the arguments of :func:`creep_arc` (``r``, ``tan_gamma``, ``wrap``, ``v``, ``rho``, the
+    sheave's axial force ``F`` = the clamping force in steady running, the friction law, and the tension gain ``D`` of
+    the arc's momentum balance) and, for comparison, at the band's nodes ``theta`` rad from the arc's entry the tension
+    ``T_theta = rho v^2 + 2 r N sin(gamma)`` N and the tangential friction coefficient ``f_theta``; ``T`` (tight,
+    slack) N from the momentum balance of the whole arc (steady running: the span tensions less ``rho v^2`` pulling
+    at the tangents balance the in-plane resultant of the contact forces)."""
+    p = band.p
+    g = band.arcs(q[0])
+    _, N, vr = band._friction(q, v, g, band.strain(q, g))
+    ft = friction_vector(vr, p.f0, p.v0, p.law, axis=0)[:, 1]   # f t (radial, tangential, axial) at the nodes
+    tg, half, th, ds = g["tg"][1], g["ts"][1], g["th"][1], g["ds"][1]
+    sg = tg / np.hypot(1.0, tg)
+    rv2 = p.rho * v[1] ** 2
+    c_r, c_t = 2 * N[1] * (sg - ft[0]), -2 * N[1] * ft[1]       # in-plane force on the band per length, N/m
+    along = np.sum((c_r * np.cos(th) - c_t * np.sin(th)) * ds)  # resultant along the arc's axis and across it
+    across = np.sum((c_r * np.sin(th) + c_t * np.cos(th)) * ds)
+    total, gain = along / np.sin(half) + 2 * rv2, -across / np.cos(half)
+    r = radii(q[0], p.length, p.L)[0][1]
+    args = {"r": r, "tan_gamma": tg, "wrap": 2 * half, "v": v[1], "rho": p.rho, "F": np.sum(N[1] * sg / tg * ds),
+            "D": gain, "f0": p.f0, "v0": p.v0, "law": p.law}
+    return {"args": args, "T": np.array([total + gain, total - gain]) / 2, "theta": th + half,
+            "T_theta": rv2 + 2 * r * N[1] * sg, "f_theta": ft[1]}
