@@ -2,7 +2,7 @@
 
 Run:  .venv/bin/python studies/chain/slack_span.py [--model chain-S1] [--t-end 0.08] [--window 0.005]
       [--link-factor 1] [--method rock4] [--rtol 1e-4] [--states out/studies/chain/slack_span_S1.npz]
-      [--band-cache out/studies/chain/band_6+2n_1s.npy] [--png FILE]
+      [--band-cache out/studies/chain/band_6+2n_1s.npy] [--v0 V] [--open-loop] [--png FILE]
 1. The band-6+2n preset runs 1 s into its stationary regime (3500 rpm, 200 N m, ratio 2.4): clamping forces, span
    tensions by the radial balance at the arc ends (the issue's reference, ``band_span_tensions``) and, as a check of
    that reading, by the momentum balance of the whole driven arc (its contact forces' resultant); the friction
@@ -38,11 +38,19 @@ from cvtfem.scene.loader import load_scene
 BIN = np.radians(6.0)      # angular bins along the driven arc, rad (about one pitch at r2 = 88 mm)
 
 
-def band_reference(cache=""):
+def band_scene(v0=None, open_loop=False):
+    """The band-6+2n preset, with the friction law's saturation speed ``v0`` (m/s) and without the loops if asked."""
+    scene = load_scene("band-6+2n")
+    if v0 is not None:
+        scene = scene.replace({"cvt": {"friction": {"v0": v0}}})
+    return scene.replace({"cvt": {"effects": {"stabilisation": False}}}) if open_loop else scene
+
+
+def band_reference(cache="", v0=None):
     """The band-6+2n preset after 1 s (its state read from / written to ``cache``): a dict with the clamping forces
     ``F`` (2,) N, the span tensions ``T_end`` (tight, slack) of ``band_span_tensions`` and the driven arc ``arc``
     (:func:`~cvtfem.elements.band.creep.driven_arc`)."""
-    band = build_model(load_scene("band-6+2n"))
+    band = build_model(band_scene(v0))
     if cache and os.path.exists(cache):
         x = np.load(cache)
     else:
@@ -58,13 +66,13 @@ def band_reference(cache=""):
             "T_end": band_span_tensions(band, x), "arc": driven_arc(band.model, q, v)}
 
 
-def chain_model(model, F, link_factor=1.0):
-    """The chain ``model`` on the sheaves with the band scene's values and clamping forces ``F`` (2,) N; link
-    stiffness times ``link_factor``."""
+def chain_model(model, F, link_factor=1.0, v0=None, open_loop=False):
+    """The chain ``model`` on the sheaves with the band scene's values (:func:`band_scene`) and clamping forces ``F``
+    (2,) N; link stiffness times ``link_factor``."""
     geom = reference_geometry()
     geom = replace(geom, c_plate=geom.c_plate * link_factor)
     contact = "rigid" if model == "chain-S1" else "hertz"
-    return from_scene(load_scene("band-6+2n"), geom, F, model=model, contact=contact)
+    return from_scene(band_scene(v0, open_loop), geom, F, model=model, contact=contact)
 
 
 def chain_run(m, t_end, method, rtol, path):
@@ -179,15 +187,17 @@ def main() -> None:
     ap.add_argument("--rtol", type=float, default=1e-4)
     ap.add_argument("--states", default="")
     ap.add_argument("--band-cache", default="", help="the band's state after 1 s (.npy), written or read")
+    ap.add_argument("--v0", type=float, default=None, help="saturation speed of the friction law, m/s (both models)")
+    ap.add_argument("--open-loop", action="store_true", help="the chain without loops: the band's forces held")
     ap.add_argument("--png", default="")
     a = ap.parse_args()
     print(f"machine: {machine()}")
-    band = band_reference(a.band_cache)
+    band = band_reference(a.band_cache, a.v0)
     Te, Ta, args = band["T_end"], band["arc"]["T"], band["arc"]["args"]
     print(f"band 6+2n: F1 {band['F'][0]:.0f} N, F2 {band['F'][1]:.0f} N; spans tight/slack {Te[0]:.0f} / {Te[1]:.0f} N "
           f"(arc ends), {Ta[0]:.0f} / {Ta[1]:.0f} N (driven arc's momentum balance); tangential friction "
           f"coefficient on the driven arc {band['arc']['f_theta'].min():.4f}..{band['arc']['f_theta'].max():.4f}")
-    m = chain_model(a.model, band["F"], a.link_factor)
+    m = chain_model(a.model, band["F"], a.link_factor, a.v0, a.open_loop)
     geom = m.family.geom
     EA, c_p = float(geom.c_link[0] * geom.L[0]), float(geom.c_pin[0])
     c_h = np.inf if a.model == "chain-S1" else float(m.contact.c[1])
@@ -201,6 +211,7 @@ def main() -> None:
     t, Y = chain_run(m, a.t_end, a.method, a.rtol, a.states)
     trend = window_means(m, t, Y, a.window)
     label = a.model + (f" (links x{a.link_factor:g})" if a.link_factor != 1 else "")
+    label += " (loops off)" if a.open_loop else ""
     print(f"{label}: span tensions over successive windows (deviation from the band's arc-end values)")
     for s, tt, ts, F1, ratio in trend:
         print(f"  {s * 1e3:5.1f}-{(s + a.window) * 1e3:5.1f} ms: tight {tt:6.0f} N ({tt / Te[0] - 1:+.2%}), slack "
