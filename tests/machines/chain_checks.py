@@ -49,8 +49,10 @@ def perturbed(model, x0, seed: int = 0, scale=None):
 
 
 def band_reference(scene):
-    """The 6+2n band model of ``scene`` run 1 s into its stationary regime: the clamping forces (2,) N it settles at
-    and its tight and slack span tensions (2,) N (:func:`~cvtfem.machines.chain_cvt.band_span_tensions`)."""
+    """The 6+2n band model of ``scene`` run 1 s into its stationary regime: the clamping forces (2,) N it settles at,
+    its tight and slack span tensions (2,) N (:func:`~cvtfem.machines.chain_cvt.band_span_tensions`) and its driven
+    arc (:func:`~cvtfem.elements.band.creep.driven_arc`)."""
+    from cvtfem.elements.band.creep import driven_arc
     from cvtfem.machines import build_model
     from cvtfem.machines.chain_cvt import band_span_tensions
 
@@ -59,13 +61,15 @@ def band_reference(scene):
                jac=band.jac, jac_sparsity=band.jac_sparsity)
     xb = rb.y[:, -1]
     ob = band.outputs(1.0, xb)
-    return np.array([ob["driving.clamping_force"], ob["driven.clamping_force"]]), band_span_tensions(band, xb)
+    q, v, _, _ = band.split(xb)
+    return (np.array([ob["driving.clamping_force"], ob["driven.clamping_force"]]), band_span_tensions(band, xb),
+            driven_arc(band.model, q, v))
 
 
-def stationary_means(model, x0, t_end: float = 10e-3, window: float = 6e-3):
-    """Means over the last ``window`` s of a Radau run (rtol 1e-3) to ``t_end`` sampled every 25 us: span tensions
-    (tight, slack), sheave axial forces and clamping forces (driving, driven), N."""
-    res = solve(model, (0.0, t_end), x0, method="Radau", rtol=1e-3, atol=1e-6, n2=model.n2, jac=model.jac,
+def stationary_means(model, x0, t_end: float = 10e-3, window: float = 6e-3, method: str = "Radau", rtol: float = 1e-3):
+    """Means over the last ``window`` s of a run (``method``, ``rtol``, atol ``1e-3 rtol``) to ``t_end`` sampled every
+    25 us: span tensions (tight, slack), sheave axial forces and clamping forces (driving, driven), N."""
+    res = solve(model, (0.0, t_end), x0, method=method, rtol=rtol, atol=1e-3 * rtol, n2=model.n2, jac=model.jac,
                 jac_sparsity=model.jac_sparsity, t_eval=np.linspace(t_end - window, t_end, int(window / 25e-6) + 1))
     assert res.status == 0
     outs = [model.outputs(t, y) for t, y in zip(res.t, res.y.T)]

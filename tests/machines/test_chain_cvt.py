@@ -125,8 +125,11 @@ def test_energy_balance_over_a_short_run(model, static):
 @pytest.mark.slow
 def test_stationary_regime_against_the_band_model(scene):
     """Acceptance of issue 13: 3500 rpm, 200 N m, ratio 2.4, the chain from its quasi-static state with the
-    band model's stationary clamping forces, 10 ms (means over the last 6 ms, every 25 us)."""
-    F, T_band = band_reference(scene)
+    band model's stationary clamping forces, 10 ms (means over the last 6 ms, every 25 us).  This window lies in
+    S2's start transient (observed -3.2 %, -3.0 %): run on, its slack span rises to +11.3 % at 75-80 ms and is not
+    settled (H1's give makes the chain's slip grow along the arc, docs/chain.md, "The span tensions against the band
+    model"), so the 5 % is asserted here for the transient state only."""
+    F, T_band, _ = band_reference(scene)
     m = from_scene(scene, reference_geometry(), F)
     x0, rep = m.static_state(RATIO, scene.cvt.regime.input_speed)
     T, axial, clamp = stationary_means(m, x0)

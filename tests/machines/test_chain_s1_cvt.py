@@ -5,6 +5,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
+from cvtfem.elements.band.creep import creep_arc
 from cvtfem.elements.chain.geometry import reference_geometry
 from cvtfem.errors import InputError
 from cvtfem.machines.chain_cvt import from_scene
@@ -114,19 +115,28 @@ def test_energy_balance_over_a_short_run(model, static):
 @pytest.mark.slow
 def test_stationary_regime_against_the_band_model(scene):
     """Issue 13's acceptance for S1: 3500 rpm, 200 N m, ratio 2.4, from the quasi-static state with the band model's
-    stationary clamping forces, 10 ms (means over the last 6 ms, every 25 us): pin axial forces on each sheave
-    balance its clamping force to 1 %, the tight span's tension is within 5 % of the 6+2n band model's.  The slack
-    span is not: +5.2 % here and +6.2..8.1 % over 4..30 ms (docs/chain.md, "S1 on the sheaves"), an open deviation
-    asserted as such so that a change of it shows."""
-    F, T_band = band_reference(scene)
+    stationary clamping forces, 20 ms of rock4 at rtol 1e-4, means over 10-20 ms (every 25 us): pin axial forces on
+    each sheave balance its clamping force to 1 %, both span tensions agree with the 6+2n band model's to 5 %
+    (observed +1.4 %, +2.7 %).  Before 10 ms the slack span is still in the start transient (+5.5 % over 5-10 ms); at
+    rtol 1e-3 rock4's error in the pins' slip, through the concave friction law, biases it by +3-4 %.  This window is
+    not a settled state: with the ratio loop raising F1 the slack span drifts on to +5.9 % over 60-80 ms, and with the
+    clamping forces held it sits at -5 % (docs/chain.md, "The span tensions against the band model").
+
+    Why the chain runs above the band: the band's slip is uniform along the arc, the chain's grows with its link
+    stretch and pin give.  The band's own span tensions are the arc balance with uniform slip (1e-4); with the
+    chain's creep the arc balance gives the chain's to 2 % (observed -0.2 %, -1.2 %)."""
+    F, T_band, arc = band_reference(scene)
     m = from_scene(scene, reference_geometry(), F, model="chain-S1", contact="rigid")
     x0, _ = m.static_state(RATIO, scene.cvt.regime.input_speed)
-    T, axial, clamp = stationary_means(m, x0)
+    T, axial, clamp = stationary_means(m, x0, t_end=20e-3, window=10e-3, method="rock4", rtol=1e-4)
+    geom = m.family.geom
+    creep = creep_arc(**arc["args"], EA=geom.c_link[0] * geom.L[0], c_pin=geom.c_pin[0], pitch=geom.L[0])["T"]
     print(f"band: tight {T_band[0]:.0f} N, slack {T_band[1]:.0f} N; S1: tight {T[0]:.0f} N, slack {T[1]:.0f} N; "
-          f"axial/clamping {axial / clamp}")
+          f"creeping band {creep[0]:.0f} N, {creep[1]:.0f} N; axial/clamping {axial / clamp}")
     np.testing.assert_allclose(axial, clamp, rtol=0.01)
-    assert T[0] == pytest.approx(T_band[0], rel=0.05)
-    assert 0.03 < T[1] / T_band[1] - 1 < 0.09
+    assert np.all(np.abs(T / T_band - 1) <= 0.05)
+    np.testing.assert_allclose(creep_arc(**arc["args"])["T"], arc["T"], rtol=1e-4)
+    np.testing.assert_allclose(T, creep, rtol=0.02)
 
 
 def test_pin_end_axial_positions_follow_the_faces(model, static):
