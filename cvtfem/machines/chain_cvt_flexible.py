@@ -13,10 +13,12 @@ on the strictly convex complementary energy: unique forces).  The face's opening
 axial offset of the sheave at that end (input ``z``), so the normal and friction forces, the sheave's axial force
 and the outputs follow the true penetration.  The mirror sheave opens alike (symmetric pair).
 
-Left out: the faces' opening rate in the slip velocity (quasi-static), the in-plane force ``N^T dK/dx N / 2`` of
-the compliance varying with the pin positions (it vanishes for pins moving rigidly together along an arc), and the
-faces' coupling in the right-hand side's Jacobian (``jac`` is the rigid-face kernel's at the deformed gaps; the
-quasi-static start adds the coupling, below).
+The forces are the gradient of the condensed energy ``min_d [sum 2/5 c (Delta_rigid - d)^2.5 + d^T K^-1 d / 2]``:
+the Hertz forces of the true penetrations and, because ``K`` moves with the pins, the in-plane force
+``N_i sum_j N_j dK_ij/dx_i`` on each pin end (small: it vanishes for pins moving rigidly together along an arc),
+so the work integrals balance the energy with the faces' strain energy ``N^T K N / 2`` per sheave.  Left out: the
+faces' opening rate in the slip velocity (quasi-static) and the faces' coupling in the right-hand side's Jacobian
+(``jac`` is the rigid-face kernel's at the deformed gaps; the quasi-static start adds the coupling, below).
 """
 from __future__ import annotations
 
@@ -59,10 +61,10 @@ class FlexibleChainCVT(ChainCVT):
 
     # ----- the faces' opening ------------------------------------------------------------------
     @cached_property
-    def _pair_weights(self) -> tuple[np.ndarray, ...]:
-        """Per pulley the weights ``B`` (H + 1, D + 1, D + 1) of :meth:`face_matrix`: with ``c_n`` a polynomial
-        ``sum_p b_np x^p`` of the mapped radius, ``c_n((x_i + x_j) / 2) = sum_{q+t <= D} B_nqt x_i^q x_j^t``,
-        ``B_nqt = b_n,q+t C(q+t, q) 2^-(q+t)``."""
+    def _pair_weights(self) -> tuple[tuple[np.ndarray, np.ndarray], ...]:
+        """Per pulley the weights ``(B, B_r)`` (each (H + 1, D + 1, D + 1)) of :meth:`face_matrices`: with ``c_n`` a
+        polynomial ``sum_p b_np x^p`` of the mapped radius ``x``, ``c_n((x_i + x_j) / 2) = sum_{q+t <= D} B_nqt
+        x_i^q x_j^t``, ``B_nqt = b_n,q+t C(q+t, q) 2^-(q+t)``; ``B_r`` the same for ``dc_n/dr`` (m/N per m)."""
         out = []
         for f in self.faces:
             D = f.coef.shape[1] - 1
@@ -70,36 +72,58 @@ class FlexibleChainCVT(ChainCVT):
             for k in range(D + 1):
                 to_power[k, :k + 1] = np.polynomial.chebyshev.cheb2poly(np.eye(D + 1)[k])[:k + 1]
             b = f.coef @ to_power                                                          # (H + 1, D + 1)
-            B = np.zeros((len(b), D + 1, D + 1))
-            for q in range(D + 1):
-                for t in range(D + 1 - q):
-                    B[:, q, t] = b[:, q + t] * math.comb(q + t, q) / 2.0 ** (q + t)
-            out.append(B)
+            b_r = np.zeros_like(b)
+            b_r[:, :-1] = b[:, 1:] * np.arange(1, D + 1) * 2 / (f.r_hi - f.r_lo)
+            pair = []
+            for poly in (b, b_r):
+                B = np.zeros((len(b), D + 1, D + 1))
+                for q in range(D + 1):
+                    for t in range(D + 1 - q):
+                        B[:, q, t] = poly[:, q + t] * math.comb(q + t, q) / 2.0 ** (q + t)
+                pair.append(B)
+            out.append(tuple(pair))
         return tuple(out)
 
-    def face_matrix(self, k: int, r, theta) -> np.ndarray:  # noqa: ANN001
-        """Influence matrix (m/N) of pulley ``k``'s face between contacts at radii ``r`` (m) and angles ``theta``
-        (rad): ``sum_n c_n(r_ij) cos n (theta_i - theta_j)`` with pairs at their mean radius, clamped to the fitted
-        range.  As ``sum_n V_n^T B_n V_n`` over ``V_n[q, i] = x_i^q cos n theta_i`` (and ``sin``): no polynomial
-        per pair (:attr:`_pair_weights`)."""
+    def face_matrices(self, k: int, r, theta, derivatives: bool = False):  # noqa: ANN001, ANN201
+        """Influence matrix ``K`` (m/N) of pulley ``k``'s face between contacts at radii ``r`` (m) and angles
+        ``theta`` (rad): ``K_ij = sum_n c_n(r_ij) cos n (theta_i - theta_j)``, pairs at their mean radius
+        ``r_ij``, clamped to the fitted range; computed as ``sum_n V_n^T B_n V_n`` over
+        ``V_n[q, i] = x_i^q cos n theta_i`` (and ``sin``), no polynomial per pair (:attr:`_pair_weights`).
+        With ``derivatives`` also ``K_r`` (m/N per m), ``sum_n dc_n/dr (r_ij) cos n (theta_i - theta_j)`` (zero
+        for a clamped ``r_i``), and ``K_t`` (m/N per rad), ``-sum_n n c_n(r_ij) sin n (theta_i - theta_j)``."""
         f = self.faces[k]
         H, D = f.coef.shape[0] - 1, f.coef.shape[1] - 1
-        if len(r) == 0:
-            return np.zeros((0, 0))
-        x = (2 * np.clip(np.asarray(r, float), f.r_lo, f.r_hi) - (f.r_lo + f.r_hi)) / (f.r_hi - f.r_lo)
+        m = len(r)
+        r = np.asarray(r, float)
+        x = (2 * np.clip(r, f.r_lo, f.r_hi) - (f.r_lo + f.r_hi)) / (f.r_hi - f.r_lo)
         powers = x[None, :] ** np.arange(D + 1)[:, None]                               # (D + 1, m)
         nt = np.arange(H + 1)[:, None] * np.asarray(theta, float)[None, :]
-        B = self._pair_weights[k]
-        K = np.zeros((len(x), len(x)))
-        for trig in (np.cos(nt), np.sin(nt)):
-            V = powers[None, :, :] * trig[:, None, :]                                    # (H + 1, D + 1, m)
-            K += V.reshape(-1, len(x)).T @ np.matmul(B, V).reshape(-1, len(x))
-        return 0.5 * (K + K.T)
+        B, B_r = self._pair_weights[k]
+        Vc = (powers[None, :, :] * np.cos(nt)[:, None, :]).reshape((H + 1) * (D + 1), m)
+        Vs = (powers[None, :, :] * np.sin(nt)[:, None, :]).reshape(Vc.shape)
+
+        def weighted(W, V):  # noqa: ANN001, ANN202
+            return np.matmul(W, V.reshape(H + 1, D + 1, m)).reshape(V.shape)
+        K = Vc.T @ weighted(B, Vc) + Vs.T @ weighted(B, Vs)
+        K = 0.5 * (K + K.T)
+        if not derivatives:
+            return K
+        inside = (r >= f.r_lo) & (r <= f.r_hi)
+        K_r = (Vc.T @ weighted(B_r, Vc) + Vs.T @ weighted(B_r, Vs)) * inside[:, None]
+        n = np.repeat(np.arange(H + 1), D + 1)[:, None]
+        K_t = -(Vs.T @ weighted(B, n * Vc) - Vc.T @ weighted(B, n * Vs))
+        return K, K_r, 0.5 * (K_t - K_t.T)
+
+    def face_matrix(self, k: int, r, theta) -> np.ndarray:  # noqa: ANN001
+        """The influence matrix ``K`` of :meth:`face_matrices`, m/N."""
+        return self.face_matrices(k, r, theta)
 
     def face_solution(self, X, shafts) -> dict[str, Any]:
         """Per contact (local inputs ``X``, shafts ``shafts``): rigid-face penetration ``delta_rigid``, true
-        penetration ``delta``, face opening ``opening`` (m), force ``N``; per pulley ``K`` (influence matrices),
-        ``members`` (contact indices) and ``iterations``."""
+        penetration ``delta``, face opening ``opening`` (m), force ``N``, and ``in_plane`` (m, 2) the in-plane force
+        on one pin end of the compliance varying with the pin positions, ``N_i sum_j N_j dK_ij/dx_i`` (N: the
+        condensed energy's gradient beyond the Hertz forces'); per pulley ``K`` (influence matrices), ``members``
+        (contact indices) and ``iterations``."""
         m = len(X)
         arm = X[:, :2] - self.contact.centres[shafts]
         r = np.hypot(arm[:, 0], arm[:, 1])
@@ -108,16 +132,20 @@ class FlexibleChainCVT(ChainCVT):
         for k in (0, 1):
             sel = shafts == k
             delta_r[sel] = self.contact._profiles[k](r[sel])[0] + X[sel, 2] - X[sel, 3]
-        delta, N = delta_r.copy(), np.zeros(m)
+        delta, N, in_plane = delta_r.copy(), np.zeros(m), np.zeros((m, 2))
         out: dict[str, Any] = {"K": [], "members": [], "iterations": []}
         for k in (0, 1):
             idx = np.flatnonzero(shafts == k)
-            K = self.face_matrix(k, r[idx], theta[idx])
+            K, K_r, K_t = self.face_matrices(k, r[idx], theta[idx], derivatives=True)
             delta[idx], N[idx], it = compliant_penetrations(delta_r[idx], K, float(self.contact.c[k]))
+            Nk = N[idx]
+            Q_r, Q_t = 0.5 * Nk * (K_r @ Nk), Nk * (K_t @ Nk)                # dK_ij/dr_i = K_r,ij / 2
+            e_r = arm[idx] / r[idx, None]
+            in_plane[idx] = Q_r[:, None] * e_r + (Q_t / r[idx])[:, None] * np.column_stack([-e_r[:, 1], e_r[:, 0]])
             out["K"].append(K)
             out["members"].append(idx)
             out["iterations"].append(it)
-        out.update(delta_rigid=delta_r, delta=delta, opening=delta_r - delta, N=N)
+        out.update(delta_rigid=delta_r, delta=delta, opening=delta_r - delta, N=N, in_plane=in_plane)
         return out
 
     def _contact_set(self, q, v, details=False):
@@ -129,7 +157,9 @@ class FlexibleChainCVT(ChainCVT):
         X[:, 3] += sol["opening"]
         if self._coupling.get("on"):
             self._coupling.update(cols=cols, coupling=self._opening_sensitivity(X, shafts, sol))
-        return ends, shafts, cols, coef, X, self.contact.local(X, shafts, details)
+        Y = self.contact.local(X, shafts, details)
+        (Y[0] if details else Y)[:, :2] += 2 * sol["in_plane"]            # both pin ends (mirror pair)
+        return ends, shafts, cols, coef, X, Y
 
     def _opening_sensitivity(self, X, shafts, sol) -> list:
         """Per pulley ``(members, T, G)``: ``T = dd/dDelta_rigid = K N' (I + K N')^-1`` (the opening's response to
@@ -189,3 +219,29 @@ class FlexibleChainCVT(ChainCVT):
         sol = self.face_solution(X, shafts)
         faces = sum(float(sol["N"][i] @ K @ sol["N"][i]) for K, i in zip(sol["K"], sol["members"]))
         return super().energy(x) + faces
+
+
+#: Margin of the faces' fitted radii beyond the scene's contact range, m: the chain's pins seat up to half a
+#: millimetre beyond ``r_max`` on the driven arc.
+RADIUS_MARGIN = 3e-3
+
+
+def flexible_faces_model(scene, model):  # noqa: ANN001, ANN201
+    """``model`` (built from a CVT ``scene`` with ``[sheave] flexibility = "reduced"``) on the scene's flexible
+    sheave faces (:func:`~cvtfem.machines.sheave.cvt_sheave_section`, ``sheave.harmonics``, the section mesh),
+    fitted over ``r_min - RADIUS_MARGIN .. r_max + RADIUS_MARGIN`` within the face; InputError naming
+    ``sheave.flexibility`` for a model other than chain-S2/S3 with H1 contact on rigid shafts, or ``"full"``."""
+    from cvtfem.elements.sheave_face import PATCH_WIDTH, face_compliance
+    from cvtfem.machines.sheave import cvt_sheave_section
+
+    opts, g = scene.sheave, scene.cvt.geometry
+    if opts.flexibility != "reduced" or type(model) is not ChainCVT or type(model.contact) is not SheaveContact:
+        raise InputError("sheave.flexibility", opts.flexibility,
+                         f"must be 'rigid' for `{scene.cvt.model}` with contact '{scene.cvt.effects.contact}': "
+                         "flexible faces ('reduced') run chain-S2 and chain-S3 with H1 contact ('hertz') on rigid "
+                         "shafts only")
+    section = cvt_sheave_section(scene)
+    lo = max(g.r_min - RADIUS_MARGIN, section.hub_radius + PATCH_WIDTH / 2)
+    hi = min(g.r_max + RADIUS_MARGIN, section.outer_radius - PATCH_WIDTH / 2)
+    faces = face_compliance(section, lo, hi, opts.harmonics, (opts.cells_radial, opts.cells_axial))
+    return FlexibleChainCVT.on_faces(model, (faces, faces))

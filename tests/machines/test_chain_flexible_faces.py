@@ -13,6 +13,7 @@ from cvtfem.machines.chain_cvt import from_scene
 from cvtfem.machines.chain_cvt_flexible import FlexibleChainCVT
 from cvtfem.machines.sheave import cvt_sheave_section
 from cvtfem.scene.loader import load_scene
+from tests.machines.chain_checks import assert_energy_balance
 
 RATIO = 2.4
 F_APPL = np.array([30000.0, 35000.0])
@@ -132,7 +133,9 @@ def test_infinitely_stiff_faces_give_the_rigid_model(rigid, faces, starts):
 
 def test_static_start_on_flexible_faces(rigid, flexible, starts):
     """The quasi-static start converges; the pins' axial forces carry the clamping forces; the driven face (near
-    the rim) opens by about a hundred um, the driving one (near the hub) by a few; F1/F2 moves by under 2 %."""
+    the rim) opens by about a hundred um, the driving one (near the hub) by a few; F1/F2 rises, as in the band
+    models (+1.7 % at this ratio: the pulley running near the rim gives most, so the other clamps harder; observed
+    +1.3 %, studies/sheaves/chain_on_flexible_sheaves.py)."""
     (xr, rr), (xf, rf) = starts
     assert rf["residual"] < 1e-9
     o = flexible.outputs(0.0, xf)
@@ -144,4 +147,40 @@ def test_static_start_on_flexible_faces(rigid, flexible, starts):
     driving, driven = (sol["opening"][on & (shafts == k)] for k in (0, 1))
     assert 2e-6 < driving.max() < 2e-5 and 5e-5 < driven.max() < 3e-4
     change = rf["F1"] / rf["F2"] / (rr["F1"] / rr["F2"]) - 1
-    assert -0.02 < change < 0.0
+    assert 0.005 < change < 0.03
+
+
+def test_energy_balance_on_flexible_faces(flexible, starts):
+    """A Radau run of 50 us from the flexible start: the work integrals balance the chain's, the Hertz contacts'
+    and the faces' energy to 1e-6 of the input work (observed 1e-11; without the in-plane force of the moving
+    compliance it was 2.5e-6)."""
+    x0, rep = starts[1]
+    assert_energy_balance(flexible.with_clamping([rep["F1"], F_APPL[1]]), x0, 5e-5)
+
+
+def _chain_scene(tmp_path, flexibility="reduced", **cvt):
+    text = ('preset = "chain-S2"\n[sheave]\nflexibility = "%s"\nharmonics = 6\ncells_radial = 12\n'
+            "bore_diameter = 0.035\nhub_diameter = 0.06\nhub_length = 0.03\nrim_thickness = 0.008\n" % flexibility)
+    for table, pairs in cvt.items():
+        text += f"[cvt.{table}]\n" + "".join(f"{k} = {v!r}\n".replace("'", '"') for k, v in pairs.items())
+    path = tmp_path / "chain_flex.toml"
+    path.write_text(text)
+    return load_scene(str(path))
+
+
+def test_scene_path(tmp_path):
+    """``[sheave] flexibility = "reduced"`` builds chain-S2 on flexible faces (fitted 3 mm beyond the scene's contact
+    radii); "rigid" the rigid-face model; S2 with impact contact is refused by the key."""
+    from cvtfem.machines import build_model
+    from cvtfem.machines.chain_cvt import ChainCVT
+
+    scene = _chain_scene(tmp_path)
+    model = build_model(scene)
+    g = scene.cvt.geometry
+    assert isinstance(model, FlexibleChainCVT)
+    assert model.faces[1].r_lo == pytest.approx(g.r_min - 0.003) and model.faces[1].r_hi == pytest.approx(
+        g.r_max + 0.003)
+    assert model.faces[0].coef.shape[0] == 7
+    assert type(build_model(_chain_scene(tmp_path, "rigid"))) is ChainCVT
+    with pytest.raises(InputError, match="sheave.flexibility"):
+        build_model(_chain_scene(tmp_path, effects={"contact": "impact"}))
