@@ -47,7 +47,7 @@ class FlexibleChainCVT(ChainCVT):
 
     faces: tuple = ()
     #: While the quasi-static start solves (:meth:`_solve_balance`): the faces' coupling of the last contact set.
-    _coupling: dict = field(default_factory=dict, repr=False, compare=False)
+    _coupling: dict = field(default_factory=dict, init=False, repr=False, compare=False)
 
     @classmethod
     def on_faces(cls, model: ChainCVT, faces) -> "FlexibleChainCVT":  # noqa: ANN001

@@ -338,7 +338,9 @@ def _contact_note(scene: Scene) -> str:
     refined = scene.cvt.effects.contact == "hertz-refined"
     where = "both ends of both pin halves" if scene.cvt.model in ("chain-A2", "chain-A5", "chain-A5-point") else \
         "both pin ends"
-    return f"{'refined (H2)' if refined else 'Hertz (H1)'} contact at {where} with"
+    faces = ", the faces opening under the pin forces," if scene.sheave is not None and \
+        scene.sheave.flexibility != "rigid" else ""
+    return f"{'refined (H2)' if refined else 'Hertz (H1)'} contact{faces} at {where} with"
 
 
 def _running_chain_layout(scene: Scene) -> tuple[Layout, ...]:
