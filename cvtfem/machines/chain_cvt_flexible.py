@@ -5,8 +5,8 @@ and up) lie far above the chain's contact dynamics, so each face takes the stati
 On pulley ``k`` the face opens at pin end ``i`` by ``d_i = sum_j K_ij N_j``,
 ``K_ij = sum_n c_n(r_ij) cos n (theta_i - theta_j)``, the face compliance of the solid sheave (bore clamped) with
 the contacts' angles ``theta`` about the shaft (only differences enter, so the sheave's spin angle drops out) and
-``r_ij = (r_i + r_j) / 2`` (the fit is in one radius; the pin ends of an arc differ by tens of um, and the
-compliance is exact on the diagonal), radii clamped to the fitted range.  The H1 gap of each end is reduced by its
+``r_ij = (r_i + r_j) / 2`` (the fit is in one radius; the pin ends of an arc differ by up to 0.4 mm, and the
+rule is exact on the diagonal), radii clamped to the fitted range.  The H1 gap of each end is reduced by its
 face's opening, ``Delta = Delta_rigid - d``, and with ``N = c Delta^1.5`` that is an implicit system per pulley and
 right-hand side, solved by :func:`~cvtfem.elements.contact.compliant_faces.compliant_penetrations` (damped Newton
 on the strictly convex complementary energy: unique forces).  The face's opening enters the contact kernel as an
@@ -15,8 +15,8 @@ and the outputs follow the true penetration.  The mirror sheave opens alike (sym
 
 The forces are the gradient of the condensed energy ``min_d [sum 2/5 c (Delta_rigid - d)^2.5 + d^T K^-1 d / 2]``:
 the Hertz forces of the true penetrations and, because ``K`` moves with the pins, the in-plane force
-``N_i sum_j N_j dK_ij/dx_i`` on each pin end (small: it vanishes for pins moving rigidly together along an arc),
-so the work integrals balance the energy with the faces' strain energy ``N^T K N / 2`` per sheave.  Left out: the
+``N_i sum_j N_j dK_ij/dx_i`` on each pin end (the normal force on the face tilted by its own opening: a few newtons
+per pin, which moves F1/F2 by about two percentage points at ratio 2.4), so the work integrals balance the energy with the faces' strain energy ``N^T K N / 2`` per sheave.  Left out: the
 faces' opening rate in the slip velocity (quasi-static) and the faces' coupling in the right-hand side's Jacobian
 (``jac`` is the rigid-face kernel's at the deformed gaps; the quasi-static start adds the coupling, below).
 """
