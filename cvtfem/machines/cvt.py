@@ -308,11 +308,16 @@ def chain_loop(scene: Scene):
     overrides = {} if eff.damping else {"damping_ratio": 0.0}
     if eff.shaft_elasticity:
         from cvtfem.machines.chain_cvt_elastic import from_scene as elastic_from_scene
-        return elastic_from_scene(scene, chain_geometry(scene), F_appl, model=model, contact=eff.contact, **overrides)
-    if eff.contact == "impact":
+        built = elastic_from_scene(scene, chain_geometry(scene), F_appl, model=model, contact=eff.contact, **overrides)
+    elif eff.contact == "impact":
         from cvtfem.machines.chain_impact_cvt import from_scene as impact_from_scene
-        return impact_from_scene(scene, chain_geometry(scene), F_appl, model=model, **overrides)
-    return from_scene(scene, chain_geometry(scene), F_appl, model=model, contact=eff.contact, **overrides)
+        built = impact_from_scene(scene, chain_geometry(scene), F_appl, model=model, **overrides)
+    else:
+        built = from_scene(scene, chain_geometry(scene), F_appl, model=model, contact=eff.contact, **overrides)
+    if scene.sheave is not None and scene.sheave.flexibility != "rigid":  # issue 20: faces that open under the pins
+        from cvtfem.machines.chain_cvt_flexible import flexible_faces_model
+        built = flexible_faces_model(scene, built)
+    return built
 
 
 def _pulley_layouts(model, outputs, sheave: str) -> list[Layout]:
@@ -335,7 +340,9 @@ def _contact_note(scene: Scene) -> str:
     refined = scene.cvt.effects.contact == "hertz-refined"
     where = "both ends of both pin halves" if scene.cvt.model in ("chain-A2", "chain-A5", "chain-A5-point") else \
         "both pin ends"
-    return f"{'refined (H2)' if refined else 'Hertz (H1)'} contact at {where} with"
+    faces = ", the faces opening under the pin forces," if scene.sheave is not None and \
+        scene.sheave.flexibility != "rigid" else ""
+    return f"{'refined (H2)' if refined else 'Hertz (H1)'} contact{faces} at {where} with"
 
 
 def _running_chain_layout(scene: Scene) -> tuple[Layout, ...]:
