@@ -48,6 +48,8 @@ class FlexibleChainCVT(ChainCVT):
     faces: tuple = ()
     #: While the quasi-static start solves (:meth:`_solve_balance`): the faces' coupling of the last contact set.
     _coupling: dict = field(default_factory=dict, init=False, repr=False, compare=False)
+    #: No compiled contact path: the faces' opening enters through the numpy contact set (:meth:`_contact_set`).
+    _compiled_contact = None
 
     @classmethod
     def on_faces(cls, model: ChainCVT, faces) -> "FlexibleChainCVT":  # noqa: ANN001
