@@ -230,6 +230,15 @@ class ChainCVT(ModelBase):
         keep = vals != 0
         return R[keep], C[keep], vals[keep]
 
+    @property
+    def backend(self) -> str:
+        """Which kernels the right-hand side runs (the run summary's label): ``"numba"`` (chain family and contacts
+        compiled), ``"numba contacts"`` (the contacts only) or ``"numpy"``."""
+        chain = getattr(self.family, "chain", self.family)
+        family = getattr(chain, "backend", "numpy") == "numba"
+        contacts = self._compiled_contact is not None
+        return "numba" if family and contacts else "numba contacts" if contacts else "numba family" if family else "numpy"
+
     @cached_property
     def _compiled_contact(self) -> tuple | None:
         """Constants of the compiled H1 contact path (:mod:`~cvtfem.elements.chain.sheave_contact_kernel`) for a
