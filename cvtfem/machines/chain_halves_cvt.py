@@ -18,13 +18,13 @@ from typing import ClassVar
 
 import numpy as np
 import scipy.sparse as sp
-import scipy.sparse.linalg as spla
 
 from cvtfem.elements.base import Block
 from cvtfem.elements.chain.halves import ChainA5
 from cvtfem.elements.chain.placement import place_on_path
 from cvtfem.errors import InputError, NumericalError
 from cvtfem.machines.chain_a_cvt import PLATE_HEIGHT, PLATE_THICKNESS, POISSON, ChainACVT
+from cvtfem.machines.static_balance import lifted_newton
 from cvtfem.outputs import OutputSpec
 
 #: Assumed half-pin and contact parameters (no source values; docs/chain.md "Parameters assumed"): half offset
@@ -38,11 +38,6 @@ HALF_PARAMETERS = dict(h_pin=1.2e-3, roll_radius=(0.004, 0.004), roll_stiffness=
 #: The chains with independent halves that run on the sheaves (both with H1: the contact point on the half's axis).
 HALVES_MODELS = ("chain-A5", "chain-A5-point")
 _ROT = np.array([[0.0, 1.0], [-1.0, 0.0]])      # a @ _ROT = k x a
-#: Phase 2 of the start's solve (:meth:`ChainHalvesCVT._solve_balance`): floors of the lift (fractions of the largest
-#: diagonal entry of the Jacobian), step lengths tried along each lifted Newton step, and the iteration limit.
-_LIFTS = (1e-9, 1e-7, 1e-5, 1e-4)
-_STEPS = (1.0, 0.5, 0.25, 0.1, 0.03, 0.01)
-_NEWTON_ITERATIONS = 150
 
 
 def halves_family(geom, damping, E: float, plate_model: str = "A4", use_numba: bool = True, **half_parameters) -> "HalvesFamily":
@@ -193,7 +188,7 @@ class ChainHalvesCVT(ChainACVT):
     at both ends of every half (:class:`ChainACVT`'s hooks for four ends per pin)."""
 
     #: The quasi-static start leaves about 1 N (2e-5 of F2) on the axial positions of the halves on the spans, which
-    #: only the plates' station terms hold (no stiffness of their own: :meth:`_solve_balance`); the sheaves' axial
+    #: only the plates' station terms hold (no stiffness of their own: :func:`lifted_newton`); the sheaves' axial
     #: balances hold to 2e-5 there (docs/chain.md).
     static_residual_limit: ClassVar[float] = 1e-4
 
@@ -252,7 +247,8 @@ class ChainHalvesCVT(ChainACVT):
 
     def wedge_guess(self, ratio: float, F2: float):
         """ChainCVT's wedge estimate with the sheaves moved to the half ends: on an arc both halves' axes run
-        ``(R - h_pin) sin(d/2)`` inside the rolling points ``U`` (:meth:`_placed`), where the wedge is narrower."""
+        ``(R - h_pin) sin(d/2)`` inside the rolling points ``U`` (:meth:`_placed`), where the wedge is narrower
+        (``start_z`` where it is set)."""
         pl, u3, z = super().wedge_guess(ratio, F2)
         R = np.mean(self.family.chain.roll_radius)
         h = self.family.chain.h_pin
@@ -261,7 +257,7 @@ class ChainHalvesCVT(ChainACVT):
             r_half = pl.r[k] - (R - h) * np.sin(0.5 * np.median(d[pl.piece == k]))
             face = self.contact.faces[k]
             z[k] += face.lever(pl.r[k]) - face.lever(r_half)
-        return pl, u3, z
+        return pl, u3, (z if self.start_z is None else np.array(self.start_z, float))
 
     def placed_state(self, ratio: float, w1: float) -> np.ndarray:
         """The start of the quasi-static solve as a running state: halves placed by :meth:`_placed` on the path of
@@ -288,62 +284,16 @@ class ChainHalvesCVT(ChainACVT):
             return self.placed_state(i, w1), {"kind": f"placed on the sheaves, off balance ({err})"}
 
     def _solve_balance(self, residual, jacobian, y0, tol: float):
-        """Damped Newton on the sparse Jacobian (scipy ``splu``) in two phases.
-
-        1. Steps ``-(J - mu S)^-1 r`` with ``S`` the Jacobian's diagonal magnitudes (floored at 1e-9 of the largest),
-           ``mu`` divided by 10 after a step that lowers ``|r|`` and multiplied by 10 (from the same point) otherwise,
-           until no ``mu`` lowers ``|r|``.  This stalls at about 2e-2 of F2: the static stiffness of A5 is indefinite
-           (the frictionless rolling faces give the relative slide and yaw of the halves negative stiffness under
-           tension, ``tests/elements/chain/test_halves_static_stability.py``), and with an indefinite ``J`` the
-           shifted step is no descent direction of ``|r|^2``.
-        2. Newton steps ``-(J - L)^-1 r`` whose shift ``L = diag(max(f max|J_ii| - |J_ii|, 0))`` lifts only the
-           coordinates without stiffness of their own (the axial positions of the halves on the spans, which no
-           force fixes: ``r`` has no part along them), so that the step is Newton's everywhere else and so a descent
-           direction of ``|r|^2`` however indefinite ``J`` is; the best of the floors ``f`` in :data:`_LIFTS` and
-           step lengths in :data:`_STEPS` by ``|r|``, while it lowers ``|r|``.
-
-        Ends when ``max |r| < 1e-3 tol`` or the step is below ``tol`` of the coordinates' scale."""
-        y, r = np.asarray(y0, float).copy(), residual(y0)
-        nfev, mu, msg = 1, 1e-6, "the iteration limit was reached"
-        converged = lambda dy: np.abs(r).max() < 1e-3 * tol or np.abs(dy).max() < tol * 1e-3   # noqa: E731
-        for _ in range(60):
-            J = sp.csc_matrix(jacobian(y))
-            S = sp.diags(np.maximum(np.abs(J.diagonal()), 1e-9 * np.abs(J.diagonal()).max()))
-            while mu < 1e8:
-                dy = spla.splu(J - mu * S).solve(-r)
-                r_new = residual(y + dy)
-                nfev += 1
-                if np.linalg.norm(r_new) < np.linalg.norm(r):
-                    y, r, mu = y + dy, r_new, max(mu / 10, 1e-12)
-                    break
-                mu *= 10
-            else:
-                break
-            if converged(dy):
-                return SimpleNamespace(x=y, nfev=nfev, status=1, message="converged")
-        for _ in range(_NEWTON_ITERATIONS):
-            J = sp.csc_matrix(jacobian(y))
-            d = np.abs(J.diagonal())
-            best = (np.linalg.norm(r), None, None)
-            for f in _LIFTS:
-                dy = spla.splu(J - sp.diags(np.maximum(f * d.max() - d, 0.0))).solve(-r)
-                for a in _STEPS:
-                    r_new = residual(y + a * dy)
-                    nfev += 1
-                    if np.linalg.norm(r_new) < best[0]:
-                        best = (np.linalg.norm(r_new), a * dy, r_new)
-            if best[1] is None:
-                msg = "no step lowered the residual"
-                break
-            y, r = y + best[1], best[2]
-            if converged(best[1]):
-                return SimpleNamespace(x=y, nfev=nfev, status=1, message="converged")
-        return SimpleNamespace(x=y, nfev=nfev, status=0, message=msg)
+        """:func:`~cvtfem.machines.static_balance.lifted_newton` on the sparse Jacobian (the static stiffness of A5 is
+        indefinite and singular: its phase 1 alone stalls at about 2e-2 of F2)."""
+        return lifted_newton(residual, jacobian, y0, tol)
 
     def _placed(self, pl, u3):
         """Straight halves rolling on each other at ``pl.u`` (the rolling faces touch on the joint's bisector
         ``b_p``): ``u-_p = U_p - R_- b_p - (h_pin - R_-) tau_p``, ``u+_p = U_p + R_+ b_p - (R_+ - h_pin) tau_{p-1}``,
-        ``tau`` the link directions; half lengths ``u3`` (n,) m, packs centred."""
+        ``tau`` the link directions; half lengths ``u3`` (n,) m, packs centred (``start_chain`` where it is set)."""
+        if self.start_chain is not None:
+            return np.array(self.start_chain, float)
         fam = self.family
         Rm, Rp = fam.chain.roll_radius
         h = fam.chain.h_pin
