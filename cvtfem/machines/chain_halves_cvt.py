@@ -13,7 +13,6 @@ dissipated work with the Rayleigh damping.
 """
 from __future__ import annotations
 
-from types import SimpleNamespace
 from typing import ClassVar
 
 import numpy as np

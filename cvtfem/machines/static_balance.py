@@ -9,12 +9,10 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 #: Phase 1: iteration limit.  Phase 2: floors of the lift (fractions of the largest diagonal entry of the Jacobian),
-#: step lengths tried along each lifted Newton step, the Levenberg-Marquardt shifts (fractions of the diagonal of
-#: ``J^T J``) tried where none of those lowers ``|r|``, iteration limit.
+#: step lengths tried along each lifted Newton step, iteration limit.
 DAMPED_ITERATIONS = 60
 LIFTS = (1e-9, 1e-7, 1e-5, 1e-4)
 STEPS = (1.0, 0.5, 0.25, 0.1, 0.03, 0.01)
-GAUSS_NEWTON_SHIFTS = (1e-4, 1e-2, 1.0, 1e2, 1e4)
 NEWTON_ITERATIONS = 150
 
 
@@ -30,10 +28,9 @@ def lifted_newton(residual, jacobian, y0, tol: float) -> SimpleNamespace:
        coordinates without stiffness of their own (a singular ``J``: A5's axial positions of the halves on the
        spans, which no force fixes, so ``r`` has no part along them); elsewhere the step is Newton's and so a
        descent direction of ``|r|^2`` however indefinite ``J`` is.  Each iteration takes the best by ``|r|`` of
-       the floors ``f`` in :data:`LIFTS` and step lengths in :data:`STEPS`; where none lowers ``|r|``, the first
-       Levenberg-Marquardt step ``-(J^T J + m D)^-1 J^T r`` (``D`` the diagonal of ``J^T J``, ``m`` in
-       :data:`GAUSS_NEWTON_SHIFTS`) that does (a descent direction of ``|r|^2`` for every ``m``); ends where none
-       does.
+       the floors ``f`` in :data:`LIFTS` and step lengths in :data:`STEPS`, while that lowers ``|r|`` (a
+       Levenberg-Marquardt step ``-(J^T J + m D)^-1 J^T r`` where none does only crawled: A5 2.46e-5 of F2 after 3906
+       evaluations against 2.34e-5 after 1623 without it).
 
     Ends when ``max |r| < 1e-3 tol`` or a step is below ``1e-3 tol`` (the coordinates' scale); returns ``x``,
     ``nfev``, ``status`` (1 converged, 0 not) and ``message``."""
@@ -70,18 +67,6 @@ def lifted_newton(residual, jacobian, y0, tol: float) -> SimpleNamespace:
                 nfev += 1
                 if np.linalg.norm(r_new) < best[0]:
                     best = (np.linalg.norm(r_new), a * dy, r_new)
-        if best[1] is None:                         # a Levenberg-Marquardt step: short, but always downhill
-            A = (J.T @ J).tocsc()
-            D = sp.diags(np.maximum(A.diagonal(), 1e-12 * A.diagonal().max()))
-            for m in GAUSS_NEWTON_SHIFTS:
-                dy = _solve(A + m * D, -(J.T @ r))
-                if dy is None:
-                    continue
-                r_new = residual(y + dy)
-                nfev += 1
-                if np.linalg.norm(r_new) < best[0]:
-                    best = (np.linalg.norm(r_new), dy, r_new)
-                    break
         if best[1] is None:
             message = "no step lowered the residual"
             break

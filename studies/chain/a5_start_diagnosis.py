@@ -1,5 +1,6 @@
-"""Why the quasi-static start of A5 on the sheaves stalls: the residual, the static stiffness and the solver's
-steps at the point where the damped Newton of :meth:`ChainHalvesCVT._solve_balance` stops.
+"""Why the quasi-static start of A5 on the sheaves needs the lifted Newton phase: the residual, the static stiffness
+and the solver's steps where the damped phase 1 of :func:`~cvtfem.machines.static_balance.lifted_newton` alone (the
+session-6 solver) stops.
 
     OPENBLAS_NUM_THREADS=1 .venv/bin/python studies/chain/a5_start_diagnosis.py
     # -> out/studies/chain/a5_start_diagnosis.txt (about 1-2 min at load 3)
@@ -25,6 +26,7 @@ from cvtfem.analysis.timing import machine
 from cvtfem.elements.chain.geometry import reference_geometry
 from cvtfem.errors import NumericalError
 from cvtfem.machines.chain_cvt import from_scene
+from cvtfem.machines import static_balance
 from cvtfem.machines.chain_halves_cvt import ChainHalvesCVT
 from cvtfem.scene.loader import load_scene
 
@@ -38,7 +40,8 @@ KINDS = {"u0 (in-plane position)": [0, 1, 10, 11], "u1 (in-plane tilt)": [2, 3, 
 
 
 class _Recorded(ChainHalvesCVT):
-    """ChainHalvesCVT that keeps the residual and Jacobian functions and the point where its solve stopped."""
+    """ChainHalvesCVT that keeps the residual and Jacobian functions and the point where its solve (phase 1 alone:
+    ``static_balance.NEWTON_ITERATIONS = 0`` in :func:`main`) stopped."""
 
     def _solve_balance(self, residual, jacobian, y0, tol):
         sol = super()._solve_balance(residual, jacobian, y0, tol)
@@ -48,6 +51,7 @@ class _Recorded(ChainHalvesCVT):
 
 def main() -> None:
     OUT.mkdir(parents=True, exist_ok=True)
+    static_balance.NEWTON_ITERATIONS = 0
     lines = [machine()]
     say = lines.append
     scene = load_scene("band-6+2n")
@@ -74,10 +78,12 @@ def main() -> None:
     big = np.abs(w).max()
     say(f"Jacobian asymmetry {np.abs(J - J.T).max() / np.abs(J).max():.2e} of its largest entry; eigenvalues of its "
         f"symmetric part (N/m over F2): largest magnitude {big:.3g}")
-    for label, sel in (("positive (unstable)", w > 1e-6 * big), ("|w| < 1e-9 of the largest (zero)", np.abs(w) < 1e-9 * big)):
+    for label, sel in (("positive (unstable)", w > 1e-6 * big),
+                       ("|w| < 1e-9 of the largest (zero)", np.abs(w) < 1e-9 * big)):
         weight = (V[:, sel] ** 2)
         kinds = {k: weight[fam.dof_index[:, cols].ravel()].sum() / max(sel.sum(), 1) for k, cols in KINDS.items()}
-        say(f"  {sel.sum()} {label}; weight by kind: " + ", ".join(f"{k} {v:.2f}" for k, v in kinds.items() if v > 0.01))
+        say(f"  {sel.sum()} {label}; weight by kind: "
+            + ", ".join(f"{k} {v:.2f}" for k, v in kinds.items() if v > 0.01))
     say("  largest positive: " + " ".join(f"{x * F2:.3g}" for x in w[-4:][::-1]) + " N/m")
     g = J.T @ r
     d = -g / np.linalg.norm(g)
