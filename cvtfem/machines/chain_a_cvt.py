@@ -31,6 +31,7 @@ from cvtfem.elements.chain.symmetric import END_SLOPE_FACTOR
 from cvtfem.errors import InputError
 from cvtfem.machines.chain import FreeChainA
 from cvtfem.machines.chain_cvt import ChainCVT
+from cvtfem.machines.static_balance import lifted_newton
 from cvtfem.outputs import OutputSpec
 
 #: Plate thickness along the pin (m): assumed, the per-plate models' default.
@@ -166,11 +167,15 @@ class ChainACVT(ChainCVT):
     start_chain : (n2_chain,) or None
         Chain coordinates the quasi-static solve starts from (None: the pins placed on the band path); A3/A4
         set it to the balance of A1 with the same plates (:meth:`_static`).
+    start_z : (2,) m or None
+        Movable sheave positions the quasi-static solve starts from (None: the wedge estimate); A3/A4 set them to
+        A1's balance with ``start_chain``.
     """
 
     movable_side: tuple = (1, -1)
     fixed_z: tuple = (0.0, 0.0)
     start_chain: Any = field(default=None, repr=False)
+    start_z: Any = field(default=None, repr=False)
 
     sheaves_per_z: ClassVar[float] = 1.0
 
@@ -289,13 +294,27 @@ class ChainACVT(ChainCVT):
 
     def _static(self, ratio, w1, F2, tol):
         """ChainCVT's quasi-static solve; a per-plate chain (A3, A4) first solves A1 of the same plates (the
-        homogenised layer, ``family.homogenised``) and continues from that balance: from the placement guess the plate
-        states make Levenberg–Marquardt stall (A3 at 1.1e-2 of F2), from A1's balance A3 converges."""
+        homogenised layer, ``family.homogenised``) and continues from that balance (its chain coordinates and movable
+        sheaves): from the placement guess the plate states make Levenberg–Marquardt stall (A3 at 1.1e-2 of F2)."""
         a1 = self.family.homogenised
         if a1 is None or self.start_chain is not None:
             return super()._static(ratio, w1, F2, tol)
-        x1, _ = replace(self, family=WholePinFamily(a1, self.family.geom))._static(ratio, w1, F2, tol)
-        return replace(self, start_chain=x1[:self.family.size])._static(ratio, w1, F2, tol)
+        homogenised = replace(self, family=WholePinFamily(a1, self.family.geom))
+        x1, _ = homogenised._static(ratio, w1, F2, tol)
+        start = replace(self, start_chain=x1[:self.family.size], start_z=x1[homogenised._idx[2]])
+        return start._static(ratio, w1, F2, tol)
+
+    def _solve_balance(self, residual, jacobian, y0, tol: float):
+        """A per-plate chain (A3, A4) from A1's balance: :func:`~cvtfem.machines.static_balance.lifted_newton` (scipy's
+        dense Levenberg-Marquardt left A4 at 4.1e-5 of F2 after 200 evaluations); A1: ChainCVT's."""
+        if self.family.homogenised is None:
+            return super()._solve_balance(residual, jacobian, y0, tol)
+        return lifted_newton(residual, jacobian, y0, tol)
+
+    def wedge_guess(self, ratio: float, F2: float):
+        """ChainCVT's wedge estimate; the sheaves at ``start_z`` where it is set."""
+        pl, u3, z = super().wedge_guess(ratio, F2)
+        return pl, u3, (z if self.start_z is None else np.array(self.start_z, float))
 
     def _placed(self, pl, u3):
         if self.start_chain is not None:

@@ -75,6 +75,8 @@ class ChainCVT(ModelBase):
 
     #: Sheaves the clamping force ``F`` acts on through one ``z`` coordinate: both of the symmetric pair.
     sheaves_per_z: ClassVar[float] = 2.0
+    #: Largest residual (over the driven clamping force) the quasi-static start accepts.
+    static_residual_limit: ClassVar[float] = 1e-6
 
     # ----- layout ------------------------------------------------------------------------------
     @cached_property
@@ -703,7 +705,7 @@ class ChainCVT(ModelBase):
         pins, shafts, _, (_, c) = self._contacts(q, vel, details=True)
         F1 = float(Q[iz[0]] / self.sheaves_per_z)                             # reaction that holds z_1 (Q excludes F1)
         res = float(np.abs(Q[free]).max() / F2)
-        if not res <= 1e-6:
+        if not res <= self.static_residual_limit:
             raise NumericalError(f"the quasi-static solve at ratio {ratio} ended with a residual of {res:.3g} of the "
                                  f"clamping force after {sol.nfev} evaluations ({sol.message})",
                                  component="ChainCVT.static_state")
