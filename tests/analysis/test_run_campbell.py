@@ -34,7 +34,8 @@ def running(scene):
 def _chain_removed(model, x0, speeds=(0.0, 0.0)):
     """The model with contact stiffness zero and the state with the structure at rest but its shafts' nodes
     spinning at ``speeds`` (rad/s; every node of shaft k)."""
-    free = replace(model, contact=replace(model.contact, c=np.zeros(2)))
+    z_ref, rigid_start = model._reference                  # the faces' references of the running model, solved now
+    free = replace(model, contact=replace(model.contact, c=np.zeros(2)), z_ref=z_ref, rigid_start=rigid_start)
     s, nc, n2 = model.structure, model.family.size, model.n2
     x = x0.copy()
     x[n2 + nc:2 * n2] = 0.0
