@@ -402,9 +402,9 @@ class ChainCVT(ModelBase):
 
     @cached_property
     def _family_acceleration_map(self) -> tuple:
-        """``(S, indices, indptr)``: the accelerations ``M^-1 [dQ/dq, dQ/dv]`` of the chain family's blocks as a
-        linear map ``S`` of their data (``dQ/dq`` then ``dQ/dv``, both on the family's sorted pattern) onto the data
-        of a fixed CSR structure ``(indices, indptr)`` of ``n2`` rows over the state (built once)."""
+        """``(S, P, indices, indptr)``: the accelerations ``M^-1 [dQ/dq, dQ/dv]`` of the chain family's blocks as a
+        linear map ``S`` of their data (``dQ/dq`` then ``dQ/dv``, both on the family's sorted pattern ``P``) onto the
+        data of a fixed CSR structure ``(indices, indptr)`` of ``n2`` rows over the state (built once)."""
         P = sp.csr_matrix(self.family.jac_sparsity, dtype=bool)
         P.sort_indices()
         nnz, n2, N = P.nnz, self.n2, self.size
