@@ -55,8 +55,8 @@ def _mutate(doc, data):
     value = container[key]
     number = isinstance(value, (int, float)) and not isinstance(value, bool)
     action = data.draw(st.sampled_from(["value", "sign", "scale", "zero", "delete"]))
-    if action == "value":
-        container[key] = data.draw(VALUES)
+    if action == "value":   # a copy: the sampled [1, 2] and {"a": 1} are shared objects, and a second mutation
+        container[key] = copy.deepcopy(data.draw(VALUES))   # inside one would make it contain itself
     elif action == "sign" and number:
         container[key] = -value
     elif action == "scale" and number:
