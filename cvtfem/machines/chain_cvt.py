@@ -521,7 +521,6 @@ class ChainCVT(ModelBase):
         nc, _, iz, _ = self._idx
         n = self.n_ends
         pins, shafts, _, (Y, c) = self._contacts(q, v, details=True)
-        on = c["delta"] > 0
         k = 2 * pins + shafts
 
         def per(values, width=1):
@@ -533,10 +532,7 @@ class ChainCVT(ModelBase):
         support = np.column_stack([np.bincount(shafts, Y[:, j], 2) for j in (0, 1)])   # forces on the pin ends
         out = dict(self.family.outputs(q[:nc], v[:nc]))
         out.update({"chain.coordinates": q[:nc], "chain.span_tension": self.span_tensions(q, v, pins, c["delta"]),
-                    "contact.normal_force": per(c["N"]), "contact.penetration": per(c["delta"]),
-                    "contact.radius": per(np.where(on, c["radius"], 0.0)),
-                    "contact.slip_speed": per(np.where(on, np.linalg.norm(c["slip"], axis=1), 0.0)),
-                    "contact.friction_force": per(c["F_fr"], 3),
+                    **self._contact_series(per, c),
                     "contact.friction_power": np.bincount(shafts, Y[:, -1], 2),
                     **self._sheave_outputs(pins, shafts, c),
                     "driving.speed": w[0], "driven.speed": w[1], "driving.torque": M[0], "driven.torque": M[1],
@@ -548,6 +544,17 @@ class ChainCVT(ModelBase):
                     "control.ratio_estimate": diag["ratio_estimate"], "control.resistance": diag["resistance"]})
         out.update(self._more_outputs(x))
         return {s.name: out[s.name] for s in self.output_specs}
+
+    @staticmethod
+    def _contact_series(per, c) -> dict[str, np.ndarray]:
+        """The per-end contact outputs from the contact details ``c``, spread over ends and shafts by ``per``:
+        normal force (N), penetration, contact radius (m), slip speed (m/s), friction force (N); radius and slip
+        are 0 off contact."""
+        on = c["delta"] > 0
+        return {"contact.normal_force": per(c["N"]), "contact.penetration": per(c["delta"]),
+                "contact.radius": per(np.where(on, c["radius"], 0.0)),
+                "contact.slip_speed": per(np.where(on, np.linalg.norm(c["slip"], axis=1), 0.0)),
+                "contact.friction_force": per(c["F_fr"], 3)}
 
     def _more_outputs(self, x) -> dict[str, Any]:
         """Outputs a subclass adds to :attr:`output_specs` (none here)."""

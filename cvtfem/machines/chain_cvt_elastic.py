@@ -405,7 +405,6 @@ class ElasticChainCVT(ChainCVT):
         q, v, _, W = self.split(x)
         nc, n, s = self._idx[0], self.n_ends, self.structure
         e, k, j, _, _, _, (Y, c) = self._mapped_set(q, v, details=True)
-        on = c["delta"] > 0
         slot = 2 * e + k
 
         def per(values, width=1):
@@ -420,10 +419,7 @@ class ElasticChainCVT(ChainCVT):
         shift = qs[s.sheave_dofs[:, :, 0:2]].reshape(2, 4)
         out = dict(self.family.outputs(q[:nc], v[:nc]))
         out.update({"chain.coordinates": q[:nc], "chain.span_tension": self.span_tensions(q, v, e, c["delta"]),
-                    "contact.normal_force": per(c["N"]), "contact.penetration": per(c["delta"]),
-                    "contact.radius": per(np.where(on, c["radius"], 0.0)),
-                    "contact.slip_speed": per(np.where(on, np.linalg.norm(c["slip"], axis=1), 0.0)),
-                    "contact.friction_force": per(c["F_fr"], 3),
+                    **self._contact_series(per, c),
                     "contact.friction_power": np.bincount(k, Y[:, -1], 2),
                     **self._axial_outputs(k, j, c),
                     "driving.speed": w[0], "driven.speed": w[1], "driving.torque": M[0], "driven.torque": M[1],

@@ -13,16 +13,15 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-import numpy as np
-
 from cvtfem.elements.chain.half_contact import CoupledHalvesContact
 from cvtfem.elements.chain.half_end_contact import HalfEndContact
+from cvtfem.elements.chain.pair_geometry import PairGeometry
 from cvtfem.elements.chain.sheave_contact import SheaveContact
 from cvtfem.elements.chain.sheave_contact_refined import RefinedSheaveContact
 
 
 @dataclass(frozen=True)
-class EndContact:
+class EndContact(PairGeometry):
     """H1 or H2 contact of single pin ends (mirrored to ``x3 > 0``) with the sheaves of two shafts.
 
     Attributes
@@ -42,26 +41,6 @@ class EndContact:
     def extra_approach(self, k: int, r) -> float:
         """Penetration beyond H1's of an untilted pin end at radius ``r`` (m) on shaft ``k`` (m; 0 for H1)."""
         return float(self.pair.extra_approach(k, r)) if self.refined else 0.0
-
-    @property
-    def centres(self) -> np.ndarray:
-        return self.pair.centres
-
-    @property
-    def faces(self) -> tuple:
-        return self.pair.faces
-
-    @property
-    def c(self) -> np.ndarray:
-        return self.pair.c
-
-    @property
-    def r_outer(self) -> float:
-        return self.pair.r_outer
-
-    def candidates(self, u):
-        """Broad phase: ``(end, shaft)`` index arrays of the end positions ``u`` (m, 2) within the outer radius."""
-        return self.pair.candidates(u)
 
     def local(self, X, shafts, details: bool = False, reference: bool = False):
         """Local outputs of single ends (H1: (m, 6), the force on the end (N), on ``z`` (N), on ``phi`` (N m) and the

@@ -20,6 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from cvtfem.elements.chain.pair_geometry import PairGeometry
 from cvtfem.elements.chain.sheave_contact import central_local_jacobian
 from cvtfem.elements.chain.sheave_contact_refined import RefinedSheaveContact
 from cvtfem.errors import InputError
@@ -54,7 +55,7 @@ def half_offset(um, up, un, sigma, h_pin):
 
 
 @dataclass(frozen=True)
-class CoupledHalvesContact:
+class CoupledHalvesContact(PairGeometry):
     """H2 contact of the two coupled halves of whole pins (A2) with the sheaves of two shafts, mirrored pair.
 
     Attributes
@@ -73,21 +74,9 @@ class CoupledHalvesContact:
             raise InputError("h_pin", self.h_pin, "must be > 0 (half the distance of the halves' centroids, m)")
 
     @property
-    def centres(self):
-        return self.pair.centres
-
-    @property
-    def faces(self):
-        return self.pair.faces
-
-    @property
     def c(self):
         """Hertz constant of a whole pin end (N/m^1.5): both halves at one penetration, ``2 c_half``."""
         return 2 * self.pair.c
-
-    @property
-    def r_outer(self):
-        return self.pair.r_outer
 
     @property
     def n_pos(self) -> int:
@@ -100,9 +89,6 @@ class CoupledHalvesContact:
 
     def extra_approach(self, k: int, r):
         return self.pair.extra_approach(k, r)
-
-    def candidates(self, u):
-        return self.pair.candidates(u)
 
     def shifted(self, X):
         """The kernel's inputs (m, n_in - 1) at the half axis, and the offset map of :func:`half_offset`."""

@@ -24,6 +24,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from cvtfem.elements.chain.pair_geometry import PairGeometry
 from cvtfem.elements.chain.sheave_contact import central_local_jacobian
 from cvtfem.elements.chain.sheave_contact_refined import RefinedSheaveContact
 from cvtfem.elements.jit import njit
@@ -61,7 +62,7 @@ def _gather(Yk, Y):
 
 
 @dataclass(frozen=True)
-class HalfEndContact:
+class HalfEndContact(PairGeometry):
     """H2 contact of the ends of independent pin halves (A5) with the sheaves of two shafts, mirrored pair.
 
     Attributes
@@ -75,22 +76,6 @@ class HalfEndContact:
     def __post_init__(self):
         if not self.pair.slopes:
             raise InputError("HalfEndContact.pair.slopes", False, "must be true: a half end has a slope (A5 bends)")
-
-    @property
-    def centres(self):
-        return self.pair.centres
-
-    @property
-    def faces(self):
-        return self.pair.faces
-
-    @property
-    def c(self):
-        return self.pair.c
-
-    @property
-    def r_outer(self):
-        return self.pair.r_outer
 
     @property
     def n_pos(self) -> int:
@@ -108,9 +93,6 @@ class HalfEndContact:
 
     def extra_approach(self, k: int, r):
         return self.pair.extra_approach(k, r)
-
-    def candidates(self, u):
-        return self.pair.candidates(u)
 
     def kernel_inputs(self, X):
         """The kernel's inputs (m, 21): neighbours ``x -+ c`` around the end ``x`` (positions and rates)."""
