@@ -173,11 +173,12 @@ class _Run:
                              f"checkpoints over {t_end:g} s ({t_end / self.interval:.3g} asked for)",
                              "checkpoints cost a full-state write each: one every few seconds of wall time is plenty")
         t_out = np.arange(0.0, t_end + 0.5 * dt, dt)
-        self.t_out = t_out[t_out <= t_end * (1 + 1e-12)]
-        # the samples a finished run emits (the stepper lands on t_end) and the start of the efficiency window
-        final = self.t_out[self.t_out <= t_end]
-        j = int(np.searchsorted(final, final[-1] - EFFICIENCY_WINDOW))
-        self.j_window = 0 if j >= len(final) - 1 else j  # run shorter than one output step past the window
+        # a sample within round-off past t_end (arange's 3 * 1e-4 = 3.0000000000000003e-4) is t_end: the stepper
+        # lands on t_end exactly, so a sample a hair beyond it would never be emitted
+        self.t_out = np.minimum(t_out[t_out <= t_end * (1 + 1e-12)], t_end)
+        # the start of the efficiency window among the samples
+        j = int(np.searchsorted(self.t_out, self.t_out[-1] - EFFICIENCY_WINDOW))
+        self.j_window = 0 if j >= len(self.t_out) - 1 else j  # run shorter than one output step past the window
         sol = scene.solver
         if sol.on_failure == "retry":  # the fallback runs adaptive: refuse one without error estimate now
             try:

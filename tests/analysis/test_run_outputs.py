@@ -54,3 +54,12 @@ def test_results_file_holds_the_reference_outputs(name, tmp_path, monkeypatch):
             assert np.abs(res.series[key][i] - value).max() <= 1e-12 * np.abs(value).max(), (key, i)
     energy = res.series["energy"][:, 0]
     assert energy.min() > 0 and np.ptp(energy) > 0  # the energy series is exercised, not constant
+
+
+def test_the_last_sample_is_written_when_the_end_is_a_round_off_multiple_of_the_step(tmp_path):
+    """``--until 3e-4`` at an output step of 1e-4: ``arange`` gives 3.0000000000000003e-4 as the last sample; the
+    run writes it at t_end (the stepper lands on t_end exactly) and its summary covers the whole span."""
+    scene = load_scene("band-4dof", {"output": {"step": 1e-4}})
+    run_scene(scene, until=3e-4, results=tmp_path / "r.h5", show_progress=False)
+    res = read_results(tmp_path / "r.h5")
+    assert res.time.tolist() == [0.0, 1e-4, 2e-4, 3e-4]
