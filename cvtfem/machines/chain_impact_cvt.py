@@ -75,9 +75,10 @@ class ContactOnsetImpacts:
         return x[:n], x[n:2 * n], x[2 * n:2 * n + nz], x[self._discrete.stop:]
 
     def discrete_state(self, x) -> tuple[np.ndarray, float]:
-        """``(state (2 n_ends,), impact loss J)`` of a state vector."""
+        """``(state (2 n_ends,), impact loss J)`` of a state vector (the state rounded: a dense output between two
+        steps may carry it as ``1 - 1e-15``)."""
         d = x[self._discrete]
-        return d[:-1], float(d[-1])
+        return np.rint(d[:-1]), float(d[-1])
 
     def end_name(self, end: int) -> str:
         """``"pin 17"`` (a mirrored pair of ends)."""
@@ -141,7 +142,7 @@ class ContactOnsetImpacts:
         cols, coef, shafts = self._gap_map
         y = np.concatenate([x[:2 * self.n2], self._constants])
         e = input_gaps(self.contact, (coef * y[cols]).sum(axis=2), shafts)
-        return e + HYSTERESIS * (x[self._discrete.start:self._discrete.stop - 1] != FREE)
+        return e + HYSTERESIS * (x[self._discrete.start:self._discrete.stop - 1] > 0.5)      # not FREE
 
     @cached_property
     def event_direction(self) -> np.ndarray:
@@ -166,7 +167,7 @@ class ContactOnsetImpacts:
                 raise NumericalError(f"the impact of {self.end_name(j // 2)} on the {('driving', 'driven')[j % 2]} "
                                      f"sheave would add {dT:.3g} J of kinetic energy (sliding impulse with f = "
                                      f"{friction_coefficient(self.contact):g})", t=t, component=type(self).__name__)
-        hit = ends[x[self._discrete.start + ends] != FREE]
+        hit = ends[x[self._discrete.start + ends] > 0.5]                                    # not FREE
         if len(hit):
             leaving = self._gap_curvature(t, x)[hit] < 0
             x[self._discrete.start + hit[leaving]] = FREE
@@ -228,7 +229,7 @@ class ContactOnsetImpacts:
 
     def _more_outputs(self, x):
         state, loss = self.discrete_state(x)
-        return {**super()._more_outputs(x), "contact.state": state.copy(), "contact.impact_loss": loss}
+        return {**super()._more_outputs(x), "contact.state": state, "contact.impact_loss": loss}
 
 
 class ImpactChainCVT(ContactOnsetImpacts, ChainCVT):

@@ -307,3 +307,32 @@ def test_s3_agrees_with_s2_where_they_coincide(s3):
         m_p = fam3.geom.m_eff[pin]                                            # in-plane end jumps: 12 P / m_p, 2 P / m_p
         np.testing.assert_allclose(dx[fam3.dof_index[pin, :2]], 12 * P3[:2] / m_p, rtol=1e-10)
         np.testing.assert_allclose(dy[fam2.dof_index[pin, :2]], 2 * P2[:2] / m_p, rtol=1e-10)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("scene_text, until", [
+    ('preset = "chain-S2"\n[cvt]\nmodel = "chain-S3"\n[cvt.effects]\ncontact = "impact"\npin_bending = true\n', 4e-4),
+    ('preset = "chain-A1"\n[cvt.effects]\ncontact = "impact"\n', 2e-4),
+], ids=["S3", "A1"])
+def test_cvtfem_run_closes_the_energy_balance_with_the_impact_losses(cli, tmp_path, scene_text, until):
+    """`cvtfem run` of S3 (rock4) and A1 (Radau) with impacts from the quasi-static start, rtol 1e-4: pins entering the
+    arcs hit their sheaves (a loss that only grows), the discrete state agrees with the penetrations (an end in contact
+    is not off the face by more than the hysteresis, a free end does not penetrate), and the work integrals close the
+    energy balance (input = output + damping + friction + impact losses + change of energy - clamping work) to 1e-6 of
+    the input work."""
+    import h5py
+
+    from cvtfem.machines.chain_impact_cvt import HYSTERESIS
+
+    scene_file, h5 = tmp_path / "impact.toml", tmp_path / "impact.h5"
+    scene_file.write_text(scene_text + "[solver]\nrtol = 1e-4\natol = 1e-7\n")
+    r = cli("run", str(scene_file), "--until", str(until), "--results", str(h5), timeout=600)
+    assert r.returncode == 0, r.stderr
+    with h5py.File(h5) as f:
+        s = f["series"]
+        W, E, loss = s["work"][-1], s["energy"][:], s["contact.impact_loss"][:].ravel()
+        state, pen = s["contact.state"][-1], s["contact.penetration"][-1]
+    assert loss[-1] > 0 and np.all(np.diff(loss) >= 0) and W[2] > loss[-1]
+    assert set(np.unique(state)) <= {FREE, SLIDING, STUCK}
+    assert np.all(pen[state != FREE] > -HYSTERESIS) and np.all(pen[state == FREE] <= 0)
+    assert W[0] > 10.0 and abs(W[0] - W[1] - W[2] + W[3] - (E[-1] - E[0])) < 1e-6 * W[0]
