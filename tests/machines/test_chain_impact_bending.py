@@ -184,6 +184,55 @@ def test_compliance_equals_the_closed_forms_of_the_pin_masses(s3, a1):
         np.testing.assert_allclose(jumps[:, 2], axial[:, hit] * side * P[2], rtol=1e-10)
 
 
+def test_both_ends_of_an_a1_pin_hit_together_settle_to_the_joint_inelastic_impact(a1):
+    """Both ends of an A1 pin fire on one shaft at once (frictionless): the mass matrix couples them, so single impacts
+    in turn leave the first end moving on its face again; the switch solves them together, and the velocities after
+    equal the joint inelastic impact ``v+ = v- + M^-1 [G_1^T n_1, G_2^T n_2] P_n`` with ``K P_n =
+    -(n . w-)``, ``K_ij = n_i . G_i M^-1 G_j^T n_j`` (both ``P_n > 0``) to 1e-8; the loss is ``P_n . K P_n / 2``, the
+    model's energy drop.  With friction: neither end approaches after, the impulses lie in their cones, the energy
+    drops by the loss."""
+    model, x0 = a1
+    smooth = _with_friction(model, 0.0)
+    n2 = smooth.n2
+    e = smooth.events(0.0, x0).reshape(-1, 2, 2)                          # (pin, far/near, shaft)
+    pin, shaft = [(p, k) for p, k in np.argwhere((e > -5e-4).all(axis=1)) if p % 3 == 1][0]
+    ends = np.array([2 * pin, 2 * pin + 1])
+    x = x0.copy()
+    d = smooth.family.dof_index[pin]
+    maps = [smooth.impact_map(x, end, shaft) for end in ends]
+    G = np.vstack([m[2][:, d] for m in maps])
+    target = np.concatenate([m[0] - (m[1] @ m[0] + speed) * m[1] for m, speed in zip(maps, (0.4, 0.7))])
+    x[n2 + d] += G.T @ np.linalg.solve(G @ G.T, target - np.concatenate([m[0] for m in maps]))
+    maps = [smooth.impact_map(x, end, shaft) for end in ends]
+    N = [m[2].T @ m[1] for m in maps]                                      # G_i^T n_i (n2,)
+    MinvN = [m[3] @ m[1] for m in maps]                                    # M^-1 G_i^T n_i
+    K = np.array([[N[i] @ MinvN[j] for j in range(2)] for i in range(2)])
+    vn = np.array([m[1] @ m[0] for m in maps])
+    assert np.all(vn < 0)
+    Pn = np.linalg.solve(K, -vn)
+    assert np.all(Pn > 0)
+    v_joint = x[n2:2 * n2] + MinvN[0] * Pn[0] + MinvN[1] * Pn[1]
+    fired = np.zeros(smooth.n_discrete, bool)
+    fired[2 * ends + shaft] = True
+    x1 = smooth.switch(0.0, x, fired)
+    np.testing.assert_allclose(x1[n2:2 * n2], v_joint, rtol=0, atol=1e-8 * np.abs(v_joint - x[n2:2 * n2]).max())
+    loss = smooth.discrete_state(x1)[1]
+    assert loss == pytest.approx(0.5 * Pn @ K @ Pn, rel=1e-7)
+    assert smooth.energy(x) - smooth.energy(x1) == pytest.approx(loss, rel=1e-7)
+    one_pass = smooth.impact(x, ends, [shaft, shaft])[0]                   # single impacts in turn: the first
+    w, normal = smooth.impact_map(one_pass, ends[0], shaft)[:2]            # end no longer at rest on its face
+    assert abs(normal @ w) > 0.05 * abs(vn[0])
+    # with friction (f = 0.1): neither end approaches after, each impulse in its cone, the loss the energy drop
+    x2, P, _, dT = model.joint_impacts(0.0, x, ends, [shaft, shaft])
+    f = friction_coefficient(model.contact)
+    for end, P_end in zip(ends, P):
+        w, normal = model.impact_map(x2, end, shaft)[:2]
+        assert normal @ w > -1e-8 * abs(vn).max()
+        Pn = P_end @ normal
+        assert Pn > 0 and np.linalg.norm(P_end - Pn * normal) <= f * Pn * (1 + 1e-9)
+    assert dT < 0 and model.energy(x2) - model.energy(x) == pytest.approx(dT, rel=1e-7)
+
+
 def test_impulse_satisfies_c2_and_takes_the_closed_form_energy(s3, a1):
     """On random approaching ends of S3 and A1: no normal relative velocity after the impact, the impulse in the
     friction cone opposing the slip, the stick check (stuck exactly when the stick impulse satisfies (1.301)), no
