@@ -186,7 +186,7 @@ def test_compliance_equals_the_closed_forms_of_the_pin_masses(s3, a1):
 
 def test_both_ends_of_an_a1_pin_hit_together_settle_to_the_joint_inelastic_impact(a1):
     """Both ends of an A1 pin fire on one shaft at once (frictionless): the mass matrix couples them, so single impacts
-    in turn leave the first end moving on its face again; the switch solves them together, and the velocities after
+    in turn throw the first end off its face again (at 57 % of its approach speed here); the switch solves them together, and the velocities after
     equal the joint inelastic impact ``v+ = v- + M^-1 [G_1^T n_1, G_2^T n_2] P_n`` with ``K P_n =
     -(n . w-)``, ``K_ij = n_i . G_i M^-1 G_j^T n_j`` (both ``P_n > 0``) to 1e-8; the loss is ``P_n . K P_n / 2``, the
     model's energy drop.  With friction: neither end approaches after, the impulses lie in their cones, the energy
@@ -219,9 +219,9 @@ def test_both_ends_of_an_a1_pin_hit_together_settle_to_the_joint_inelastic_impac
     loss = smooth.discrete_state(x1)[1]
     assert loss == pytest.approx(0.5 * Pn @ K @ Pn, rel=1e-7)
     assert smooth.energy(x) - smooth.energy(x1) == pytest.approx(loss, rel=1e-7)
-    one_pass = smooth.impact(x, ends, [shaft, shaft])[0]                   # single impacts in turn: the first
-    w, normal = smooth.impact_map(one_pass, ends[0], shaft)[:2]            # end no longer at rest on its face
-    assert abs(normal @ w) > 0.05 * abs(vn[0])
+    one_pass = smooth.impact(x, ends, [shaft, shaft])[0]                   # single impacts in turn: the second
+    w, normal = smooth.impact_map(one_pass, ends[0], shaft)[:2]            # throws the first off its face
+    assert normal @ w > 0.25 * abs(vn[0])
     # with friction (f = 0.1): neither end approaches after, each impulse in its cone, the loss the energy drop
     x2, P, _, dT = model.joint_impacts(0.0, x, ends, [shaft, shaft])
     f = friction_coefficient(model.contact)
