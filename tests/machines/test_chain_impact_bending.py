@@ -51,8 +51,9 @@ def _inputs(model, x, end, shaft):
 
 def _approaching(model, x, seed, n=12, speed=0.3):
     """``x`` with random chain/shaft/sheave velocities and ``n`` (end, shaft) pairs near their sheave given a relative
-    velocity into the face (the least-norm change of that pin's velocities that sets ``w``; one end per pin): every other one straight in with its
-    slip kept, the others ``w = -A P`` for a sticking impulse ``P`` inside the friction cone."""
+    velocity into the face (the least-norm change of that pin's velocities that sets ``w``; one end per pin): every
+    other one straight in with its slip kept, the others ``w = -A P`` for a sticking impulse ``P`` inside the friction
+    cone."""
     rng = np.random.default_rng(seed)
     x = x.copy()
     n2, nc = model.n2, model.family.size
@@ -186,11 +187,11 @@ def test_compliance_equals_the_closed_forms_of_the_pin_masses(s3, a1):
 
 def test_both_ends_of_an_a1_pin_hit_together_settle_to_the_joint_inelastic_impact(a1):
     """Both ends of an A1 pin fire on one shaft at once (frictionless): the mass matrix couples them, so single impacts
-    in turn throw the first end off its face again (at 57 % of its approach speed here); the switch solves them together, and the velocities after
-    equal the joint inelastic impact ``v+ = v- + M^-1 [G_1^T n_1, G_2^T n_2] P_n`` with ``K P_n =
-    -(n . w-)``, ``K_ij = n_i . G_i M^-1 G_j^T n_j`` (both ``P_n > 0``) to 1e-8; the loss is ``P_n . K P_n / 2``, the
-    model's energy drop.  With friction: neither end approaches after, the impulses lie in their cones, the energy
-    drops by the loss."""
+    in turn throw the first end off its face again (at 57 % of its approach speed here); the switch solves them
+    together, and the velocities after equal the joint inelastic impact ``v+ = v- + M^-1 [G_1^T n_1, G_2^T n_2] P_n``
+    with ``K P_n = -(n . w-)``, ``K_ij = n_i . G_i M^-1 G_j^T n_j`` (both ``P_n > 0``) to 1e-8; the loss is ``P_n . K
+    P_n / 2``, the model's energy drop. With friction: neither end approaches after, the impulses lie in their cones,
+    the energy drops by the loss."""
     model, x0 = a1
     smooth = _with_friction(model, 0.0)
     n2 = smooth.n2
@@ -284,10 +285,10 @@ def test_frictionless_loss_is_the_inelastic_normal_closed_form(s3, a1):
 
 def test_momentum_of_pin_and_shaft_is_conserved_through_the_impulse(s3, a1):
     """The impulse is internal between the pin and its shaft: the angular momentum about the shaft axis of the pin and
-    the shaft (sheave inertia included) and, against a movable sheave, the axial momentum of the pin and that sheave
-    are conserved (``r^T M v`` over the rigid modes ``r``: the pin's jump cancels the shaft's, or the sheave's, to
-    1e-9 of it or of the impulse's moment, the round-off of the shaft's spin momentum); nothing but that pin, shaft and sheave moves.  Against
-    A1's fixed sheave the axial momentum changes by the impulse's axial part (the ground takes it)."""
+    the shaft (sheave inertia included) and, against a movable sheave, the axial momentum of the pin and that sheave are
+    conserved (``r^T M v`` over the rigid modes ``r``: the pin's jump cancels the shaft's, or the sheave's, to 1e-9 of
+    it or of the impulse's moment, the round-off of the shaft's spin momentum); nothing but that pin, shaft and sheave
+    moves. Against A1's fixed sheave the axial momentum changes by the impulse's axial part (the ground takes it)."""
     for model, x0 in (s3, a1):
         M = _mass(model)
         n2, (_, iphi, iz, _) = model.n2, model._idx
@@ -353,7 +354,7 @@ def test_s3_agrees_with_s2_where_they_coincide(s3):
         dp3, dp2 = (M3 @ dx)[fam3.dof_index[pin, :2]], (M2 @ dy)[fam2.dof_index[pin, :2]]
         np.testing.assert_allclose(dp3, dp2, rtol=1e-12)
         np.testing.assert_allclose(dp3, 2 * P3[:2], rtol=1e-12)
-        m_p = fam3.geom.m_eff[pin]                                            # in-plane end jumps: 12 P / m_p, 2 P / m_p
+        m_p = fam3.geom.m_eff[pin]                          # in-plane end jumps: 12 P / m_p, 2 P / m_p
         np.testing.assert_allclose(dx[fam3.dof_index[pin, :2]], 12 * P3[:2] / m_p, rtol=1e-10)
         np.testing.assert_allclose(dy[fam2.dof_index[pin, :2]], 2 * P2[:2] / m_p, rtol=1e-10)
 
