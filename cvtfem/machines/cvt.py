@@ -245,13 +245,15 @@ def chain_refusal(scene: Scene) -> InputError | None:
     if model not in ("chain-S1", "chain-S2") and not eff.pin_bending:
         return InputError("cvt.effects.pin_bending", False, f"must be true for `{model}` (its pins bend); "
                           "without pin bending use `chain-S2`")
+    impact_chains = ("chain-S2", "chain-S3", "chain-A1")   # effects.contact = "impact" (rigid shafts)
     if model == "chain-S1" and eff.contact == "impact":
         return InputError("cvt.effects.contact", eff.contact, "must be 'rigid' for `chain-S1`: its pins carry no axial "
                           "inertia, so a pin end entering a sheave takes no impulse (chain-models-1 2.1); the impact "
-                          "at contact onset runs with `chain-S2`")
-    if eff.contact == "impact" and model != "chain-S2":
+                          "at contact onset runs with " + ", ".join(impact_chains))
+    if eff.contact == "impact" and model not in impact_chains:
         return InputError("cvt.effects.contact", eff.contact, f"must be 'hertz' or 'hertz-refined' for `{model}`: the "
-                          "impact at contact onset runs with `chain-S2` only so far (rigid shafts)")
+                          "impact at contact onset runs with " + ", ".join(impact_chains) + " only so far (rigid "
+                          "shafts)")
     if model == "chain-S1" and eff.contact != "rigid":
         return InputError("cvt.effects.contact", eff.contact, "must be 'rigid' for `chain-S1`: its pins have no axial "
                           "coordinate, their ends follow the sheave faces (chain-models-1 2.2)")
@@ -266,7 +268,7 @@ def chain_refusal(scene: Scene) -> InputError | None:
     if model != "chain-S1" and eff.contact not in ("hertz", "hertz-refined", "impact"):
         return InputError("cvt.effects.contact", eff.contact, f"must be 'hertz' or 'hertz-refined' for `{model}`: "
                           "Hertz contact at the pin-axis end or refined (the rigid contact runs with `chain-S1` only, "
-                          "the impact at contact onset with `chain-S2`)")
+                          "the impact at contact onset with " + ", ".join(impact_chains) + ")")
     if eff.contact == "hertz-refined" and model not in ("chain-S2", "chain-S3", "chain-A1", "chain-A2", "chain-A5"):
         return InputError("cvt.effects.contact", eff.contact, f"must be 'hertz' for `{model}`: the refined contact "
                           "runs with chain-S2, chain-S3, chain-A1, chain-A2 and chain-A5 only so far")

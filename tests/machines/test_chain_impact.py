@@ -66,9 +66,9 @@ def test_scene_routing_and_what_impact_refuses(scene, model, x0):
     assert sum(p.n1 for p in parts) == model.size - 2 * model.n2 and parts[0].discrete == 2 * n
     s1 = load_scene("chain-S1").replace({"cvt": {"effects": {"contact": "impact"}}})
     assert "no axial inertia" in str(chain_refusal(s1))
-    a1 = load_scene("chain-A1").replace({"cvt": {"effects": {"contact": "impact"}}})
-    with pytest.raises(InputError, match=r"cvt\.effects\.contact.*chain-S2"):
-        chain_loop(a1)
+    a2 = load_scene("chain-A1").replace({"cvt": {"model": "chain-A2", "effects": {"contact": "impact"}}})
+    with pytest.raises(InputError, match=r"cvt\.effects\.contact.*chain-S2, chain-S3, chain-A1"):
+        chain_loop(a2)
     # the discrete state at the start: the ends that penetrate, and nothing lost yet
     state, loss = model.discrete_state(x0)
     assert loss == 0.0 and np.array_equal(state, np.where(model.events(0.0, x0) > 0, SLIDING, FREE))
