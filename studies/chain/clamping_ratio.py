@@ -76,27 +76,30 @@ def drift(m, t, Y):
     return ratio, rate, spans
 
 
-def plot(runs, prof, model_arc, F_pred_ratio, band_ratio, path):
+def plot(runs, prof, model_arc, F_pred_ratio, band_ratio, path, model="chain-S1"):
+    """The speed ratio of the open-loop runs over time; slip and friction along the driving arc, chain against
+    :func:`held_arc`."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
     fig, ax = plt.subplots(3, 1, figsize=(8, 10.5))
     for k, (rq, (t, ratio, rate, _)) in enumerate(runs.items()):
-        ax[0].plot(1e3 * t, ratio, c=f"C{k}", label=f"S1, loops off, F1/F2 = {rq:.4g}: drift {rate:+.3f} 1/s")
+        ax[0].plot(1e3 * t, ratio, c=f"C{k}", label=f"{model}, loops off, F1/F2 = {rq:.4g}: drift {rate:+.3f} 1/s")
     ax[0].set_xlabel("t, ms")
     ax[0].set_ylabel("speed ratio w1 / w2")
-    ax[0].set_title(f"band 6+2n holds the ratio at F1/F2 = {band_ratio:.3f}; held_arc (S1 give) predicts "
+    ax[0].set_title(f"band 6+2n holds the ratio at F1/F2 = {band_ratio:.3f}; held_arc ({model}'s give) predicts "
                     f"{F_pred_ratio:.3f}", fontsize=9)
     deg, _, _, f_t, f_r, w_t, w_r = prof
     th = np.degrees(model_arc["theta"] - model_arc["theta"][-1] / 2)
-    ax[1].plot(np.degrees(deg), 1e3 * np.abs(w_t), "o", c="C0", ms=3, label="S1 pins: |tangential slip|")
-    ax[1].plot(np.degrees(deg), 1e3 * w_r, "s", c="C1", ms=3, label="S1 pins: radial slip (outwards > 0)")
+    ax[1].plot(np.degrees(deg), 1e3 * np.abs(w_t), "o", c="C0", ms=3, label=f"{model} pins: |tangential slip|")
+    ax[1].plot(np.degrees(deg), 1e3 * w_r, "s", c="C1", ms=3, label=f"{model} pins: radial slip (outwards > 0)")
     ax[1].plot(th, 1e3 * np.abs(model_arc["w_t"]), "-", c="C0", label="held_arc: |tangential slip|")
     ax[1].plot(th, 1e3 * model_arc["w_r"], "-", c="C1", label="held_arc: radial slip")
     ax[1].set_ylabel("slip, mm/s")
-    ax[2].plot(np.degrees(deg), np.abs(f_t), "o", c="C0", ms=3, label="S1 pins: |F_t| / N")
-    ax[2].plot(np.degrees(deg), f_r, "s", c="C1", ms=3, label="S1 pins: F_r / N on the sheave (outwards > 0)")
+    ax[1].set_ylim(-80, 80)                             # the arriving pin (~ -1 m/s radially) is off the scale
+    ax[2].plot(np.degrees(deg), np.abs(f_t), "o", c="C0", ms=3, label=f"{model} pins: |F_t| / N")
+    ax[2].plot(np.degrees(deg), f_r, "s", c="C1", ms=3, label=f"{model} pins: F_r / N on the sheave (outwards > 0)")
     ax[2].plot(th, np.abs(model_arc["f_t"]), "-", c="C0", label="held_arc: |f_t|")
     ax[2].plot(th, model_arc["f_r"], "-", c="C1", label="held_arc: f_r")
     ax[2].set_ylabel("friction coefficient parts")
@@ -116,15 +119,20 @@ def main() -> None:
     ap.add_argument("--t-end", type=float, default=0.03)
     ap.add_argument("--v0", type=float, default=0.02)
     ap.add_argument("--states-dir", default="out/studies/chain/clamping")
+    ap.add_argument("--model", default="chain-S1", help="chain-S1 (give: pin spring) or chain-S2 (and Hertz)")
+    ap.add_argument("--method", default="rock4")
+    ap.add_argument("--rtol", type=float, default=1e-4)
+    ap.add_argument("--no-table", action="store_true", help="skip the held_arc table")
     ap.add_argument("--png", default="")
     a = ap.parse_args()
+    own = "S1: links + pin spring" if a.model == "chain-S1" else "H1 (S2, A1): + Hertz"
     print(f"machine: {machine()}")
     F, spans, arcs = band_steady(a.v0)
     print(f"band 6+2n (v0 {a.v0}): F1 {F[0]:.0f} N, F2 {F[1]:.0f} N, F1/F2 {F[0] / F[1]:.4f}; spans {spans[0]:.0f} / "
           f"{spans[1]:.0f} N; wraps {arcs[0]['args']['wrap']:.4f} / {arcs[1]['args']['wrap']:.4f} rad, tan(gamma) "
           f"{arcs[0]['args']['tan_gamma']:.4f} / {arcs[1]['args']['tan_gamma']:.4f}")
     print("held_arc at the band's spans: F1, F2 N, F1/F2, mean radial slip on the driving arc mm/s")
-    for v0 in V0S:
+    for v0 in () if a.no_table else V0S:
         Fv, sv, av = (F, spans, arcs) if v0 == a.v0 else band_steady(v0)
         for name, kw in gives().items():
             Fh, out = held_forces(av, sv, **kw)
@@ -132,13 +140,14 @@ def main() -> None:
                   f"({Fh[0] / Fh[1] / (Fv[0] / Fv[1]) - 1:+6.1%} on the band's)  {1e3 * out[0]['w_r'].mean():+5.1f}")
     runs, states = {}, {}
     for rq in [float(s) for s in a.ratios.split(",")]:
-        m = chain_model("chain-S1", np.array([rq * F[1], F[1]]), v0=a.v0, open_loop=True)
-        path = os.path.join(a.states_dir, f"S1_open_v0{a.v0:g}_F1F2_{rq:g}_{a.t_end * 1e3:g}ms.npz")
-        t, Y = chain_run(m, a.t_end, "rock4", 1e-4, path)
+        m = chain_model(a.model, np.array([rq * F[1], F[1]]), v0=a.v0, open_loop=True)
+        name = a.model.replace("chain-", "")
+        path = os.path.join(a.states_dir, f"{name}_open_v0{a.v0:g}_F1F2_{rq:g}_{a.t_end * 1e3:g}ms.npz")
+        t, Y = chain_run(m, a.t_end, a.method, a.rtol, path)
         ratio, rate, sp = drift(m, t, Y)
         runs[rq], states[rq] = (t, ratio, rate, sp), (m, t, Y)
-        Fh, _ = held_forces(arcs, sp, **gives()["S1: links + pin spring"])
-        print(f"S1 loops off, F1/F2 {rq:.4f}: ratio {ratio[0]:.4f} -> {ratio[-1]:.4f}, drift over the 2nd half "
+        Fh, _ = held_forces(arcs, sp, **gives()[own])
+        print(f"{a.model} loops off, F1/F2 {rq:.4f}: ratio {ratio[0]:.4f} -> {ratio[-1]:.4f}, drift over the 2nd half "
               f"{rate:+.4f} 1/s; spans (last third) {sp[0]:.0f} / {sp[1]:.0f} N; held_arc at these spans: F1/F2 "
               f"{Fh[0] / Fh[1]:.4f}")
     rq = np.array(sorted(runs))
@@ -146,7 +155,7 @@ def main() -> None:
     if len(rq) > 1 and rates.min() < 0 < rates.max():
         j = int(np.nonzero(np.diff(np.sign(rates)))[0][0])
         zero = rq[j] - rates[j] * (rq[j + 1] - rq[j]) / (rates[j + 1] - rates[j])
-        print(f"S1 holds its ratio (no drift) at F1/F2 = {zero:.4f} (linear between {rq[j]:g} and {rq[j + 1]:g}); "
+        print(f"{a.model} holds its ratio (no drift) at F1/F2 = {zero:.4f} (linear between {rq[j]:g} and {rq[j + 1]:g}); "
               f"band {F[0] / F[1]:.4f}")
     else:
         zero = rq[np.argmin(np.abs(rates))]
@@ -155,7 +164,7 @@ def main() -> None:
     m, t, Y = states[near]
     sel = slice(None, None, 2)
     prof = arc_profile(m, t[sel], Y[:, sel], 2 * t[-1] / 3, shaft=0)
-    Fh, out = held_forces(arcs, runs[near][3], **gives()["S1: links + pin spring"])
+    Fh, out = held_forces(arcs, runs[near][3], **gives()[own])
     deg, T, N, f_t, f_r, w_t, w_r = prof
     print(f"driving arc, F1/F2 {near:g}, last third: angle deg, link tension N, N per sample, F_t/N, F_r/N, slip t/r "
           f"mm/s; sum F_r / sum N sin(gamma): ", end="")
@@ -167,7 +176,7 @@ def main() -> None:
         print(f"  {np.degrees(deg[j]):6.0f} {T[j]:7.0f} {N[j]:7.0f} {f_t[j]:+.4f} {f_r[j]:+.4f} {1e3 * w_t[j]:+7.1f} "
               f"{1e3 * w_r[j]:+7.1f}")
     if a.png:
-        plot(runs, prof, out[0], Fh[0] / Fh[1], F[0] / F[1], a.png)
+        plot(runs, prof, out[0], Fh[0] / Fh[1], F[0] / F[1], a.png, a.model)
 
 
 if __name__ == "__main__":
