@@ -1,13 +1,16 @@
 """The clamping-force ratio F1/F2 that holds the ratio: the 6+2n band against the S1 chain (issue 13/14).
 
 Run:  .venv/bin/python studies/chain/clamping_ratio.py [--ratios 0.8335,1.0,1.25] [--t-end 0.03] [--v0 0.02]
-      [--states-dir out/studies/chain/clamping] [--png out/studies/chain/clamping_ratio.png]
+      [--model chain-S1] [--method rock4] [--rtol 1e-4] [--no-table] [--states-dir out/studies/chain/clamping]
+      [--png out/studies/chain/clamping_ratio.png]
+      (S1: ~1 min for the table, 60-110 s per 30 ms run at load 11-17; S2 with ``--method Radau --rtol 1e-3 --t-end
+      0.02``: 2-4.5 min per run.)
 1. The band-6+2n preset's steady start (3500 rpm, 200 N m, ratio 2.4; ``--v0`` the friction law's saturation
    speed): both arcs, span tensions and clamping forces.
 2. :func:`~cvtfem.elements.band.creep.held_arc` at the band's span tensions: the force each arc needs, without give
    (the Euler arc: the band's own F1/F2), with the chain's link stretch, pin spring (S1), Hertz give (H1), with and
    without the pins' radial slip (spiral running), for v0 = 0.02, 0.05, 0.2 m/s.
-3. The S1 chain with the loops off at held clamping forces ``F1 = ratio x F2`` (``--ratios``, F2 the band's), from
+3. The chain (``--model``) with the loops off at held clamping forces ``F1 = ratio x F2`` (``--ratios``, F2 the band's), from
    its quasi-static state to ``--t-end`` (rock4, rtol 1e-4; states cached in ``--states-dir``): the speed ratio's
    drift over the second half of the run; the F1/F2 where it does not drift (linear interpolation), against
    held_arc's prediction at the chain's own span tensions.
