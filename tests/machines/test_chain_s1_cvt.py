@@ -137,7 +137,7 @@ def test_stationary_regime_against_the_band_model(scene):
     from cvtfem.machines.chain_cvt import band_span_tensions
 
     band = build_model(scene)
-    xb = band.initial_state()                      # the band's steady start: what its 1 s run settles at (0.3 %)
+    xb = band.initial_state()                      # the band's steady start: its 1 s run's spans to 0.6 %
     q, v, _, _ = band.split(xb)
     F2 = band.outputs(0.0, xb)["driven.clamping_force"]
     T_band = band_span_tensions(band, xb)
