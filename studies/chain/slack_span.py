@@ -106,39 +106,41 @@ def window_means(m, t, Y, width):
     return np.array(rows)
 
 
-def arc_profile(m, t, Y, t_from):
-    """Along the driven arc (angle from its axis, rad, bins of :data:`BIN`) from ``t_from`` s on: bin centres and,
-    per bin, mean link tension N, summed normal force per sample N, ``F_t / N``, mean tangential and radial slip
-    m/s of the pin ends in contact."""
+def arc_profile(m, t, Y, t_from, shaft=1):
+    """Along arc ``shaft`` (1 driven, 0 driving; angle from its axis, rad, negative at the entry, bins of
+    :data:`BIN`) from ``t_from`` s on: bin centres and, per bin, mean link tension N, summed normal force per sample N,
+    the tangential and radial friction coefficients ``F_t / N``, ``F_r / N`` (on the sheave, outwards > 0), the mean
+    tangential and radial slip m/s of the pin ends in contact (radial: outwards > 0)."""
     edges = np.arange(-2.2, 2.2 + 1e-9, BIN)
     nb = len(edges) - 1
-    acc, cnt, ten, tcnt = np.zeros((4, nb)), np.zeros(nb), np.zeros(nb), np.zeros(nb)
-    nc, centre = m.family.size, m.contact.centres[1]
+    acc, cnt, ten, tcnt = np.zeros((5, nb)), np.zeros(nb), np.zeros(nb), np.zeros(nb)
+    nc, centre = m.family.size, m.contact.centres[shaft]
+    side = -1.0 if shaft == 1 else 1.0                       # the driven arc lies at x < 0 of its centre
     samples = np.nonzero(t >= t_from)[0]
     for i in samples:
         q, v = Y[:m.n2, i], Y[m.n2:2 * m.n2, i]
         pins, shafts, X, _ = m._contacts(q, v)
         _, det = m.contact.local(X, shafts, details=True)
-        s = (shafts == 1) & (det["N"] > 0)
+        s = (shafts == shaft) & (det["N"] > 0)
         arm = X[s, :2] - centre
         e_r = arm / np.linalg.norm(arm, axis=1)[:, None]
         e_t = np.column_stack([-e_r[:, 1], e_r[:, 0]])
-        b = np.digitize(np.arctan2(-arm[:, 1], -arm[:, 0]), edges) - 1
+        b = np.digitize(np.arctan2(side * arm[:, 1], side * arm[:, 0]), edges) - 1
         F_fr, w = det["F_fr"][s], det["slip"][s]
-        for j, val in enumerate([det["N"][s], (F_fr[:, :2] * e_t).sum(1), (w[:, :2] * e_t).sum(1),
-                                 (w[:, :2] * e_r).sum(1)]):
+        for j, val in enumerate([det["N"][s], (F_fr[:, :2] * e_t).sum(1), (F_fr[:, :2] * e_r).sum(1),
+                                 (w[:, :2] * e_t).sum(1), (w[:, :2] * e_r).sum(1)]):
             np.add.at(acc[j], b, val)
         np.add.at(cnt, b, 1)
         u = m.pin_positions(q[:nc])
         mid = 0.5 * (u + np.roll(u, -1, axis=0)) - centre
         T = m.family.outputs(q[:nc], v[:nc])[f"{m.family.name}.link_tension"]
-        bl = np.digitize(np.arctan2(-mid[:, 1], -mid[:, 0]), edges) - 1
+        bl = np.digitize(np.arctan2(side * mid[:, 1], side * mid[:, 0]), edges) - 1
         ok = (bl >= 0) & (bl < nb)
         np.add.at(ten, bl[ok], T[ok])
         np.add.at(tcnt, bl[ok], 1)
     with np.errstate(invalid="ignore", divide="ignore"):
         return (0.5 * (edges[1:] + edges[:-1]), ten / tcnt, acc[0] / len(samples), -acc[1] / acc[0],
-                acc[2] / cnt, acc[3] / cnt)
+                -acc[2] / acc[0], acc[3] / cnt, acc[4] / cnt)
 
 
 def plot(trend, prof, band, creep, label, path):
@@ -155,7 +157,7 @@ def plot(trend, prof, band, creep, label, path):
     ax[0].axhline(0.0, c="k", lw=0.8)
     ax[0].set_ylabel("span tension / band 6+2n - 1")
     ax[0].set_xlabel("t, ms (window means)")
-    deg, T, _, f, _, _ = prof
+    deg, T, _, f, _, _, _ = prof
     arc = band["arc"]
     half = arc["args"]["wrap"] / 2
     on = np.abs(deg) <= half
@@ -218,7 +220,7 @@ def main() -> None:
               f"{ts:5.0f} N ({ts / Te[1] - 1:+.2%}), mean ({(tt + ts) / Te.sum() - 1:+.2%}), F1 {F1:.0f} N, "
               f"ratio {ratio:.4f}")
     prof = arc_profile(m, t[::2], Y[:, ::2], t[-1] / 2)
-    deg, T, N, f, wt, wr = prof
+    deg, T, N, f, _, wt, wr = prof
     print("driven arc, second half of the run: angle deg, link tension N, normal force N, F_t/N, slip t/r mm/s")
     for j in np.nonzero(np.isfinite(f) & (np.abs(deg) <= args["wrap"] / 2 + BIN))[0]:
         print(f"  {np.degrees(deg[j]):6.0f} {T[j]:7.0f} {N[j]:7.0f} {f[j]:+.4f} {1e3 * wt[j]:+8.1f} "

@@ -128,7 +128,10 @@ def test_stationary_regime_against_the_band_model(scene):
     band model's stationary clamping forces, 10 ms (means over the last 6 ms, every 25 us).  This window lies in
     S2's start transient (observed -3.2 %, -3.0 %): run on, its slack span rises to +11.3 % at 75-80 ms and is not
     settled (H1's give makes the chain's slip grow along the arc, docs/chain.md, "The span tensions against the band
-    model"), so the 5 % is asserted here for the transient state only."""
+    model"), so the 5 % is asserted here for the transient state only.  Session 8: S2 holds the ratio at F1/F2 = 1.094
+    (the band at 0.834: the pins' radial slip as their give changes along the driving arc), where its slack span is
+    ~+11 % above the band's; a run there (loops off, 20 ms of Radau) takes 2-4.5 min, over a slow test's budget
+    (``studies/chain/clamping_ratio.py --model chain-S2``)."""
     F, T_band, _ = band_reference(scene)
     m = from_scene(scene, reference_geometry(), F)
     x0, rep = m.static_state(RATIO, scene.cvt.regime.input_speed)

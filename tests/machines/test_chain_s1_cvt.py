@@ -5,15 +5,14 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from cvtfem.elements.band.creep import creep_arc
 from cvtfem.elements.chain.geometry import reference_geometry
 from cvtfem.errors import InputError
+from cvtfem.integrate import solve
 from cvtfem.machines.chain_cvt import from_scene
 from cvtfem.machines.chain_s1_cvt import ChainS1CVT
 from cvtfem.machines.cvt import chain_refusal
 from cvtfem.scene.loader import load_scene
-from tests.machines.chain_checks import (assert_energy_balance, assert_jacobian_on_pattern, band_reference, perturbed,
-                                         stationary_means)
+from tests.machines.chain_checks import assert_energy_balance, assert_jacobian_on_pattern, perturbed
 
 RATIO = 2.4
 F_APPL = np.array([30000.0, 35000.0])   # N per sheave
@@ -114,29 +113,60 @@ def test_energy_balance_over_a_short_run(model, static):
 
 @pytest.mark.slow
 def test_stationary_regime_against_the_band_model(scene):
-    """Issue 13's acceptance for S1: 3500 rpm, 200 N m, ratio 2.4, from the quasi-static state with the band model's
-    stationary clamping forces, 20 ms of rock4 at rtol 1e-4, means over 10-20 ms (every 25 us): pin axial forces on
-    each sheave balance its clamping force to 1 %, both span tensions agree with the 6+2n band model's to 5 %
-    (observed +1.4 %, +2.7 %).  Before 10 ms the slack span is still in the start transient (+5.5 % over 5-10 ms); at
-    rtol 1e-3 rock4's error in the pins' slip, through the concave friction law, biases it by +3-4 %.  This window is
-    not a settled state: with the ratio loop raising F1 the slack span drifts on to +5.9 % over 60-80 ms, and with the
-    clamping forces held it sits at -5 % (docs/chain.md, "The span tensions against the band model").
+    """Issue 13's acceptance for S1 at its settled operating point: 3500 rpm, 200 N m, ratio 2.4, the band's driven
+    clamping force F2 and torque, loops off, and the driving clamping force that holds the chain's ratio.  That force
+    is the chain's, not the band's: the 6+2n band holds the ratio at F1/F2 = tan(gamma_2) wrap_1 / (tan(gamma_1)
+    wrap_2) = 0.834 (its slip, taken at h = 0, is uniform and has no radial part), the S1 chain at F1/F2 = 1.00
+    (``studies/chain/clamping_ratio.py``: loops off, the speed ratio drifts +0.37 1/s at 0.834, -0.0025 1/s at 1.0,
+    -0.64 1/s at 1.25).  The difference is spiral running: each pin's axial give changes with its load along the arc,
+    so the pins rise through the driving arc (+10 mm/s, against 20-30 mm/s of tangential slip and v0 = 20 mm/s), the
+    friction turns against that, and the driving sheave must clamp harder for the same span tensions
+    (docs/chain.md, "The span tensions against the band model").
 
-    Why the chain runs above the band: the band's slip is uniform along the arc, the chain's grows with its link
-    stretch and pin give.  The band's own span tensions are the arc balance with uniform slip (1e-4); with the
-    chain's creep the arc balance gives the chain's to 2 % (observed -0.2 %, -1.2 %)."""
-    F, T_band, arc = band_reference(scene)
-    m = from_scene(scene, reference_geometry(), F, model="chain-S1", contact="rigid")
+    20 ms of rock4 at rtol 1e-4 from the quasi-static state, F1 = F2, means over 10-20 ms (69 s at load 12): pin axial
+    forces balance each clamping force to 1 %; the ratio holds: its drift, a linear fit over the window, is below 0.15
+    1/s (observed -0.050; a 10 ms fit resolves it to ~0.05 1/s through the link-passing ripple: -0.044 over 10-20 ms,
+    -0.036 over 20-30 ms, -0.003 over 15-30 ms in the study's 30 ms run, where the band's F1/F2 gives +0.38 and 1.25
+    gives -0.65), its mean within 1 % of 2.4 (2.415); the tight span agrees with the band's to 5 % (observed
+    +2.3 %).  The slack span does not meet the issue's 5 % (observed +7.7 %): the chain's creep and the pins' radial
+    slip move it, and the driven arc's balance with both (``held_arc`` with S1's link stretch and pin spring) needs the
+    clamping force F2 at the chain's span tensions to 2 % (observed +0.6 %), where the band's uniform-slip arc would
+    need over 3 % more (observed +5.1 %)."""
+    from cvtfem.elements.band.creep import band_arc, held_arc
+    from cvtfem.machines import build_model
+    from cvtfem.machines.chain_cvt import band_span_tensions
+
+    band = build_model(scene)
+    xb = band.initial_state()                      # the band's steady start: its 1 s run's spans to 0.6 %
+    q, v, _, _ = band.split(xb)
+    F2 = band.outputs(0.0, xb)["driven.clamping_force"]
+    T_band = band_span_tensions(band, xb)
+    arc = band_arc(band.model, q, v, 1)["args"]
+    open_loop = scene.replace({"cvt": {"effects": {"stabilisation": False}}})
+    m = from_scene(open_loop, reference_geometry(), np.array([F2, F2]), model="chain-S1", contact="rigid")
     x0, _ = m.static_state(RATIO, scene.cvt.regime.input_speed)
-    T, axial, clamp = stationary_means(m, x0, t_end=20e-3, window=10e-3, method="rock4", rtol=1e-4)
+    t_eval = np.linspace(10e-3, 20e-3, 401)
+    res = solve(m, (0.0, 20e-3), x0, method="rock4", rtol=1e-4, atol=1e-7, n2=m.n2, jac=m.jac,
+                jac_sparsity=m.jac_sparsity, t_eval=t_eval)
+    assert res.status == 0
+    outs = [m.outputs(t, y) for t, y in zip(res.t, res.y.T)]
+    T = np.nanmean([o["chain.span_tension"] for o in outs], axis=0)
+    axial = np.mean([o["contact.sheave_axial_force"] for o in outs], axis=0)
+    ratio = np.array([o["ratio"] for o in outs])
+    drift = np.polyfit(res.t, ratio, 1)[0]
     geom = m.family.geom
-    creep = creep_arc(**arc["args"], EA=geom.c_link[0] * geom.L[0], c_pin=geom.c_pin[0], pitch=geom.L[0])["T"]
-    print(f"band: tight {T_band[0]:.0f} N, slack {T_band[1]:.0f} N; S1: tight {T[0]:.0f} N, slack {T[1]:.0f} N; "
-          f"creeping band {creep[0]:.0f} N, {creep[1]:.0f} N; axial/clamping {axial / clamp}")
-    np.testing.assert_allclose(axial, clamp, rtol=0.01)
-    assert np.all(np.abs(T / T_band - 1) <= 0.05)
-    np.testing.assert_allclose(creep_arc(**arc["args"])["T"], arc["T"], rtol=1e-4)
-    np.testing.assert_allclose(T, creep, rtol=0.02)
+    give = dict(EA=geom.c_link[0] * geom.L[0], c_pin=geom.c_pin[0], pitch=geom.L[0])
+    F2_chain = held_arc(**arc, T_in=T[1], T_out=T[0], **give)["F"]
+    F2_band = held_arc(**arc, T_in=T[1], T_out=T[0], pitch=geom.L[0])["F"]
+    print(f"band: {T_band[0]:.0f} / {T_band[1]:.0f} N; S1 at F1 = F2: {T[0]:.0f} / {T[1]:.0f} N "
+          f"({T[0] / T_band[0] - 1:+.2%} / {T[1] / T_band[1] - 1:+.2%}), ratio {ratio.mean():.4f}, drift {drift:+.4f} "
+          f"1/s; the driven arc needs {F2_chain:.0f} N with the chain's give, {F2_band:.0f} N without (F2 {F2:.0f} N)")
+    np.testing.assert_allclose(axial, F2, rtol=0.01)
+    assert abs(drift) < 0.15
+    assert ratio.mean() == pytest.approx(RATIO, rel=0.01)
+    assert abs(T[0] / T_band[0] - 1) <= 0.05
+    assert F2_chain == pytest.approx(F2, rel=0.02)
+    assert F2_band > 1.03 * F2
 
 
 def test_pin_end_axial_positions_follow_the_faces(model, static):
