@@ -140,9 +140,9 @@ class ElasticChainHalvesCVT(ElasticChainACVT, ChainHalvesCVT):
             return x0, {"kind": f"placed on the sheaves on undeformed elastic shafts, off balance (rigid start: "
                                 f"{rep['placed']})", "model": rep["model"]}
         what = "quasi-static" if rep["unbalanced"] is None else "off balance, the quasi-static solve not converged:"
-        return x0, {"kind": f"{what} on elastic shafts (residual {rep['residual']:.1e} of F2 after {rep['nfev_elastic']} "
-                            f"evaluations; rigid A5 start {rep['rigid_residual']:.1e}), largest penetration "
-                            f"{1e6 * rep['max_penetration']:.1f} um", "model": rep["model"]}
+        return x0, {"kind": f"{what} on elastic shafts (residual {rep['residual']:.1e} of F2 after "
+                            f"{rep['nfev_elastic']} evaluations; rigid A5 start {rep['rigid_residual']:.1e}), largest "
+                            f"penetration {1e6 * rep['max_penetration']:.1f} um", "model": rep["model"]}
 
     def static_state(self, ratio: float, w1: float, tension: float | None = None, tol: float = 1e-10):
         """:meth:`ElasticChainACVT.static_state` with ``report["rigid_residual"]``, the rigid A5 start's residual
@@ -168,7 +168,7 @@ class ElasticChainHalvesRefinedCVT(ElasticChainHalvesCVT, ChainHalvesRefinedCVT)
         seven chain positions, mirrored, then the sheave's translation, tilt and the other sheave's axial position):
         A1's map (:meth:`ElasticChainACVT._refined_frame`) of the points ``x - c, x, x + c``, gathered back."""
         K, dK = super()._refined_frame(P @ SPREAD.T, k, j)
-        return K @ GATHER.T, np.einsum("ij,mjk,kl->mil", GATHER, dK, SPREAD)
+        return K @ GATHER.T, GATHER @ dK @ SPREAD
 
 
 def elastic_halves(rigid: ChainHalvesCVT, structure) -> ElasticChainHalvesCVT:
