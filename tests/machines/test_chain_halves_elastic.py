@@ -105,9 +105,9 @@ def test_construction_and_scene_path():
         m = chain_loop(scene)
         assert type(m) is cls and type(m.rigid()) is rigid_cls and m.z_ref is None
         assert m.n2 == 21 * scene.cvt.chain.n_pins + m.structure.n and m.n_ends == 4 * m.family.n
-        listed = [o.name for part in layout(scene) for o in part.outputs]
-        assert sorted(listed) == sorted(o.name for o in m.output_specs)
-        assert sum(p.n2 for p in layout(scene)) == m.n2
+    parts = layout(scene)                                   # variant (zh)'s: the model it builds is m
+    assert sorted(o.name for part in parts for o in part.outputs) == sorted(o.name for o in m.output_specs)
+    assert sum(p.n2 for p in parts) == m.n2
     e = load_scene("variant-e")
     with pytest.raises(InputError, match=r"hertz-refined.*chain-A5-point"):     # the point contact by name
         chain_loop(e.replace({"cvt": {"model": "chain-A5-point"}}))
