@@ -26,6 +26,7 @@ the rigid placement on undeformed shafts, off balance, and the start's ``kind`` 
 from __future__ import annotations
 
 from dataclasses import dataclass, fields, replace
+from functools import cached_property
 from typing import ClassVar
 
 import numpy as np
@@ -72,6 +73,17 @@ class ElasticChainHalvesCVT(ElasticChainACVT, ChainHalvesCVT):
     #: The elastic start's lifted Newton may end above ``static_residual_limit`` (the span halves' axial positions
     #: and the driven shaft's end tilts; docs/transmission.md): the run starts from the state it reached and says so.
     keeps_unbalanced_start: ClassVar[bool] = True
+
+    @cached_property
+    def _pair_map_table(self) -> tuple:
+        """``(ends, shafts, sheaves, cols, coef)`` of the mapped contact of every ``(end, shaft)`` pair, row ``2 end +
+        shaft`` (built once; the broad phase's candidates index it)."""
+        return self._pairs_map(*self._all_pairs())
+
+    def _mapped_pairs(self, q):
+        ends, shafts = self._candidates(q)
+        rows = 2 * ends + shafts
+        return tuple(a[rows] for a in self._pair_map_table)
 
     def rigid(self) -> ChainHalvesCVT:
         cls = self.rigid_class
