@@ -30,6 +30,7 @@ from functools import cached_property
 from typing import ClassVar
 
 import numpy as np
+import scipy.sparse as sp
 
 from cvtfem.errors import NumericalError
 from cvtfem.machines.chain_cvt_elastic import ElasticChainACVT
@@ -61,6 +62,8 @@ def _gather_matrix() -> np.ndarray:
 
 
 SPREAD, GATHER = _spread_matrix(), _gather_matrix()
+#: Arm (m) at which the elastic start measures the structure's tilts (about the contact radii).
+TILT_ARM = 0.05
 
 
 @dataclass(frozen=True, eq=False)
@@ -102,8 +105,19 @@ class ElasticChainHalvesCVT(ElasticChainACVT, ChainHalvesCVT):
 
     def _solve_elastic_balance(self, residual, jacobian, y0, tol: float):
         """:func:`~cvtfem.machines.static_balance.lifted_newton` (as the rigid A5 start: the span halves' axial
-        positions have no stiffness of their own, and the rolling halves make the static stiffness indefinite)."""
-        return lifted_newton(residual, jacobian, y0, tol)
+        positions have no stiffness of their own, and the rolling halves make the static stiffness indefinite) on the
+        structure's tilts as arc lengths at :data:`TILT_ARM` (rotations and moments in the units of the rest: the
+        lift compares diagonal stiffnesses, which would lift the tilts in rad as if they had none)."""
+        nc, s = self._idx[0], self.structure
+        held = np.concatenate([nc + np.flatnonzero(s.dof_kind == 5), self._idx[2][:1]])
+        free = np.setdiff1d(np.arange(self.n2), held)                  # the unknowns of _elastic_static
+        tilts = nc + np.flatnonzero(np.isin(s.dof_kind, (3, 4)))
+        scale = np.where(np.isin(free, tilts), 1.0 / TILT_ARM, 1.0)
+        D = sp.diags(scale)
+        sol = lifted_newton(lambda z: scale * residual(scale * z), lambda z: D @ jacobian(scale * z) @ D,
+                            np.asarray(y0) / scale, tol)
+        sol.x = scale * sol.x
+        return sol
 
     def _elastic_static(self, x0r, rep, w1, tol):
         """:meth:`ElasticChainACVT._elastic_static` from a converged rigid start; from the rigid placement
