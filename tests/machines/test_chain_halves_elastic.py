@@ -363,3 +363,33 @@ def test_cvtfem_run_variant_e(cli, tmp_path):
     assert start.startswith("placed on the sheaves on undeformed elastic shafts") and "residual" in start
     assert np.abs(speed / (3500 * np.pi / 30) - 1).max() < 1e-3
     assert W[0] > 0.0 and abs(W[0] - W[1] - W[2] + W[3] - (E[-1] - E[0])) < 1e-5 * W[0]
+
+
+@pytest.mark.slow
+def test_start_of_variant_zh_on_elastic_shafts():
+    """The uniform chain's start of variant (zh) (clamping 30 / 35 kN): the rigid A5 start (lifted Newton, 5e-5 of F2),
+    then chain and structure together; the lifted Newton ends at about 1.1e-4 of F2, just above the limit 1e-4, so
+    the start keeps the state it reached and says so.  There the pins push the movable sheaves with the clamping
+    forces (F1 the held sheave's reaction; 1e-3) and the fixed ones with nearly the same (2e-3), each shaft's
+    bearings carry the resultant of the frictionless contact forces on its sheaves (1e-6), the sheaves of a pulley
+    tilt opposite ways (their main components; the other is a thousandth of it), and F1 is within 2 % of the rigid
+    A5's."""
+    rigid, model = _rigid("zh")
+    w1, _, i = rigid.regime.targets(0.0)
+    x0, rep = model.static_state(i, w1)
+    assert rep["rigid_residual"] < 1e-4 and rep["residual"] < 2e-4
+    assert (rep["unbalanced"] is None) == (rep["residual"] <= model.static_residual_limit)
+    m = rep["model"]
+    o = m.outputs(0.0, x0)
+    F = np.array([rep["F1"], rep["F2"]])
+    np.testing.assert_allclose(o["contact.sheave_axial_force"], F, rtol=1e-3)
+    np.testing.assert_allclose(o["contact.fixed_sheave_axial_force"], o["contact.sheave_axial_force"], rtol=2e-3)
+    n2 = m.n2
+    _, k, _, _, _, _, Y = m._mapped_set(x0[:n2], np.zeros(n2))
+    for s, name in enumerate(("driving", "driven")):
+        b = o[f"{name}.bearing_force"].reshape(2, 3)
+        np.testing.assert_allclose(b.sum(axis=0), Y[k == s, 3:6].sum(axis=0), rtol=1e-6, atol=1e-6 * F[1])
+        tilt = o[f"{name}.sheave_tilt"].reshape(2, 2)
+        main = np.argmax(abs(tilt[0]))                        # about the in-plane axis across the chain's path
+        assert 1e-5 < abs(tilt).max() < 1e-2 and tilt[0, main] * tilt[1, main] < 0
+    assert abs(rep["F1"] / rep["rigid_F1"] - 1) < 0.02
