@@ -84,7 +84,7 @@ class ElasticChainCVT(ChainCVT):
         rs = self.rigid_start
         if rs is None:
             w1, _, i = self.regime.targets(0.0)
-            rs = (i, w1) + tuple(self.rigid().static_state(i, w1))
+            rs = (i, w1) + tuple(self._rigid_static_state(i, w1))
         return self._face_reference(rs[2]), rs
 
     @property
@@ -147,6 +147,9 @@ class ElasticChainCVT(ChainCVT):
     sheaves_per_end: ClassVar[int] = 2
     #: The sheaves' axial motion counts from the pulley's mid-plane (the symmetric chain has no axial motion).
     axial_relative: ClassVar[bool] = True
+    #: Where the elastic start's solve ends above ``static_residual_limit``: raise (False), or keep the state it
+    #: reached with the failure in ``report["unbalanced"]`` (True: a chain whose balance the solve may not reach).
+    keeps_unbalanced_start: ClassVar[bool] = False
 
     def _mapped_pairs(self, q):
         """``(ends, shafts, sheaves, cols, coef)``: each broad-phase candidate with both sheaves (0 fixed,
@@ -451,9 +454,20 @@ class ElasticChainCVT(ChainCVT):
         if rs is not None and tension is None and (rs[0], rs[1]) == (ratio, w1):
             x0r, rep = rs[2], rs[3]
         else:
-            x0r, rep = self.rigid().static_state(ratio, w1, tension, tol)
+            x0r, rep = self._rigid_static_state(ratio, w1, tension, tol)
         model = replace(self, z_ref=self._face_reference(x0r), rigid_start=(ratio, w1, x0r, rep))
         return model._elastic_static(x0r, rep, w1, tol)
+
+    def _rigid_static_state(self, ratio: float, w1: float, tension: float | None = None, tol: float = 1e-10):
+        """``(x0, report)`` of the rigid model's quasi-static start (the hook a chain whose rigid start may fail
+        overrides)."""
+        return self.rigid().static_state(ratio, w1, tension, tol)
+
+    def _solve_elastic_balance(self, residual, jacobian, y0, tol: float):
+        """The elastic start's solve of ``residual(y) = 0`` with the sparse ``jacobian(y)``: scipy's dense
+        Levenberg-Marquardt (the hook a chain with an indefinite, singular static stiffness overrides)."""
+        return least_squares(residual, y0, jac=lambda y: jacobian(y).toarray(), method="lm", xtol=tol, ftol=tol,
+                             gtol=tol, x_scale=1e-5, max_nfev=200)
 
     def _face_reference(self, x0r) -> np.ndarray:
         """``z_ref`` (2, 2) from the rigid start ``x0r``: both faces of a pair at its ``z``."""
@@ -498,18 +512,20 @@ class ElasticChainCVT(ChainCVT):
             x = np.concatenate([qq, vel, self.control.initial_state(0.0, 0.0), np.zeros(4)])
             K = self.jac(0.0, x)[n2:2 * n2, :n2]
             Ms = sp.block_diag([sp.csr_matrix(fam.mass_matrix()), self.structure.M], format="csr")
-            dQ = (Ms @ K).toarray()
-            dQ[mu3[0]] += dQ[iz[0]]
-            return dQ[free][:, free] / F2
-        sol = least_squares(lambda y: forces(y)[free] / F2, q[free], jac=jacobian, method="lm", xtol=tol,
-                            ftol=tol, gtol=tol, x_scale=1e-5, max_nfev=200)
+            held_reaction = sp.csr_matrix(([1.0], ([mu3[0]], [iz[0]])), shape=(n2, n2))
+            dQ = (sp.identity(n2, format="csr") + held_reaction) @ (Ms @ K)
+            return sp.csr_matrix(dQ)[free][:, free] / F2
+        sol = self._solve_elastic_balance(lambda y: forces(y)[free] / F2, jacobian, q[free], tol)
         q[free] = sol.x
         Q = forces(sol.x)
         res = float(np.abs(Q[free]).max() / F2)
-        if not res <= 1e-6:
-            raise NumericalError(f"the quasi-static solve on elastic shafts ended with a residual of {res:.3g} of the "
-                                 f"clamping force after {sol.nfev} evaluations ({sol.message})",
-                                 component="ElasticChainCVT.static_state")
+        unbalanced = None
+        if not res <= self.static_residual_limit:
+            unbalanced = NumericalError(f"the quasi-static solve on elastic shafts ended with a residual of {res:.3g} "
+                                        f"of the clamping force after {sol.nfev} evaluations ({sol.message})",
+                                        component="ElasticChainCVT.static_state")
+            if not self.keeps_unbalanced_start:
+                raise unbalanced
         side = self._sides[:, 1]
         F1 = float(Q[iz[0]] / side[0])
         v = np.zeros(n2)
@@ -522,6 +538,7 @@ class ElasticChainCVT(ChainCVT):
         x0 = np.concatenate([q, v, self.control.initial_state(*w), np.zeros(4)])
         _, _, _, (_, c) = self._contacts(q, v, details=True)
         report = dict(rep, residual=res, F1=F1, rigid_F1=rep["F1"], model=self, nfev_elastic=sol.nfev,
+                      unbalanced=None if unbalanced is None else str(unbalanced),
                       max_penetration=float(c["delta"].max()),
                       tension=float(self._elastic_link_tension(q[:nc]).mean()))
         return x0, report
@@ -559,6 +576,9 @@ class ElasticChainACVT(ElasticChainCVT, ChainACVT):
     kernel_share: ClassVar[float] = 1.0
     sheaves_per_end: ClassVar[int] = 1
     axial_relative: ClassVar[bool] = False
+    #: H2: the kernel's chain position inputs (without ``z``) and the slots of the end's ``X1, X2, X3`` among them.
+    refined_chain_inputs: ClassVar[int] = N_REFINED_CHAIN
+    refined_end_slots: ClassVar[tuple] = (2, 3, 6)
 
     def _sheave_of(self, ends, shafts) -> np.ndarray:
         """Sheave (0 fixed, 1 movable) an end on side ``+-1`` (odd ends: ``x3 > 0``) meets on each shaft."""
@@ -568,7 +588,7 @@ class ElasticChainACVT(ElasticChainCVT, ChainACVT):
     def _pairs_map(self, ends, shafts):
         j = self._sheave_of(ends, shafts)
         cols, coef = ChainACVT._contact_map(self, ends, shafts)
-        n_chain = N_REFINED_CHAIN if self.contact.refined else 3        # the kernel's chain positions (no z)
+        n_chain = self.refined_chain_inputs if self.contact.refined else 3   # the kernel's chain positions (no z)
         return (ends, shafts, j) + self._mapped_map(cols[:, :n_chain], coef[:, :n_chain], shafts, j)
 
     def mapped_local(self, Z, k, j, details: bool = False, sign=None):
@@ -579,18 +599,20 @@ class ElasticChainACVT(ElasticChainCVT, ChainACVT):
         coupled-halves kernel (variant (v)), an input of it before the spin rate."""
         if not self.contact.refined:
             return super().mapped_local(Z, k, j, details)
-        n = N_REFINED_CHAIN + 6
+        nk = self.refined_chain_inputs
+        n = nk + 6
         P, V = Z[:, :n], Z[:, n:2 * n]
         K, dK = self._refined_frame(P, k, j)
         extra = [] if sign is None else [sign]
         kin = np.column_stack([K, np.einsum("mij,mj->mi", dK, V)] + extra + [Z[:, -1]])
         out = self.contact.local(kin, k, details)
         Y, det = out if details else (out, None)
-        Q = np.einsum("mij,mi->mj", dK[:, :N_REFINED_CHAIN], Y[:, :N_REFINED_CHAIN])   # z_ref is a constant
+        Q = np.einsum("mij,mi->mj", dK[:, :nk], Y[:, :nk])                  # z_ref is a constant
         res = np.column_stack([Q, Y[:, -2], Y[:, -1]])
         if not details:
             return res
-        return res, dict(det, X=K[:, [2, 3, 6]], tilt=_tilt(P[:, 12:14]), side=self._sides[k, j].astype(float))
+        return res, dict(det, X=K[:, list(self.refined_end_slots)], tilt=_tilt(P[:, nk + 3:nk + 5]),
+                         side=self._sides[k, j].astype(float))
 
     def _refined_frame(self, P, k, j):
         """``(K, dK/dP)``: the H2 kernel's position inputs (m, 10) in the frame of the displaced, tilted sheave ``j``
@@ -656,7 +678,7 @@ class ElasticChainACVT(ElasticChainCVT, ChainACVT):
         for kk in range(2):
             pins = np.unique(self.pin_of(e[(k == kk) & (det["delta"] > 0)]))
             centre = self.contact.centres[kk] + q[nc + s.sheave_dofs[kk, :, :2]].mean(axis=0)
-            ChainACVT._turn_with_sheave(self, q[:nc], v[:nc], pins, v[iphi[kk]], centre)
+            self._turn_with_sheave(q[:nc], v[:nc], pins, v[iphi[kk]], centre)
 
 
 @dataclass(frozen=True, eq=False)
@@ -686,6 +708,10 @@ def elastic(rigid: ChainCVT, structure: ShaftStructure) -> ElasticChainCVT:
     """The rigid transmission ``rigid`` (ChainCVT, or ChainACVT: :class:`ElasticChainACVT`) on ``structure``
     (``z_ref`` set by :meth:`ElasticChainCVT.static_state`)."""
     args = (rigid.family, rigid.contact, rigid.J, rigid.m_sheave, rigid.regime, rigid.F_appl, rigid.control)
+    from cvtfem.machines.chain_halves_cvt import ChainHalvesCVT   # the A5 transmissions build on this module
+    if isinstance(rigid, ChainHalvesCVT):
+        from cvtfem.machines.chain_halves_elastic_cvt import elastic_halves
+        return elastic_halves(rigid, structure)
     if isinstance(rigid, ChainACVT):
         cls = ElasticChainA2CVT if isinstance(rigid, ChainA2CVT) else ElasticChainACVT
         return cls(*args, movable_side=rigid.movable_side, fixed_z=rigid.fixed_z,

@@ -257,14 +257,17 @@ def chain_refusal(scene: Scene) -> InputError | None:
     if model == "chain-S1" and eff.contact != "rigid":
         return InputError("cvt.effects.contact", eff.contact, "must be 'rigid' for `chain-S1`: its pins have no axial "
                           "coordinate, their ends follow the sheave faces (chain-models-1 2.2)")
-    if eff.shaft_elasticity and model not in ("chain-S2", "chain-S3", "chain-A1", "chain-A2"):
+    if eff.shaft_elasticity and model not in ("chain-S2", "chain-S3", "chain-A1", "chain-A2", "chain-A5",
+                                              "chain-A5-point"):
         return InputError("cvt.effects.shaft_elasticity", True, f"is not available for `{model}` yet: elastic shafts "
-                          "run under chain-S2, chain-S3, chain-A1 and chain-A2 (set it false to run on rigid shafts)")
+                          "run under chain-S2, chain-S3, chain-A1, chain-A2 and chain-A5 (set it false to run on rigid "
+                          "shafts)")
     if eff.shaft_elasticity and eff.contact != "hertz" and not (eff.contact == "hertz-refined"
-                                                                and model in ("chain-A1", "chain-A2")):
+                                                                and model in ("chain-A1", "chain-A2", "chain-A5")):
         return InputError("cvt.effects.shaft_elasticity", True, f"is not available with contact '{eff.contact}' for "
                           f"`{model}` yet: elastic shafts run with H1 contact ('hertz'), or the refined one under "
-                          "chain-A1 and chain-A2 (variants (b), (v)); set it false for the refined or rigid contact")
+                          "chain-A1, chain-A2 and chain-A5 (variants (b), (v), (e)); set it false for the refined or "
+                          "rigid contact")
     if model != "chain-S1" and eff.contact not in ("hertz", "hertz-refined", "impact"):
         return InputError("cvt.effects.contact", eff.contact, f"must be 'hertz' or 'hertz-refined' for `{model}`: "
                           "Hertz contact at the pin-axis end or refined (the rigid contact runs with `chain-S1` only, "

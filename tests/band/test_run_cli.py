@@ -37,9 +37,9 @@ def test_run_writes_results_and_summary(cli, tmp_path):
 
 
 def test_chain_model_without_a_time_run_is_refused(cli):
-    proc = cli("run", "reference_cvt", "--results", "none")      # chain-A5 on elastic shafts: not built yet
+    proc = cli("run", "chain-S3-refined,shafts-elastic", "--results", "none")      # S3 + H2 on elastic shafts: not yet
     assert proc.returncode == 2
-    assert "cvt.effects.shaft_elasticity" in proc.stderr and "chain-A5" in proc.stderr and "chain-S2" in proc.stderr
+    assert "cvt.effects.shaft_elasticity" in proc.stderr and "chain-S3" in proc.stderr and "chain-A5" in proc.stderr
     assert len(proc.stderr.splitlines()) == 1
     proc = cli("run", "band-1dof", "--results", "none")
     assert proc.returncode == 2 and "static" in proc.stderr
