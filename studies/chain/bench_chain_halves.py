@@ -9,11 +9,11 @@ The reference chain (band-6+2n scene values, clamping 30/35 kN) placed on the sh
 :meth:`ChainHalvesCVT.placed_state`, halves rolling on each other; A1, S2: the wedge estimate's placement) with
 random coordinate offsets (0.2 um) and velocities (0.05 m/s).  Per model: ``rhs`` (chain pass, contacts, loops) and
 ``jac`` (all blocks: the Jacobian is asked alternately at two states 1e-12 m apart, so no cached block is reused);
-for A5 also the family's compiled pass, the contact pass (``_contact_forces``: broad phase, gather, kernel,
-scatter) and the family's element-by-element Jacobian (its default, exact link blocks, and central link
-differences).  Wall medians (:mod:`cvtfem.analysis.timing`) and medians of process CPU time over batches (on a
-loaded machine CPU time is the steadier figure), the Jacobians in RHS-equivalents of both; the machine and its load (1, 5, 15 min) before and
-after.  The script runs on older trees too (``PYTHONPATH``), for before/after tables.
+for A5 also the family's compiled pass, the contact pass (``_contact_forces``: broad phase, gather, kernel, scatter)
+and the family's element-by-element Jacobian (its default, exact link blocks, and central link differences).  Wall
+medians (:mod:`cvtfem.analysis.timing`) and medians of process CPU time over batches (on a loaded machine CPU time
+is the steadier figure), the Jacobians in RHS-equivalents of both; the machine and its load (1, 5, 15 min) before
+and after.  The script runs on older trees too (``PYTHONPATH``), for before/after tables.
 """
 from __future__ import annotations
 

@@ -132,8 +132,11 @@ def _end_strains(ve, l, L, te):
     k = 2.0 / l
     psi1 = k * (t0 * ve[0, 2] + t1 * ve[0, 3]) + t2
     psi2 = k * (t0 * ve[1, 2] + t1 * ve[1, 3]) + t2
-    te[1, 0], te[1, 1], te[1, 2] = (k * ve[0, 2] - t0 * psi1) * il, (k * ve[0, 3] - t1 * psi1) * il, (1.0 - t2 * psi1) * il
-    te[2, 0], te[2, 1], te[2, 2] = (k * ve[1, 2] - t0 * psi2) * il, (k * ve[1, 3] - t1 * psi2) * il, (1.0 - t2 * psi2) * il
+    for a in range(2):
+        psi = psi1 if a == 0 else psi2
+        te[1 + a, 0] = (k * ve[a, 2] - t0 * psi) * il
+        te[1 + a, 1] = (k * ve[a, 3] - t1 * psi) * il
+        te[1 + a, 2] = (1.0 - t2 * psi) * il
     return psi1, psi2, Lt - L
 
 
@@ -170,38 +173,6 @@ def _to_link(out, g0, g1, g2, x, xis, Hm, ve, te, l):
         out[o + 8] += fw - k * S
         out[o + 9] += fw * xis[b]
         out[20 + b] += k * S
-
-
-@njit(cache=True)
-def _plate(x, xd, e, k, L, plate_w, plate_d, plate_c, plate_c1, plate_c2, par, kmodel, wk, gr):
-    """Plate ``k`` of link ``e``: its virtual ends, strains and state into the scratch ``wk``, and into ``gr`` (8,) the
-    generalized forces on its strains ``g = -A^T (stress + D A epsdot)`` (times the plate weight), the state-projected
-    strain rates ``r = A epsdot``, the power of its damping forces (W), the state (1..10) and whether it is slack
-    within a difference step of tension (:func:`_near_kink`).  Returns the tension (N, weighted)."""
-    Hm, ve, te, A, m, ed, xis = wk[0], wk[1], wk[2], wk[3], wk[4], wk[5], wk[8]
-    l, beta_ext, beta_shear, h_pl = par[0], par[6], par[7], par[15]
-    pw = plate_w[e, k]
-    xis[0] = _virtual_end(x, xd, 0, plate_d[e, k], l, Hm, ve)
-    xis[1] = _virtual_end(x, xd, 1, plate_d[e, k], l, Hm, ve)
-    c, c1, c2 = plate_c[e, k], plate_c1[e, k], plate_c2[e, k]
-    psi1, psi2, Delta = _end_strains(ve, l, L[e], te)
-    st, d1, d2, tension = _plate_law(kmodel, psi1, psi2, Delta, c, c1, c2, h_pl, A, m)
-    z1, z2 = psi1 - d1, psi2 - d2
-    _end_rates(ve, l, te, ed)
-    r0 = A[0, 0] * ed[0] + A[0, 1] * ed[1] + A[0, 2] * ed[2]
-    r1 = A[1, 0] * ed[0] + A[1, 1] * ed[1] + A[1, 2] * ed[2]
-    r2 = A[2, 0] * ed[0] + A[2, 1] * ed[1] + A[2, 2] * ed[2]
-    s0 = c1 * z1 + c2 * z2 + beta_shear * (c1 * r0 + c2 * r1)
-    s1 = c2 * z1 + c1 * z2 + beta_shear * (c2 * r0 + c1 * r1)
-    s2 = tension + beta_ext * c * r2
-    gr[0] = -(A[0, 0] * s0 + A[1, 0] * s1 + A[2, 0] * s2) * pw
-    gr[1] = -(A[0, 1] * s0 + A[1, 1] * s1 + A[2, 1] * s2) * pw
-    gr[2] = -(A[0, 2] * s0 + A[1, 2] * s1 + A[2, 2] * s2) * pw
-    gr[3], gr[4], gr[5] = r0, r1, r2
-    gr[6] = -pw * (beta_shear * (r0 * (c1 * r0 + c2 * r1) + r1 * (c2 * r0 + c1 * r1)) + beta_ext * c * r2 * r2)
-    gr[7] = st
-    gr[8] = st == 10 and _near_kink(kmodel, st, Delta, m, c, c1, c2, h_pl, l, 1e-7)
-    return tension * pw
 
 
 @njit(cache=True)
@@ -251,25 +222,61 @@ def _twist(x, xd, e, L, c_twist, par, Jp, M):
 
 
 @njit(cache=True)
-def _link(x, xd, e, L, c_twist, plate_w, plate_d, plate_c, plate_c1, plate_c2, par, kmodel, loc, Dv, want_dv, wk):
+def _keep(K):
+    """Per-plate store of :func:`_link` for K plates (0: none): shape values, virtual ends, strain gradients, state
+    Jacobian, strain forces (the ``gr`` of :func:`_link`) and stations."""
+    return (np.zeros((K, 2, 3, 4)), np.zeros((K, 2, 12)), np.zeros((K, 3, 3)), np.zeros((K, 3, 3)), np.zeros((K, 9)),
+            np.zeros((K, 2)))
+
+
+@njit(cache=True)
+def _link(x, xd, e, L, c_twist, plate_w, plate_d, plate_c, plate_c1, plate_c2, par, kmodel, loc, Dv, want_dv, wk,
+          keep):
     """Plates (per-plate law, elastic plus damping) and twist (1.146), (1.217) of link ``e`` on its 22 local
     coordinates ``x`` (half ``-`` of pin ``e``, half ``+`` of pin ``e+1``, ``q_e``, ``q_{e+1}``; layout of
     ``ChainA5._links``) and velocities ``xd``.  Adds the forces to ``loc`` (22,) and, with ``want_dv``,
     their exact velocity derivative (they are linear in ``xd``) to ``Dv`` (22, 22; symmetric, the upper triangle
     overwritten).  Returns the link tension (N).
+
+    Per plate ``gr`` (9,) holds the generalized forces on its strains ``g = -A^T (stress + D A epsdot)`` (times the
+    plate weight), the state-projected strain rates ``r = A epsdot``, the power of its damping forces (W), the
+    state (1..10) and whether it is slack within a difference step of tension (:func:`_near_kink`); a ``keep`` of
+    :func:`_keep` with room for the link's plates stores them with the plate's geometry for :func:`_link_jacobian`.
     """
-    Hm, ve, te, A, AJG, xis, gr, Jp, pw_ = wk[0], wk[1], wk[2], wk[3], wk[7], wk[8], wk[9], wk[6], wk[-1]
-    l, beta_ext, beta_shear, beta_twist = par[0], par[6], par[7], par[8]
+    Hm, ve, te, A, m, ed, Jp, AJG, xis, gr, pw_ = wk
+    kHm, kve, kte, kA, kgr, kxis = keep
+    l, beta_ext, beta_shear, beta_twist, h_pl = par[0], par[6], par[7], par[8], par[15]
+    Le = L[e]
     T = 0.0
     for k in range(plate_w.shape[1]):
         pw = plate_w[e, k]
         if pw == 0.0:
             continue
-        T += _plate(x, xd, e, k, L, plate_w, plate_d, plate_c, plate_c1, plate_c2, par, kmodel, wk, gr)
-        pw_[0] += gr[6]
-        _to_link(loc, gr[0], gr[1], gr[2], x, xis, Hm, ve, te, l)
+        xis[0] = _virtual_end(x, xd, 0, plate_d[e, k], l, Hm, ve)
+        xis[1] = _virtual_end(x, xd, 1, plate_d[e, k], l, Hm, ve)
+        c, c1, c2 = plate_c[e, k], plate_c1[e, k], plate_c2[e, k]
+        psi1, psi2, Delta = _end_strains(ve, l, Le, te)
+        st, d1, d2, tension = _plate_law(kmodel, psi1, psi2, Delta, c, c1, c2, h_pl, A, m)
+        z1, z2 = psi1 - d1, psi2 - d2
+        _end_rates(ve, l, te, ed)
+        r0 = A[0, 0] * ed[0] + A[0, 1] * ed[1] + A[0, 2] * ed[2]
+        r1 = A[1, 0] * ed[0] + A[1, 1] * ed[1] + A[1, 2] * ed[2]
+        r2 = A[2, 0] * ed[0] + A[2, 1] * ed[1] + A[2, 2] * ed[2]
+        s0 = c1 * z1 + c2 * z2 + beta_shear * (c1 * r0 + c2 * r1)
+        s1 = c2 * z1 + c1 * z2 + beta_shear * (c2 * r0 + c1 * r1)
+        s2 = tension + beta_ext * c * r2
+        g0 = -(A[0, 0] * s0 + A[1, 0] * s1 + A[2, 0] * s2) * pw
+        g1 = -(A[0, 1] * s0 + A[1, 1] * s1 + A[2, 1] * s2) * pw
+        g2 = -(A[0, 2] * s0 + A[1, 2] * s1 + A[2, 2] * s2) * pw
+        p = -pw * (beta_shear * (r0 * (c1 * r0 + c2 * r1) + r1 * (c2 * r0 + c1 * r1)) + beta_ext * c * r2 * r2)
+        pw_[0] += p
+        T += tension * pw
+        _to_link(loc, g0, g1, g2, x, xis, Hm, ve, te, l)
+        if kgr.shape[0] > 0:
+            gr[0], gr[1], gr[2], gr[3], gr[4], gr[5], gr[6], gr[7] = g0, g1, g2, r0, r1, r2, p, st
+            gr[8] = st == 10 and _near_kink(kmodel, st, Delta, m, c, c1, c2, h_pl, l, 1e-7)
+            kHm[k], kve[k], kte[k], kA[k], kgr[k], kxis[k] = Hm, ve, te, A, gr, xis
         if want_dv:                                               # -(A J G)^T D (A J G), D of (1.192)-(1.193)
-            c, c1, c2 = plate_c[e, k], plate_c1[e, k], plate_c2[e, k]
             for i in range(3):
                 AJG[i, :] = 0.0
                 _to_link(AJG[i], A[i, 0], A[i, 1], A[i, 2], x, xis, Hm, ve, te, l)
@@ -384,8 +391,9 @@ def _map_curvature(Kx, F, x, Hm, ve, l):
 
 @njit(cache=True)
 def _link_jacobian(x, xd, e, L, c_twist, plate_w, plate_d, plate_c, plate_c1, plate_c2, par, kmodel, loc, Kx, Dv,
-                   dT, dPx, dPv, wk, jw):
-    """Link ``e`` as :func:`_link` with its exact derivatives within the plates' states: adds the forces to ``loc``,
+                   dT, dPx, dPv, wk, jw, keep):
+    """Link ``e`` as :func:`_link` (its pass, with the plates kept in ``keep``, :func:`_keep`) with its exact
+    derivatives within the plates' states: adds the forces to ``loc``,
     ``dQ/dx`` to ``Kx`` and ``dQ/dx'`` to ``Dv`` (22, 22), the tension's gradient to ``dT`` and the gradients of the
     power of its damping forces (W) to ``dPx``, ``dPv`` (22,); returns ``(tension (N), power (W))``.
 
@@ -399,20 +407,21 @@ def _link_jacobian(x, xd, e, L, c_twist, plate_w, plate_d, plate_c, plate_c1, pl
     damping stays the slack state's, none, as in its forces): at a kink the exact blocks are one-sided, and the slack
     side has no stiffness at all (Newton from an unstretched chain stalls on it; central differences average the
     two sides)."""
-    Hm, ve, te, A, xis, gr, Jp = wk[0], wk[1], wk[2], wk[3], wk[8], wk[9], wk[6]
+    Jp, pw_ = wk[6], wk[-1]
+    kHm, kve, kte, kA, kgr, kxis = keep
     Rx, Rd, dRd, Jr, Mm, W, AJG, MR, Mt = jw
     l, beta_ext, beta_shear, beta_twist = par[0], par[6], par[7], par[8]
     kl = 2.0 / l
-    T, P = 0.0, 0.0
+    p0 = pw_[0]
+    T = _link(x, xd, e, L, c_twist, plate_w, plate_d, plate_c, plate_c1, plate_c2, par, kmodel, loc, Mt, False, wk,
+              keep)
+    P = pw_[0] - p0
     F, HR, AJr, AJe, AHR = np.zeros(7), np.zeros((3, 7)), np.zeros((3, 7)), np.zeros((3, 7)), np.zeros((3, 7))
     for kp in range(plate_w.shape[1]):
         pw = plate_w[e, kp]
         if pw == 0.0:
             continue
-        Tk = _plate(x, xd, e, kp, L, plate_w, plate_d, plate_c, plate_c1, plate_c2, par, kmodel, wk, gr)
-        T += Tk
-        P += gr[6]
-        _to_link(loc, gr[0], gr[1], gr[2], x, xis, Hm, ve, te, l)
+        Hm, ve, te, A, gr, xis = kHm[kp], kve[kp], kte[kp], kA[kp], kgr[kp], kxis[kp]
         c, c1, c2 = plate_c[e, kp], plate_c1[e, kp], plate_c2[e, kp]
         taut = gr[8] != 0.0                                       # slack within a step of tension: K of state 1
         _reduced(x, xd, xis, Hm, ve, l, Rx, Rd, dRd)
@@ -508,9 +517,8 @@ def _link_jacobian(x, xd, e, L, c_twist, plate_w, plate_d, plate_c, plate_c1, pl
             # P = -pw r^T D r, r = A eps', d eps'/dx = HR Rx + Jr dRd
             dPv[j] -= 2 * pw * (Dr[0] * AJG[0, j] + Dr[1] * AJG[1, j] + Dr[2] * AJG[2, j])
             dPx[j] -= 2 * pw * (Dr[0] * (W[0, j] + h0) + Dr[1] * (W[1, j] + h1) + Dr[2] * (W[2, j] + h2))
-    if c_twist[e] != 0.0:
-        f, phid, pt = _twist(x, xd, e, L, c_twist, par, Jp, Mt)
-        P += pt
+    if c_twist[e] != 0.0:                                         # its forces and power came with _link's
+        f, phid, _ = _twist(x, xd, e, L, c_twist, par, Jp, Mt)
         ct, bt = c_twist[e], beta_twist
         Mxd = np.zeros(22)
         for i in range(22):
@@ -519,7 +527,6 @@ def _link_jacobian(x, xd, e, L, c_twist, plate_w, plate_d, plate_c, plate_c1, pl
                 s += Mt[i, j] * xd[j]
             Mxd[i] = s
         for i in range(22):
-            loc[i] -= f * Jp[i]
             for j in range(22):
                 Kx[i, j] -= ct * (Jp[i] * Jp[j] + bt * Jp[i] * Mxd[j]) + f * Mt[i, j]
                 Dv[i, j] -= ct * bt * Jp[i] * Jp[j]
@@ -760,12 +767,12 @@ def forces_power(q, v, gl, gp, L, c_twist, b_joint, cs, plate_w, plate_d, plate_
     Q = np.zeros(q.shape[0])
     T = np.zeros(n)
     x, xd, loc, Dv = np.zeros(22), np.zeros(22), np.zeros(22), np.zeros((1, 1))
-    wk = _link_work()
+    wk, none = _link_work(), _keep(0)
     for e in range(n):
         for j in range(22):
             x[j], xd[j], loc[j] = q[gl[e, j]], v[gl[e, j]], 0.0
         T[e] = _link(x, xd, e, L, c_twist, plate_w, plate_d, plate_c, plate_c1, plate_c2, par, kmodel, loc, Dv,
-                     False, wk)
+                     False, wk, none)
         for j in range(22):
             Q[gl[e, j]] += loc[j]
     y, yd, lp = np.zeros(29), np.zeros(29), np.zeros(29)
@@ -814,7 +821,7 @@ def jacobian(q, v, gl, gp, L, c_twist, b_joint, cs, plate_w, plate_d, plate_c, p
     T, dT = np.zeros(n), np.zeros((n, 22))
     x, xd, f_0, f_p, f_m = np.zeros(22), np.zeros(22), np.zeros(22), np.zeros(22), np.zeros(22)
     Dv, Dx = np.zeros((22, 22)), np.zeros((1, 1))
-    wk = _link_work()
+    wk, none, keep = _link_work(), _keep(0), _keep(plate_w.shape[1])
     pw = wk[-1]
     Kx, dPx, dPv, jw = np.zeros((22, 22)), np.zeros(22), np.zeros(22), _jac_work()
     for e in range(n):
@@ -826,7 +833,7 @@ def jacobian(q, v, gl, gp, L, c_twist, b_joint, cs, plate_w, plate_d, plate_c, p
             dPx[:] = 0.0
             dPv[:] = 0.0
             T[e] = _link_jacobian(x, xd, e, L, c_twist, plate_w, plate_d, plate_c, plate_c1, plate_c2, par, kmodel,
-                                  f_0, Kx, Dv, dT[e], dPx, dPv, wk, jw)[0]
+                                  f_0, Kx, Dv, dT[e], dPx, dPv, wk, jw, keep)[0]
             for j in range(22):
                 dDq[gl[e, j]] -= dPx[j]
                 dDv[gl[e, j]] -= dPv[j]
@@ -836,7 +843,7 @@ def jacobian(q, v, gl, gp, L, c_twist, b_joint, cs, plate_w, plate_d, plate_c, p
             continue
         pw[0] = 0.0                                               # each pass's power alone (no round-off of a sum)
         T[e] = _link(x, xd, e, L, c_twist, plate_w, plate_d, plate_c, plate_c1, plate_c2, par, kmodel, f_0, Dv,
-                     True, wk)
+                     True, wk, none)
         P0 = pw[0]
         for j in range(22):
             x0 = x[j]
@@ -845,14 +852,14 @@ def jacobian(q, v, gl, gp, L, c_twist, b_joint, cs, plate_w, plate_d, plate_c, p
             f_p[:] = 0.0
             pw[0] = 0.0
             Tp = _link(x, xd, e, L, c_twist, plate_w, plate_d, plate_c, plate_c1, plate_c2, par, kmodel, f_p, Dx,
-                       False, wk)
+                       False, wk, none)
             Pp = pw[0]
             if link_scheme != FORWARD:
                 x[j] = x0 - h
                 f_m[:] = 0.0
                 pw[0] = 0.0
                 Tm = _link(x, xd, e, L, c_twist, plate_w, plate_d, plate_c, plate_c1, plate_c2, par, kmodel, f_m,
-                           Dx, False, wk)
+                           Dx, False, wk, none)
                 Pm = pw[0]
                 h2 = 2 * h
             else:
