@@ -34,17 +34,17 @@ class StateLayout:
         if any(o not in (1, 2) for o in orders) or orders != sorted(orders, reverse=True):
             raise InputError("layout.blocks", orders, "orders must be 2 or 1, the second-order blocks first")
 
-    @property
+    @cached_property
     def n2(self) -> int:
         """Second-order coordinates (each with a velocity)."""
         return sum(b.size for b in self.blocks if b.order == 2)
 
-    @property
+    @cached_property
     def n1(self) -> int:
         """First-order states."""
         return sum(b.size for b in self.blocks if b.order == 1)
 
-    @property
+    @cached_property
     def size(self) -> int:
         """State length ``2 n2 + n1``."""
         return 2 * self.n2 + self.n1

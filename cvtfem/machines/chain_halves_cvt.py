@@ -86,6 +86,9 @@ class HalvesFamily:
     name = "chain"
     #: No homogenised A1 pre-solve of the start (ChainACVT's for A3/A4): the halves' start is their own.
     homogenised = None
+    #: How the compiled Jacobian takes the links' blocks (:meth:`ChainA5.jacobian`'s ``scheme``); the quasi-static
+    #: start switches to "central" (:meth:`ChainHalvesCVT._solve_balance`).
+    scheme = "analytic"
 
     def __init__(self, chain: ChainA5, geom):
         self.chain, self.geom = chain, geom
@@ -163,11 +166,11 @@ class HalvesFamily:
     def _blocks(self, q, v) -> tuple:
         """``(dQ/dq, dQ/dv, dD/dq, dD/dv)`` at ``(q, v)`` (the gradients None with the numpy backend), cached:
         ChainCVT.jac asks for the matrices and the gradient at one state."""
-        key = np.concatenate([q, v]).tobytes()
+        key = np.concatenate([q, v]).tobytes() + self.scheme.encode()
         if self._last[0] != key:
             compiled = self.chain.backend == "numba"
-            blocks = self.chain.jacobian_and_power_gradient(q, v) if compiled else (*self.chain.jacobian(q, v),
-                                                                                    None, None)
+            blocks = self.chain.jacobian_and_power_gradient(q, v, self.scheme) if compiled else (
+                *self.chain.jacobian(q, v), None, None)
             self._last = (key, *blocks)
         return self._last[1:]
 
@@ -301,8 +304,14 @@ class ChainHalvesCVT(ChainACVT):
 
     def _solve_balance(self, residual, jacobian, y0, tol: float):
         """:func:`~cvtfem.machines.static_balance.lifted_newton` on the sparse Jacobian (the static stiffness of A5 is
-        indefinite and singular: its phase 1 alone stalls at about 2e-2 of F2)."""
-        return lifted_newton(residual, jacobian, y0, tol)
+        indefinite and singular: its phase 1 alone stalls at about 2e-2 of F2), with central link differences: from
+        the placement half the plates sit at the slack/taut kink, where the exact link blocks are one-sided, and the
+        lifted Newton stalled on them at 2.5e-2 of F2 (central differences average the two sides: 2.3e-5)."""
+        scheme, self.family.scheme = self.family.scheme, "central"
+        try:
+            return lifted_newton(residual, jacobian, y0, tol)
+        finally:
+            self.family.scheme = scheme
 
     def _placed(self, pl, u3):
         """Straight halves rolling on each other at ``pl.u`` (the rolling faces touch on the joint's bisector

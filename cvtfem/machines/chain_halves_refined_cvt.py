@@ -16,19 +16,57 @@ Hertz potential, the friction power the exact work rate.
 from __future__ import annotations
 
 from dataclasses import replace
+from functools import cached_property
 
 import numpy as np
 
+from cvtfem.elements.chain import half_end_contact_kernel as HEK
 from cvtfem.elements.chain.end_contact import EndContact
 from cvtfem.elements.chain.half_end_contact import HalfEndContact
 from cvtfem.elements.chain.sheave_contact_refined import RefinedSheaveContact
 from cvtfem.elements.chain.symmetric import END_SLOPE_FACTOR
-from cvtfem.errors import InputError
+from cvtfem.elements.jit import HAVE_NUMBA
+from cvtfem.errors import InputError, NumericalError
 from cvtfem.machines.chain_halves_cvt import ChainHalvesCVT
 
 
 class ChainHalvesRefinedCVT(ChainHalvesCVT):
-    """A5 on two rigid shafts with H2 at both ends of every pin half (variant (e) on rigid shafts)."""
+    """A5 on two rigid shafts with H2 at both ends of every pin half (variant (e) on rigid shafts).
+
+    The contact pass and its Jacobian run compiled over ChainCVT's pair table
+    (:mod:`~cvtfem.elements.chain.half_end_contact_kernel`, as H1's :mod:`sheave_contact_kernel`); ChainCVT's numpy
+    path (``reference=True``, and for the mean slip of ``evaluate(slip=True)``) is their tested twin."""
+
+    @cached_property
+    def _compiled_contact(self) -> tuple | None:
+        """Constants of :mod:`~cvtfem.elements.chain.half_end_contact_kernel` (None without numba)."""
+        return HEK.pack(self.contact.pair, 0.5) if HAVE_NUMBA else None
+
+    def _contact_forces(self, q, v, Q, slip: bool = False, reference: bool = False):
+        """ChainCVT's contact forces (the friction power, W, and with ``slip`` the mean slip speed per shaft, m/s),
+        compiled unless ``reference`` or ``slip`` (the mean slip comes from the numpy path's details)."""
+        ck = self._compiled_contact
+        if reference or slip or ck is None:
+            return super()._contact_forces(q, v, Q, slip, reference=True)
+        Pf, bad = HEK.forces(np.concatenate([q, v, self._constants]), *self._pair_table, *ck, Q)
+        if bad >= 0:
+            raise NumericalError(f"H2 contact: a pin-half end on the shaft axis (pair {bad})",
+                                 component="contact.refined")
+        return Pf, None
+
+    def _contact_jacobian(self, q, v, reference: bool = False):
+        """``(rows, cols, values)`` of the contacts' ``dQ/dy`` and ``-d P_fr / dy`` (2 n2,), compiled unless
+        ``reference`` (ChainCVT's numpy path)."""
+        ck = self._compiled_contact
+        if reference or ck is None:
+            return super()._contact_jacobian(q, v, reference=True)
+        table = self._pair_table
+        cols, rows = table[0], table[3]
+        size = cols.shape[0] * rows.shape[1] * cols.shape[1] * cols.shape[2] ** 2     # at most, all pairs near
+        r, c, d = np.empty(size, np.int64), np.empty(size, np.int64), np.empty(size)
+        dD = np.zeros(2 * self.n2)
+        k = HEK.jacobian(np.concatenate([q, v, self._constants]), *table, *ck, HEK.STEPS, 2 * self.n2, r, c, d, dD)
+        return (r[:k], c[:k], d[:k]), dD
 
     def _link_chords(self, ends, d):
         """``(front, rear)`` (m, 2) coordinate positions of the ``u_0`` of the two halves of each end's link: ``p-``

@@ -6,10 +6,11 @@ refined contact H2 at every half end), its contact pass's share, and the same fo
 
 The reference chain (band-6+2n scene values, clamping 30/35 kN) placed on the sheaves at ratio 2.4
 (:meth:`ChainHalvesCVT.placed_state`) with random coordinate offsets (0.2 um) and velocities (0.05 m/s), for each
-contact: the model's ``rhs``; its contact pass (broad phase, contact map, local kernel, scatter of the forces);
-the local kernel alone (H2: :class:`HalfEndContact`, and inside it the refined kernel); the model's ``jac`` and the
-contact's local Jacobian.  Wall medians (``cvtfem.analysis.timing``) and mean CPU times; Jacobians also in
-RHS-equivalents.  Machine and load before and after.
+contact: the model's ``rhs``; its contact pass (broad phase, contact map, local kernel, scatter of the forces); the
+local kernel alone (H2: :class:`HalfEndContact`, and inside it the refined kernel); the model's ``jac``, the
+contacts' Jacobian entries as the model takes them (``_contact_jacobian``) and the numpy local Jacobian.  See
+``bench_chain_halves.py`` for the before/after tables of issue 13.  Wall medians (``cvtfem.analysis.timing``) and
+mean CPU times; Jacobians also in RHS-equivalents.  Machine and load before and after.
 """
 from __future__ import annotations
 
@@ -37,10 +38,11 @@ def cpu_us(fun, calls: int) -> float:
 
 
 def contact_pass(m, q, v):
-    """The contact part of one RHS: broad phase, input map, local kernel, scatter of the local forces."""
-    _, _, cols, coef, _, Y = m._contact_set(q, v)
-    rows, w = m._output_rows(cols, coef)
-    return np.bincount(rows.ravel(), (w * Y[:, :-1, None]).ravel(), m.n2)
+    """The contact part of one RHS as the model runs it (``_contact_forces``: broad phase, gather, local kernel,
+    scatter; compiled for H1 and H2 since session 8, the numpy path before)."""
+    Q = np.zeros(m.n2)
+    m._contact_forces(q, v, Q)
+    return Q
 
 
 def bench(name: str, m, x, calls: int, jac_calls: int) -> list[str]:
@@ -56,7 +58,8 @@ def bench(name: str, m, x, calls: int, jac_calls: int) -> list[str]:
     if inner is not None:
         Xk = inner(X)
         runs.append(("  of which the refined kernel", lambda: m.contact.pair.pair.local(Xk, shafts), calls))
-    runs += [("contact local Jacobian", lambda: m.contact.local_jacobian(X, shafts), jac_calls),
+    runs += [("contact local Jacobian (numpy)", lambda: m.contact.local_jacobian(X, shafts), jac_calls),
+             ("contact Jacobian entries (model)", lambda: m._contact_jacobian(q, v), jac_calls),
              ("model jac", lambda: m.jac(0.0, x), max(jac_calls // 4, 3))]
     lines = [f"{name}: {m.size} states, {len(X)} candidate half-end contacts, Jacobian pattern "
              f"{m.jac_sparsity.nnz} entries"]
@@ -67,7 +70,7 @@ def bench(name: str, m, x, calls: int, jac_calls: int) -> list[str]:
         lines.append(f"  {label:<50} median of {k:4d}: {t[label]:10.1f} us (mean CPU {c[label]:9.1f} us)")
     rhs, cp = "model rhs", runs[1][0]
     lines.append(f"  contact pass share of the rhs: {t[cp] / t[rhs]:.0%} (CPU {c[cp] / c[rhs]:.0%})")
-    for label in ("contact local Jacobian", "model jac"):
+    for label in ("contact local Jacobian (numpy)", "contact Jacobian entries (model)", "model jac"):
         lines.append(f"  {label:<50} {t[label] / t[rhs]:7.1f} RHS (CPU {c[label] / c[rhs]:6.1f})")
     return lines
 

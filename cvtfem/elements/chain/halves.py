@@ -677,28 +677,28 @@ class ChainA5:
         return pat
 
     def jacobian(self, q: np.ndarray, v: np.ndarray, damping: bool = True,
-                 scheme: str = "central") -> tuple[sp.csr_matrix, sp.csr_matrix | None]:
+                 scheme: str = "analytic") -> tuple[sp.csr_matrix, sp.csr_matrix | None]:
         """``(dQ/dq, dQ/dv)`` of :meth:`forces` on :attr:`jac_sparsity`; ``damping=False`` returns None for ``dQ/dv``.
 
         Compiled backend: element by element (:func:`halves_kernel.jacobian`): each link's velocity block exact,
-        its coordinate block by ``scheme`` ("central", step ``1e-7``, or "forward", step ``sqrt(eps)``, relative to
-        ``max(|x|, l)``) differences of that link alone; each pin's blocks (bending, contacts, friction) central
-        differences of the pin alone (steps ``1e-7 max(|x|, l)`` and ``1e-2 v_0``: the friction laws bend on the scale
-        ``v_0`` of the slip, whatever the chain's speed);
-        the axial friction's tension dependence by the chain rule.  Per element 45 (central) or 23 (forward) link
-        passes and 116 pin passes: about 56 or 38 force evaluations in time for 84 pins (docs/chain.md).  Forward
-        differences are one-sided at the kinks of the plate law and the contacts: Newton from the exact straight
-        chain diverged with them, hence central by default.
+        its coordinate block by ``scheme``: "analytic" (default; exact within the plates' states: the strain
+        Hessians, the state law's Jacobian and the curvature of the moving plate stations,
+        :func:`halves_kernel._link_jacobian`), or "central" (step ``1e-7``) or "forward" (step ``sqrt(eps)``, relative
+        to ``max(|x|, l)``) differences of that link alone, kept as its cross-check; each pin's blocks (bending,
+        contacts, friction) central differences of the pin alone (steps ``1e-7 max(|x|, l)`` and ``1e-2 v_0``: the
+        friction laws bend on the scale ``v_0`` of the slip, whatever the chain's speed); the axial friction's
+        tension dependence by the chain rule.  Forward differences are one-sided at the kinks of the plate law and
+        the contacts: Newton from the exact straight chain diverged with them.
         numpy backend: :meth:`coloured_jacobian`.
         """
-        if scheme not in ("forward", "central"):
-            raise InputError("scheme", scheme, 'must be "forward" or "central"')
+        if scheme not in ("analytic", "forward", "central"):
+            raise InputError("scheme", scheme, 'must be "analytic", "forward" or "central"')
         if self.backend != "numba":
             return self.coloured_jacobian(q, v, damping=damping)
         Jq, Jv, _, _ = self.jacobian_and_power_gradient(q, v, scheme)
         return Jq, Jv if damping else None
 
-    def jacobian_and_power_gradient(self, q: np.ndarray, v: np.ndarray, scheme: str = "central") -> tuple:
+    def jacobian_and_power_gradient(self, q: np.ndarray, v: np.ndarray, scheme: str = "analytic") -> tuple:
         """``(dQ/dq, dQ/dv, dD/dq, dD/dv)`` of the compiled backend: :meth:`jacobian`'s matrices and the gradient
         (W/m, W s/m; arrays (21 n,)) of the dissipated power ``D`` of :meth:`forces_and_dissipation` from the same
         element passes (:func:`halves_kernel.jacobian`)."""
@@ -710,8 +710,9 @@ class ChainA5:
         Jq, Jv = np.zeros(pat.nnz + 1), np.zeros(pat.nnz + 1)
         dDq, dDv = np.zeros(self.n2), np.zeros(self.n2)
         steps = np.array([np.sqrt(np.finfo(float).eps) if scheme == "forward" else 1e-7, 1e-7, 1e-2])
-        HK.jacobian(np.asarray(q, float), np.asarray(v, float), *self._kernel_args, *self._positions, steps,
-                    scheme == "central", Jq, Jv, dDq, dDv)
+        link = {"forward": HK.FORWARD, "central": HK.CENTRAL, "analytic": HK.ANALYTIC}[scheme]
+        HK.jacobian(np.asarray(q, float), np.asarray(v, float), *self._kernel_args, *self._positions, steps, link,
+                    Jq, Jv, dDq, dDv)
         out = [sp.csr_matrix((d[:-1], pat.indices, pat.indptr), shape=pat.shape) for d in (Jq, Jv)]
         return out[0], out[1], dDq, dDv
 

@@ -13,12 +13,14 @@ from __future__ import annotations
 
 import numpy as np
 
-from cvtfem.elements.chain.plates_kernel import _plate_law, _strain_rates
+from cvtfem.elements.chain.plates_kernel import A4, _plate_law
 from cvtfem.elements.contact.kernels import LAW_CODES, _gain
 from cvtfem.elements.jit import HAVE_NUMBA, njit
 
 #: ``friction_gain``'s default blend width of the ``smooth`` law, as the numpy twin calls it.
 SMOOTH_EPS = 0.1
+#: How :func:`jacobian` takes the links' coordinate blocks: forward or central differences, or exact (within states).
+FORWARD, CENTRAL, ANALYTIC = 0, 1, 2
 _G = 1.0 / np.sqrt(3.0)
 
 
@@ -82,90 +84,167 @@ def _shape(xi, l, H, Hp, Hpp):
 # ---------------------------------------------------------------------------------------------- links
 @njit(cache=True)
 def _link_work():
-    """Scratch arrays of :func:`_link` (``J`` zero: :func:`_virtual_strains` writes only its nonzero columns); the
-    last accumulates the power of the link damping forces (W)."""
-    return (np.zeros(20), np.zeros(20), np.zeros(20), np.zeros((3, 4)), np.zeros((3, 4)), np.zeros((3, 20)),
-            np.zeros((3, 3)), np.zeros(3), np.zeros((2, 3)), np.zeros(3), np.zeros(3), np.zeros(10), np.zeros(22),
-            np.zeros(20), np.zeros((3, 22)), np.zeros(1))
+    """Scratch arrays of :func:`_link`: shape values per plate end ``Hm (2, 3, 4)``, virtual end values ``ve (2, 12)``,
+    strain gradients ``te (3, 3)``, state Jacobian, margins, rates, twist map, ``A J G`` rows, the stations, the plate's
+    strain forces and state (:func:`_plate`); the last accumulates
+    the power of the link damping forces (W)."""
+    return (np.zeros((2, 3, 4)), np.zeros((2, 12)), np.zeros((3, 3)), np.zeros((3, 3)), np.zeros(10), np.zeros(3),
+            np.zeros(22), np.zeros((3, 22)), np.zeros(2), np.zeros(9), np.zeros(1))
 
 
 @njit(cache=True)
-def _virtual_pin(x, xd, b, d, l, qv, qvd, Hm):
-    """End ``b`` of a plate at offset ``d`` as a virtual whole pin at ``xi = 0`` (``qv``, ``qvd`` entries
-    ``10 b .. 10 b + 9``): ``u_0 = U_perp(xi_b)``, ``u_1 = dU_perp/dxi``, ``u_2 = u_3 = 0``, ``w_0 = U_par(xi_b)``,
-    ``w_1``, the same strains as the half's axis (1.211)-(1.212).  ``Hm`` (3, 4) gets ``h, h', h''``; returns
-    ``xi_b``."""
+def _virtual_end(x, xd, b, d, l, Hm, ve):
+    """End ``b`` of a plate at offset ``d`` as a virtual whole pin at ``xi = 0`` (1.211)-(1.212): ``Hm[b]`` gets
+    ``h, h', h''`` at ``xi_b``, ``ve[b]`` the pin's ``u_0 = U_perp(xi_b)`` (0, 1), ``u_1 = dU_perp/dxi`` (2, 3),
+    ``w_0 = U_par(xi_b)`` (4), their rates (5..9) and ``d u_1/dxi`` (10, 11) (``u_2 = u_3 = 0``, ``w_1`` the half's:
+    the same strains as the half's axis).  Returns ``xi_b``."""
     o = 10 * b
     xi = 2.0 / l * (x[20 + b] - x[o + 8] + d)
     xid = 2.0 / l * (xd[20 + b] - xd[o + 8])
-    _shape(xi, l, Hm[0], Hm[1], Hm[2])
+    _shape(xi, l, Hm[b, 0], Hm[b, 1], Hm[b, 2])
     for c in range(2):
         U, u1, du1, Ud, u1d = 0.0, 0.0, 0.0, 0.0, 0.0
         for i in range(4):
-            U += Hm[0, i] * x[o + 2 * i + c]
-            u1 += Hm[1, i] * x[o + 2 * i + c]
-            du1 += Hm[2, i] * x[o + 2 * i + c]
-            Ud += Hm[0, i] * xd[o + 2 * i + c]
-            u1d += Hm[1, i] * xd[o + 2 * i + c]
-        qv[o + c], qv[o + 2 + c], qv[o + 4 + c], qv[o + 6 + c] = U, u1, 0.0, 0.0
-        qvd[o + c], qvd[o + 2 + c], qvd[o + 4 + c], qvd[o + 6 + c] = Ud + u1 * xid, u1d + du1 * xid, 0.0, 0.0
-    qv[o + 8], qv[o + 9] = x[o + 8] + x[o + 9] * xi, x[o + 9]
-    qvd[o + 8], qvd[o + 9] = xd[o + 8] + xd[o + 9] * xi + x[o + 9] * xid, xd[o + 9]
+            y, yd = x[o + 2 * i + c], xd[o + 2 * i + c]
+            U += Hm[b, 0, i] * y
+            u1 += Hm[b, 1, i] * y
+            du1 += Hm[b, 2, i] * y
+            Ud += Hm[b, 0, i] * yd
+            u1d += Hm[b, 1, i] * yd
+        ve[b, c], ve[b, 2 + c], ve[b, 10 + c] = U, u1, du1
+        ve[b, 5 + c], ve[b, 7 + c] = Ud + u1 * xid, u1d + du1 * xid
+    ve[b, 4] = x[o + 8] + x[o + 9] * xi
+    ve[b, 9] = xd[o + 8] + xd[o + 9] * xi + x[o + 9] * xid
     return xi
 
 
 @njit(cache=True)
-def _virtual_strains(qv, l, L, J, tau, e):
-    """``(psi_1, psi_2, Delta)`` of a plate between two virtual pins (``xi = 0``, ``u_2 = u_3 = 0``): the strains
-    (1.186)-(1.189) of ``plates_kernel._strains`` there, ``V = u_0+ - u_0-``, ``t_a = (2/l u_1, 1)``.  Fills the
-    columns ``u_0``, ``u_1``, ``w_0`` of ``J`` (3, 20); the others (``u_2``, ``u_3``, ``w_1``) stay zero."""
-    V0, V1, V2 = qv[10] - qv[0], qv[11] - qv[1], qv[18] - qv[8]
+def _end_strains(ve, l, L, te):
+    """``(psi_1, psi_2, Delta)`` of a plate between its virtual end pins ``ve`` (the strains (1.186)-(1.189) at
+    ``xi = 0``, ``u_2 = u_3 = 0``: ``V = u_0+ - u_0-``, ``t_a = (2/l u_1, 1)``) and their gradients over ``V``
+    into ``te`` (3, 3): ``tau`` (of ``Delta``), ``e_1``, ``e_2`` (of ``psi_a``); ``psi_a`` also moves with end
+    ``a``'s ``u_1`` as ``2/l tau``."""
+    V0, V1, V2 = ve[1, 0] - ve[0, 0], ve[1, 1] - ve[0, 1], ve[1, 4] - ve[0, 4]
     Lt = np.sqrt(V0 * V0 + V1 * V1 + V2 * V2)
-    tau[0], tau[1], tau[2] = V0 / Lt, V1 / Lt, V2 / Lt
-    psi = (tau[0] * 2.0 / l * qv[2] + tau[1] * 2.0 / l * qv[3] + tau[2],
-           tau[0] * 2.0 / l * qv[12] + tau[1] * 2.0 / l * qv[13] + tau[2])
+    il = 1.0 / Lt
+    t0, t1, t2 = V0 * il, V1 * il, V2 * il
+    te[0, 0], te[0, 1], te[0, 2] = t0, t1, t2
+    k = 2.0 / l
+    psi1 = k * (t0 * ve[0, 2] + t1 * ve[0, 3]) + t2
+    psi2 = k * (t0 * ve[1, 2] + t1 * ve[1, 3]) + t2
     for a in range(2):
-        o = 10 * a
-        e[a, 0] = (2.0 / l * qv[o + 2] - tau[0] * psi[a]) / Lt
-        e[a, 1] = (2.0 / l * qv[o + 3] - tau[1] * psi[a]) / Lt
-        e[a, 2] = (1.0 - tau[2] * psi[a]) / Lt
+        psi = psi1 if a == 0 else psi2
+        te[1 + a, 0] = (k * ve[a, 2] - t0 * psi) * il
+        te[1 + a, 1] = (k * ve[a, 3] - t1 * psi) * il
+        te[1 + a, 2] = (1.0 - t2 * psi) * il
+    return psi1, psi2, Lt - L
+
+
+@njit(cache=True)
+def _end_rates(ve, l, te, ed):
+    """Strain rates ``ed`` (3,) of a plate from its virtual end rates (``J qvd`` over the nonzero columns)."""
+    d0, d1, d2 = ve[1, 5] - ve[0, 5], ve[1, 6] - ve[0, 6], ve[1, 9] - ve[0, 9]
+    k = 2.0 / l
+    for a in range(2):
+        ed[a] = (te[1 + a, 0] * d0 + te[1 + a, 1] * d1 + te[1 + a, 2] * d2
+                 + k * (te[0, 0] * ve[a, 7] + te[0, 1] * ve[a, 8]))
+    ed[2] = te[0, 0] * d0 + te[0, 1] * d1 + te[0, 2] * d2
+
+
+@njit(cache=True)
+def _to_link(out, g0, g1, g2, x, xis, Hm, ve, te, l):
+    """Add ``G^T J^T g`` to ``out`` (22,): a generalized force ``g`` on a plate's strains ``(psi_1, psi_2, Delta)``
+    through the strain gradients ``J`` (nonzero on the virtual pins' ``u_0``, ``u_1``, ``w_0`` only) and the
+    transpose of the virtual-end map (its stations ``xi_b`` moving with ``q`` and ``w_0``)."""
+    k = 2.0 / l
+    F0 = g0 * te[1, 0] + g1 * te[2, 0] + g2 * te[0, 0]
+    F1 = g0 * te[1, 1] + g1 * te[2, 1] + g2 * te[0, 1]
+    F2 = g0 * te[1, 2] + g1 * te[2, 2] + g2 * te[0, 2]
     for b in range(2):
         o = 10 * b
         sg = 2.0 * b - 1.0
-        for x in range(2):
-            J[0, o + x], J[1, o + x], J[2, o + x] = sg * e[0, x], sg * e[1, x], sg * tau[x]
-            J[b, o + 2 + x] = 2.0 / l * tau[x]
-        J[0, o + 8], J[1, o + 8], J[2, o + 8] = sg * e[0, 2], sg * e[1, 2], sg * tau[2]
-    return psi[0], psi[1], Lt - L
-
-
-@njit(cache=True)
-def _back(out, f, x, b, xi, Hm, l):
-    """Add ``G_b^T f`` to ``out`` (22,): a vector ``f`` (20,) on the virtual pin ``b`` mapped back to the link's
-    local coordinates (the transpose of :func:`_virtual_pin`'s linearisation, ``xi_b`` moving with ``q``, ``w_0``)."""
-    o = 10 * b
-    S = f[o + 8] * x[o + 9]
-    for c in range(2):
-        u1, du1 = 0.0, 0.0
+        gb = k * (g0 if b == 0 else g1)
+        fu0, fu1, fw = sg * F0, sg * F1, sg * F2                  # on u_0 (2), w_0 of the virtual pin
+        fv0, fv1 = gb * te[0, 0], gb * te[0, 1]                   # on u_1
         for i in range(4):
-            out[o + 2 * i + c] += Hm[0, i] * f[o + c] + Hm[1, i] * f[o + 2 + c]
-            u1 += Hm[1, i] * x[o + 2 * i + c]
-            du1 += Hm[2, i] * x[o + 2 * i + c]
-        S += f[o + c] * u1 + f[o + 2 + c] * du1
-    out[o + 8] += f[o + 8] - 2.0 / l * S
-    out[o + 9] += f[o + 8] * xi + f[o + 9]
-    out[20 + b] += 2.0 / l * S
+            out[o + 2 * i] += Hm[b, 0, i] * fu0 + Hm[b, 1, i] * fv0
+            out[o + 2 * i + 1] += Hm[b, 0, i] * fu1 + Hm[b, 1, i] * fv1
+        S = fw * x[o + 9] + fu0 * ve[b, 2] + fu1 * ve[b, 3] + fv0 * ve[b, 10] + fv1 * ve[b, 11]
+        out[o + 8] += fw - k * S
+        out[o + 9] += fw * xis[b]
+        out[20 + b] += k * S
 
 
 @njit(cache=True)
-def _link(x, xd, e, L, c_twist, plate_w, plate_d, plate_c, plate_c1, plate_c2, par, kmodel, loc, Dv, want_dv, wk):
+def _near_kink(kmodel, st, Delta, m, c, c1, c2, h_pl, l, rel):
+    """Whether a plate's law may switch within a difference step ``rel l`` of its link's coordinates: its best state
+    margin (A4, N m) leads the next one, or (A3) its strain ``Delta`` sits, by less than ten times what such a step
+    changes them."""
+    c0 = h_pl * h_pl * c / 4.0
+    dM = rel * (c * h_pl * l / 2.0 + 2.0 * (c0 + c1 + abs(c2)))
+    if kmodel != A4:
+        return abs(Delta) * c * h_pl / 2.0 < 10.0 * dM
+    k = st - 1
+    second = -np.inf
+    for j in range(10):
+        if j != k and m[j] > second:
+            second = m[j]
+    return m[k] - second < 10.0 * dM
+
+
+@njit(cache=True)
+def _twist(x, xd, e, L, c_twist, par, Jp, M):
+    """Twist (1.146), (1.217) of link ``e``: ``Jp`` (22,) gets ``d phi / dx`` and, with ``M`` of shape (22, 22), that
+    constant matrix ``d^2 phi / dx^2`` (``phi`` is a quadratic form of the cross-half differences).  Returns
+    ``(f, phi', power)``: the twist moment (elastic and damping, the forces are ``-f Jp``), the twist rate and the
+    power of the damping (W)."""
+    l, beta_twist = par[0], par[8]
+    kk = 2.0 / (l * L[e])
+    d00, d01, d10, d11 = x[10] - x[0], x[11] - x[1], x[12] - x[2], x[13] - x[3]
+    phi = kk * (d10 * d01 - d11 * d00)
+    Jp[:] = 0.0
+    Jp[10], Jp[11], Jp[12], Jp[13] = -kk * d11, kk * d10, kk * d01, -kk * d00
+    for j in range(4):
+        Jp[j] = -Jp[10 + j]
+    if M.shape[0] == 22:                                          # Jp = M x: the entries of that linear map
+        M[:, :] = 0.0
+        for a, b, s in ((2, 1, 1.0), (3, 0, -1.0)):               # d_ab pairs (d10 d01 - d11 d00)
+            for i in (a, 10 + a):
+                for j in (b, 10 + b):
+                    sg = s * kk * (1.0 if (i < 10) == (j < 10) else -1.0)
+                    M[i, j] += sg
+                    M[j, i] += sg
+    phid = 0.0
+    for j in range(22):
+        phid += Jp[j] * xd[j]
+    f = c_twist[e] * (phi + beta_twist * phid)
+    return f, phid, -beta_twist * c_twist[e] * phid * phid
+
+
+@njit(cache=True)
+def _keep(K):
+    """Per-plate store of :func:`_link` for K plates (0: none): shape values, virtual ends, strain gradients, state
+    Jacobian, strain forces (the ``gr`` of :func:`_link`) and stations."""
+    return (np.zeros((K, 2, 3, 4)), np.zeros((K, 2, 12)), np.zeros((K, 3, 3)), np.zeros((K, 3, 3)), np.zeros((K, 9)),
+            np.zeros((K, 2)))
+
+
+@njit(cache=True)
+def _link(x, xd, e, L, c_twist, plate_w, plate_d, plate_c, plate_c1, plate_c2, par, kmodel, loc, Dv, want_dv, wk,
+          keep):
     """Plates (per-plate law, elastic plus damping) and twist (1.146), (1.217) of link ``e`` on its 22 local
     coordinates ``x`` (half ``-`` of pin ``e``, half ``+`` of pin ``e+1``, ``q_e``, ``q_{e+1}``; layout of
     ``ChainA5._links``) and velocities ``xd``.  Adds the forces to ``loc`` (22,) and, with ``want_dv``,
     their exact velocity derivative (they are linear in ``xd``) to ``Dv`` (22, 22; symmetric, the upper triangle
     overwritten).  Returns the link tension (N).
+
+    Per plate ``gr`` (9,) holds the generalized forces on its strains ``g = -A^T (stress + D A epsdot)`` (times the
+    plate weight), the state-projected strain rates ``r = A epsdot``, the power of its damping forces (W), the
+    state (1..10) and whether it is slack within a difference step of tension (:func:`_near_kink`); a ``keep`` of
+    :func:`_keep` with room for the link's plates stores them with the plate's geometry for :func:`_link_jacobian`.
     """
-    qv, qvd, Qf, Ha, Hb, J, A, V, ev, ed, r, m, Jp, row, AJG, pw_ = wk
+    Hm, ve, te, A, m, ed, Jp, AJG, xis, gr, pw_ = wk
+    kHm, kve, kte, kA, kgr, kxis = keep
     l, beta_ext, beta_shear, beta_twist, h_pl = par[0], par[6], par[7], par[8], par[15]
     Le = L[e]
     T = 0.0
@@ -173,33 +252,34 @@ def _link(x, xd, e, L, c_twist, plate_w, plate_d, plate_c, plate_c1, plate_c2, p
         pw = plate_w[e, k]
         if pw == 0.0:
             continue
-        xa = _virtual_pin(x, xd, 0, plate_d[e, k], l, qv, qvd, Ha)
-        xb = _virtual_pin(x, xd, 1, plate_d[e, k], l, qv, qvd, Hb)
+        xis[0] = _virtual_end(x, xd, 0, plate_d[e, k], l, Hm, ve)
+        xis[1] = _virtual_end(x, xd, 1, plate_d[e, k], l, Hm, ve)
         c, c1, c2 = plate_c[e, k], plate_c1[e, k], plate_c2[e, k]
-        psi1, psi2, Delta = _virtual_strains(qv, l, Le, J, V, ev)
+        psi1, psi2, Delta = _end_strains(ve, l, Le, te)
         st, d1, d2, tension = _plate_law(kmodel, psi1, psi2, Delta, c, c1, c2, h_pl, A, m)
         z1, z2 = psi1 - d1, psi2 - d2
-        _strain_rates(J, qvd, A, ed, r)
-        s0 = c1 * z1 + c2 * z2 + beta_shear * (c1 * r[0] + c2 * r[1])
-        s1 = c2 * z1 + c1 * z2 + beta_shear * (c2 * r[0] + c1 * r[1])
-        s2 = tension + beta_ext * c * r[2]
-        pw_[0] -= pw * (beta_shear * (r[0] * (c1 * r[0] + c2 * r[1]) + r[1] * (c2 * r[0] + c1 * r[1]))
-                        + beta_ext * c * r[2] * r[2])
-        g0 = -(A[0, 0] * s0 + A[1, 0] * s1 + A[2, 0] * s2)
-        g1 = -(A[0, 1] * s0 + A[1, 1] * s1 + A[2, 1] * s2)
-        g2 = -(A[0, 2] * s0 + A[1, 2] * s1 + A[2, 2] * s2)
-        for j in range(20):
-            Qf[j] = (J[0, j] * g0 + J[1, j] * g1 + J[2, j] * g2) * pw
+        _end_rates(ve, l, te, ed)
+        r0 = A[0, 0] * ed[0] + A[0, 1] * ed[1] + A[0, 2] * ed[2]
+        r1 = A[1, 0] * ed[0] + A[1, 1] * ed[1] + A[1, 2] * ed[2]
+        r2 = A[2, 0] * ed[0] + A[2, 1] * ed[1] + A[2, 2] * ed[2]
+        s0 = c1 * z1 + c2 * z2 + beta_shear * (c1 * r0 + c2 * r1)
+        s1 = c2 * z1 + c1 * z2 + beta_shear * (c2 * r0 + c1 * r1)
+        s2 = tension + beta_ext * c * r2
+        g0 = -(A[0, 0] * s0 + A[1, 0] * s1 + A[2, 0] * s2) * pw
+        g1 = -(A[0, 1] * s0 + A[1, 1] * s1 + A[2, 1] * s2) * pw
+        g2 = -(A[0, 2] * s0 + A[1, 2] * s1 + A[2, 2] * s2) * pw
+        p = -pw * (beta_shear * (r0 * (c1 * r0 + c2 * r1) + r1 * (c2 * r0 + c1 * r1)) + beta_ext * c * r2 * r2)
+        pw_[0] += p
         T += tension * pw
-        _back(loc, Qf, x, 0, xa, Ha, l)
-        _back(loc, Qf, x, 1, xb, Hb, l)
+        _to_link(loc, g0, g1, g2, x, xis, Hm, ve, te, l)
+        if kgr.shape[0] > 0:
+            gr[0], gr[1], gr[2], gr[3], gr[4], gr[5], gr[6], gr[7] = g0, g1, g2, r0, r1, r2, p, st
+            gr[8] = st == 10 and _near_kink(kmodel, st, Delta, m, c, c1, c2, h_pl, l, 1e-7)
+            kHm[k], kve[k], kte[k], kA[k], kgr[k], kxis[k] = Hm, ve, te, A, gr, xis
         if want_dv:                                               # -(A J G)^T D (A J G), D of (1.192)-(1.193)
             for i in range(3):
-                for j in range(20):
-                    row[j] = A[i, 0] * J[0, j] + A[i, 1] * J[1, j] + A[i, 2] * J[2, j]
                 AJG[i, :] = 0.0
-                _back(AJG[i], row, x, 0, xa, Ha, l)
-                _back(AJG[i], row, x, 1, xb, Hb, l)
+                _to_link(AJG[i], A[i, 0], A[i, 1], A[i, 2], x, xis, Hm, ve, te, l)
             for a in range(22):                                   # lower triangle; symmetric
                 da0 = pw * beta_shear * (c1 * AJG[0, a] + c2 * AJG[1, a])
                 da1 = pw * beta_shear * (c2 * AJG[0, a] + c1 * AJG[1, a])
@@ -207,18 +287,8 @@ def _link(x, xd, e, L, c_twist, plate_w, plate_d, plate_c, plate_c1, plate_c2, p
                 for b in range(a, 22):
                     Dv[b, a] -= AJG[0, b] * da0 + AJG[1, b] * da1 + AJG[2, b] * da2
     if c_twist[e] != 0.0:
-        kk = 2.0 / (l * Le)
-        d00, d01, d10, d11 = x[10] - x[0], x[11] - x[1], x[12] - x[2], x[13] - x[3]
-        phi = kk * (d10 * d01 - d11 * d00)
-        Jp[:] = 0.0
-        Jp[10], Jp[11], Jp[12], Jp[13] = -kk * d11, kk * d10, kk * d01, -kk * d00
-        for j in range(4):
-            Jp[j] = -Jp[10 + j]
-        phid = 0.0
-        for j in range(22):
-            phid += Jp[j] * xd[j]
-        f = c_twist[e] * (phi + beta_twist * phid)
-        pw_[0] -= beta_twist * c_twist[e] * phid * phid
+        f, phid, pt = _twist(x, xd, e, L, c_twist, par, Jp, AJG[:1, :1])
+        pw_[0] += pt
         for j in range(22):
             loc[j] -= f * Jp[j]
         if want_dv:
@@ -230,6 +300,239 @@ def _link(x, xd, e, L, c_twist, plate_w, plate_d, plate_c, plate_c1, plate_c2, p
             for b in range(a + 1, 22):
                 Dv[a, b] = Dv[b, a]
     return T
+
+
+@njit(cache=True)
+def _jac_work():
+    """Scratch of :func:`_link_jacobian`: ``Rx`` (7, 22) the gradients of the reduced variables ``R = (V (3), u_1 of
+    end 0 (2), of end 1 (2))`` of a plate, ``Rd`` (7,) their rates, ``dRd`` (7, 22) ``d R' / dx``, ``Jr`` (3, 7) the
+    strain gradients over ``R``, ``Mm`` (7, 7), ``W`` (3, 22), ``AJG`` (3, 22), ``MR`` (7, 22), ``Mt`` (22, 22)."""
+    return (np.zeros((7, 22)), np.zeros(7), np.zeros((7, 22)), np.zeros((3, 7)), np.zeros((7, 7)), np.zeros((3, 22)),
+            np.zeros((3, 22)), np.zeros((7, 22)), np.zeros((22, 22)))
+
+
+@njit(cache=True)
+def _reduced(x, xd, xis, Hm, ve, l, Rx, Rd, dRd):
+    """Gradients ``Rx`` of a plate's reduced variables ``R = (V, u_1^0, u_1^1)`` over the link's 22 coordinates (the
+    virtual-end map (1.211)-(1.212) with its moving stations ``xi_b``), their rates ``Rd = Rx x'`` and
+    ``dRd = d(Rx x')/dx``."""
+    k = 2.0 / l
+    l6 = 6.0 * l / 8.0                                            # h_i''' of i = 2, 3
+    Rx[:, :] = 0.0
+    dRd[:, :] = 0.0
+    for b in range(2):
+        o = 10 * b
+        sg = 2.0 * b - 1.0
+        xid = k * (xd[20 + b] - xd[o + 8])
+        cb, co = 20 + b, o + 8                                    # d xi_b / dx = k (e_cb - e_co)
+        for c in range(2):
+            u1, du1 = ve[b, 2 + c], ve[b, 10 + c]
+            d3u = l6 * (x[o + 4 + c] + x[o + 6 + c])
+            u1d_raw, du1d_raw = 0.0, 0.0
+            ru, r1 = c, 3 + 2 * b + c
+            for i in range(4):
+                col = o + 2 * i + c
+                Rx[ru, col] += sg * Hm[b, 0, i]
+                Rx[r1, col] += Hm[b, 1, i]
+                u1d_raw += Hm[b, 1, i] * xd[col]
+                du1d_raw += Hm[b, 2, i] * xd[col]
+                dRd[ru, col] += sg * xid * Hm[b, 1, i]
+                dRd[r1, col] += xid * Hm[b, 2, i]
+            for cc, s in ((cb, k), (co, -k)):
+                Rx[ru, cc] += sg * u1 * s
+                Rx[r1, cc] += du1 * s
+                dRd[ru, cc] += sg * (u1d_raw + xid * du1) * s
+                dRd[r1, cc] += (du1d_raw + xid * d3u) * s
+        Rx[2, o + 8] += sg
+        Rx[2, o + 9] += sg * xis[b]
+        Rx[2, cb] += sg * x[o + 9] * k
+        Rx[2, co] -= sg * x[o + 9] * k
+        dRd[2, cb] += sg * xd[o + 9] * k
+        dRd[2, co] -= sg * xd[o + 9] * k
+        dRd[2, o + 9] += sg * xid
+    for r in range(7):
+        s = 0.0
+        for j in range(22):
+            s += Rx[r, j] * xd[j]
+        Rd[r] = s
+
+
+@njit(cache=True)
+def _map_curvature(Kx, F, x, Hm, ve, l):
+    """Add ``sum_r F_r d^2 R_r / dx^2`` to ``Kx`` (22, 22): the curvature of the virtual-end map under the reduced
+    forces ``F`` (7,) (``F = Jr^T g``: on ``V`` and the two ends' ``u_1``)."""
+    k = 2.0 / l
+    l6 = 6.0 * l / 8.0
+    a = np.zeros(22)
+    for b in range(2):
+        o = 10 * b
+        sg = 2.0 * b - 1.0
+        a[:] = 0.0
+        s = 0.0
+        for c in range(2):
+            fu0, fu1 = sg * F[c], F[3 + 2 * b + c]
+            for i in range(4):
+                a[o + 2 * i + c] += fu0 * Hm[b, 1, i] + fu1 * Hm[b, 2, i]
+            s += fu0 * ve[b, 10 + c] + fu1 * l6 * (x[o + 4 + c] + x[o + 6 + c])
+        a[o + 9] += sg * F[2]
+        cb, co = 20 + b, o + 8
+        for j in range(22):
+            if a[j] != 0.0:
+                Kx[j, cb] += k * a[j]
+                Kx[j, co] -= k * a[j]
+                Kx[cb, j] += k * a[j]
+                Kx[co, j] -= k * a[j]
+        kk = k * k * s
+        Kx[cb, cb] += kk
+        Kx[co, co] += kk
+        Kx[cb, co] -= kk
+        Kx[co, cb] -= kk
+
+
+@njit(cache=True)
+def _link_jacobian(x, xd, e, L, c_twist, plate_w, plate_d, plate_c, plate_c1, plate_c2, par, kmodel, loc, Kx, Dv,
+                   dT, dPx, dPv, wk, jw, keep):
+    """Link ``e`` as :func:`_link` (its pass, with the plates kept in ``keep``, :func:`_keep`) with its exact
+    derivatives within the plates' states: adds the forces to ``loc``,
+    ``dQ/dx`` to ``Kx`` and ``dQ/dx'`` to ``Dv`` (22, 22), the tension's gradient to ``dT`` and the gradients of the
+    power of its damping forces (W) to ``dPx``, ``dPv`` (22,); returns ``(tension (N), power (W))``.
+
+    Per plate with the reduced variables ``R`` of :func:`_reduced` (``eps = eps(R)``, ``Jr = d eps/dR``, the strain
+    Hessians ``Hr_s`` over ``R`` of (1.186)-(1.189)): ``loc = Rx^T Jr^T g``, and
+    ``dQ/dx = Rx^T (sum_s g_s Hr_s) Rx + curvature of the map (F = Jr^T g) - (A Jr Rx)^T (K A Jr Rx + D A d eps'/dx)``
+    with ``d eps'/dx = (Hr . R') Rx + Jr dR'/dx``, ``K``, ``D`` the plate's stiffness and damping.  As in
+    :mod:`per_plate_kernel`, the tension's stiffness ``c`` counts in every state (a slack plate, state 10, has
+    ``A = 0``), so an unstretched plate in state 1 gets the one-sided stiffness into tension; a slack plate within a
+    difference step of tension (:func:`_near_kink`) gets the elastic stiffness of the taut state 1 (``A = I``; its
+    damping stays the slack state's, none, as in its forces): at a kink the exact blocks are one-sided, and the slack
+    side has no stiffness at all (Newton from an unstretched chain stalls on it; central differences average the
+    two sides)."""
+    Jp, pw_ = wk[6], wk[-1]
+    kHm, kve, kte, kA, kgr, kxis = keep
+    Rx, Rd, dRd, Jr, Mm, W, AJG, MR, Mt = jw
+    l, beta_ext, beta_shear, beta_twist = par[0], par[6], par[7], par[8]
+    kl = 2.0 / l
+    p0 = pw_[0]
+    T = _link(x, xd, e, L, c_twist, plate_w, plate_d, plate_c, plate_c1, plate_c2, par, kmodel, loc, Mt, False, wk,
+              keep)
+    P = pw_[0] - p0
+    F, HR, AJr, AJe, AHR = np.zeros(7), np.zeros((3, 7)), np.zeros((3, 7)), np.zeros((3, 7)), np.zeros((3, 7))
+    for kp in range(plate_w.shape[1]):
+        pw = plate_w[e, kp]
+        if pw == 0.0:
+            continue
+        Hm, ve, te, A, gr, xis = kHm[kp], kve[kp], kte[kp], kA[kp], kgr[kp], kxis[kp]
+        c, c1, c2 = plate_c[e, kp], plate_c1[e, kp], plate_c2[e, kp]
+        taut = gr[8] != 0.0                                       # slack within a step of tension: K of state 1
+        _reduced(x, xd, xis, Hm, ve, l, Rx, Rd, dRd)
+        Jr[:, :] = 0.0
+        for j in range(3):
+            Jr[0, j], Jr[1, j], Jr[2, j] = te[1, j], te[2, j], te[0, j]
+        Jr[0, 3], Jr[0, 4], Jr[1, 5], Jr[1, 6] = kl * te[0, 0], kl * te[0, 1], kl * te[0, 0], kl * te[0, 1]
+        # strain Hessians over R: Delta: P/Lt; psi_a: -(psi_a P/Lt + t e_a^T + e_a t^T)/Lt, mixed k P[:, c]/Lt
+        t0, t1, t2 = te[0, 0], te[0, 1], te[0, 2]
+        V0, V1, V2 = ve[1, 0] - ve[0, 0], ve[1, 1] - ve[0, 1], ve[1, 4] - ve[0, 4]
+        il = 1.0 / np.sqrt(V0 * V0 + V1 * V1 + V2 * V2)
+        psi = (kl * (t0 * ve[0, 2] + t1 * ve[0, 3]) + t2, kl * (t0 * ve[1, 2] + t1 * ve[1, 3]) + t2)
+        Mm[:, :] = 0.0
+        HR[:, :] = 0.0
+        for i in range(3):
+            for j in range(3):
+                Pij = ((1.0 if i == j else 0.0) - te[0, i] * te[0, j]) * il
+                h2 = Pij
+                h0 = -(psi[0] * Pij + te[0, i] * te[1, j] + te[1, i] * te[0, j]) * il
+                h1 = -(psi[1] * Pij + te[0, i] * te[2, j] + te[2, i] * te[0, j]) * il
+                Mm[i, j] += gr[0] * h0 + gr[1] * h1 + gr[2] * h2
+                HR[0, i] += h0 * Rd[j]
+                HR[1, i] += h1 * Rd[j]
+                HR[2, i] += h2 * Rd[j]
+            for a in range(2):
+                for cc in range(2):
+                    m_ = kl * ((1.0 if i == cc else 0.0) - te[0, i] * te[0, cc]) * il
+                    Mm[i, 3 + 2 * a + cc] += gr[a] * m_
+                    Mm[3 + 2 * a + cc, i] += gr[a] * m_
+                    HR[a, i] += m_ * Rd[3 + 2 * a + cc]
+                    HR[a, 3 + 2 * a + cc] += m_ * Rd[i]
+        for r in range(7):
+            F[r] = Jr[0, r] * gr[0] + Jr[1, r] * gr[1] + Jr[2, r] * gr[2]
+        _map_curvature(Kx, F, x, Hm, ve, l)
+        # A Jr (3, 7) and the stiffness/damping rows over R: -pw (A Jr)^T (K A Jr + D A HR) into Mm
+        for i in range(3):
+            for r in range(7):
+                AJr[i, r] = A[i, 0] * Jr[0, r] + A[i, 1] * Jr[1, r] + A[i, 2] * Jr[2, r]
+                AJe[i, r] = Jr[i, r] if taut else AJr[i, r]
+        Kd = ((c1, c2, 0.0), (c2, c1, 0.0), (0.0, 0.0, c))
+        Dd = ((beta_shear * c1, beta_shear * c2, 0.0), (beta_shear * c2, beta_shear * c1, 0.0),
+              (0.0, 0.0, beta_ext * c))
+        for i in range(3):
+            for r in range(7):
+                AHR[i, r] = A[i, 0] * HR[0, r] + A[i, 1] * HR[1, r] + A[i, 2] * HR[2, r]
+        for i in range(3):
+            for r in range(7):
+                se, sd = 0.0, 0.0
+                for jj in range(3):
+                    se += Kd[i][jj] * AJe[jj, r]
+                    sd += Dd[i][jj] * AHR[jj, r]
+                for q in range(7):
+                    Mm[q, r] -= pw * (AJe[i, q] * se + AJr[i, q] * sd)
+        # Kx += Rx^T Mm Rx
+        for q in range(7):
+            for j in range(22):
+                s = 0.0
+                for r in range(7):
+                    s += Mm[q, r] * Rx[r, j]
+                MR[q, j] = s
+        for i in range(22):
+            for q in range(7):
+                rq = Rx[q, i]
+                if rq != 0.0:
+                    for j in range(22):
+                        Kx[i, j] += rq * MR[q, j]
+        # AJG = A Jr Rx, W = A Jr dRd (the rate term of d eps'/dx through the map)
+        for i in range(3):
+            for j in range(22):
+                s, w_ = 0.0, 0.0
+                for r in range(7):
+                    s += AJr[i, r] * Rx[r, j]
+                    w_ += AJr[i, r] * dRd[r, j]
+                AJG[i, j], W[i, j] = s, w_
+        r0, r1, r2 = gr[3], gr[4], gr[5]
+        Dr = (Dd[0][0] * r0 + Dd[0][1] * r1, Dd[1][0] * r0 + Dd[1][1] * r1, Dd[2][2] * r2)
+        for j in range(22):
+            h0, h1, h2 = 0.0, 0.0, 0.0                            # A (Hr . R') Rx
+            for r in range(7):
+                h0 += AHR[0, r] * Rx[r, j]
+                h1 += AHR[1, r] * Rx[r, j]
+                h2 += AHR[2, r] * Rx[r, j]
+            dw0 = Dd[0][0] * W[0, j] + Dd[0][1] * W[1, j]
+            dw1 = Dd[1][0] * W[0, j] + Dd[1][1] * W[1, j]
+            dw2 = Dd[2][2] * W[2, j]
+            da0 = Dd[0][0] * AJG[0, j] + Dd[0][1] * AJG[1, j]
+            da1 = Dd[1][0] * AJG[0, j] + Dd[1][1] * AJG[1, j]
+            da2 = Dd[2][2] * AJG[2, j]
+            for i in range(22):
+                Kx[i, j] -= pw * (AJG[0, i] * dw0 + AJG[1, i] * dw1 + AJG[2, i] * dw2)
+                Dv[i, j] -= pw * (AJG[0, i] * da0 + AJG[1, i] * da1 + AJG[2, i] * da2)
+            dT[j] += pw * c * AJG[2, j]
+            # P = -pw r^T D r, r = A eps', d eps'/dx = HR Rx + Jr dRd
+            dPv[j] -= 2 * pw * (Dr[0] * AJG[0, j] + Dr[1] * AJG[1, j] + Dr[2] * AJG[2, j])
+            dPx[j] -= 2 * pw * (Dr[0] * (W[0, j] + h0) + Dr[1] * (W[1, j] + h1) + Dr[2] * (W[2, j] + h2))
+    if c_twist[e] != 0.0:                                         # its forces and power came with _link's
+        f, phid, _ = _twist(x, xd, e, L, c_twist, par, Jp, Mt)
+        ct, bt = c_twist[e], beta_twist
+        Mxd = np.zeros(22)
+        for i in range(22):
+            s = 0.0
+            for j in range(22):
+                s += Mt[i, j] * xd[j]
+            Mxd[i] = s
+        for i in range(22):
+            for j in range(22):
+                Kx[i, j] -= ct * (Jp[i] * Jp[j] + bt * Jp[i] * Mxd[j]) + f * Mt[i, j]
+                Dv[i, j] -= ct * bt * Jp[i] * Jp[j]
+            dPx[i] -= 2 * bt * ct * phid * Mxd[i]
+            dPv[i] -= 2 * bt * ct * phid * Jp[i]
+    return T, P
 
 
 # ---------------------------------------------------------------------------------------------- pins
@@ -464,12 +767,12 @@ def forces_power(q, v, gl, gp, L, c_twist, b_joint, cs, plate_w, plate_d, plate_
     Q = np.zeros(q.shape[0])
     T = np.zeros(n)
     x, xd, loc, Dv = np.zeros(22), np.zeros(22), np.zeros(22), np.zeros((1, 1))
-    wk = _link_work()
+    wk, none = _link_work(), _keep(0)
     for e in range(n):
         for j in range(22):
             x[j], xd[j], loc[j] = q[gl[e, j]], v[gl[e, j]], 0.0
         T[e] = _link(x, xd, e, L, c_twist, plate_w, plate_d, plate_c, plate_c1, plate_c2, par, kmodel, loc, Dv,
-                     False, wk)
+                     False, wk, none)
         for j in range(22):
             Q[gl[e, j]] += loc[j]
     y, yd, lp = np.zeros(29), np.zeros(29), np.zeros(29)
@@ -492,13 +795,14 @@ def _step(x, rel, floor):
 
 @njit(cache=True)
 def jacobian(q, v, gl, gp, L, c_twist, b_joint, cs, plate_w, plate_d, plate_c, plate_c1, plate_c2, arc, idx, sig,
-             cw, par, ints, pos_l, pos_p, pos_t, first, steps, central_link, Jq, Jv, dDq, dDv):
+             cw, par, ints, pos_l, pos_p, pos_t, first, steps, link_scheme, Jq, Jv, dDq, dDv):
     """``dQ/dq``, ``dQ/dv`` of :func:`forces` added into the CSR data ``Jq``, ``Jv`` (positions ``pos_l (n, 22, 22)``
     of the link blocks, ``pos_p (n, 29, 29)`` of the pin blocks, ``pos_t (n, 2, 3, 22)`` of the axial friction
     rows against the tensions' link coordinates; ``first`` of :func:`positions`).
 
     Element by element: a link's velocity block is exact (its forces are linear in the velocities), its
-    coordinate block forward (``central_link`` false) or central differences of the link alone; a pin's blocks
+    coordinate block exact within the plates' states (``link_scheme`` :data:`ANALYTIC`, :func:`_link_jacobian`) or
+    :data:`FORWARD` or :data:`CENTRAL` differences of the link alone; a pin's blocks
     central differences of the pin alone (a coordinate and its copies at once); the axial friction's
     dependence on the link tensions by the chain rule with the tensions' differences.  ``steps = (link, pin
     coordinate, pin velocity)`` relative steps, applied to ``max(|x|, l)`` (smaller steps drown in the round-off
@@ -517,15 +821,29 @@ def jacobian(q, v, gl, gp, L, c_twist, b_joint, cs, plate_w, plate_d, plate_c, p
     T, dT = np.zeros(n), np.zeros((n, 22))
     x, xd, f_0, f_p, f_m = np.zeros(22), np.zeros(22), np.zeros(22), np.zeros(22), np.zeros(22)
     Dv, Dx = np.zeros((22, 22)), np.zeros((1, 1))
-    wk = _link_work()
+    wk, none, keep = _link_work(), _keep(0), _keep(plate_w.shape[1])
     pw = wk[-1]
+    Kx, dPx, dPv, jw = np.zeros((22, 22)), np.zeros(22), np.zeros(22), _jac_work()
     for e in range(n):
         for j in range(22):
             x[j], xd[j], f_0[j] = q[gl[e, j]], v[gl[e, j]], 0.0
         Dv[:, :] = 0.0
+        if link_scheme == ANALYTIC:
+            Kx[:, :] = 0.0
+            dPx[:] = 0.0
+            dPv[:] = 0.0
+            T[e] = _link_jacobian(x, xd, e, L, c_twist, plate_w, plate_d, plate_c, plate_c1, plate_c2, par, kmodel,
+                                  f_0, Kx, Dv, dT[e], dPx, dPv, wk, jw, keep)[0]
+            for j in range(22):
+                dDq[gl[e, j]] -= dPx[j]
+                dDv[gl[e, j]] -= dPv[j]
+                for r in range(22):
+                    Jq[pos_l[e, r, j]] += Kx[r, j]
+                    Jv[pos_l[e, r, j]] += Dv[r, j]
+            continue
         pw[0] = 0.0                                               # each pass's power alone (no round-off of a sum)
         T[e] = _link(x, xd, e, L, c_twist, plate_w, plate_d, plate_c, plate_c1, plate_c2, par, kmodel, f_0, Dv,
-                     True, wk)
+                     True, wk, none)
         P0 = pw[0]
         for j in range(22):
             x0 = x[j]
@@ -534,14 +852,14 @@ def jacobian(q, v, gl, gp, L, c_twist, b_joint, cs, plate_w, plate_d, plate_c, p
             f_p[:] = 0.0
             pw[0] = 0.0
             Tp = _link(x, xd, e, L, c_twist, plate_w, plate_d, plate_c, plate_c1, plate_c2, par, kmodel, f_p, Dx,
-                       False, wk)
+                       False, wk, none)
             Pp = pw[0]
-            if central_link:
+            if link_scheme != FORWARD:
                 x[j] = x0 - h
                 f_m[:] = 0.0
                 pw[0] = 0.0
                 Tm = _link(x, xd, e, L, c_twist, plate_w, plate_d, plate_c, plate_c1, plate_c2, par, kmodel, f_m,
-                           Dx, False, wk)
+                           Dx, False, wk, none)
                 Pm = pw[0]
                 h2 = 2 * h
             else:
@@ -602,4 +920,5 @@ def jacobian(q, v, gl, gp, L, c_twist, b_joint, cs, plate_w, plate_d, plate_c, p
                         Jq[pos_t[p, j, r, c]] += slopes[j, r] * dT[e, c]
 
 
-__all__ = ["HAVE_NUMBA", "SMOOTH_EPS", "forces", "forces_power", "jacobian", "pack", "positions"]
+__all__ = ["ANALYTIC", "CENTRAL", "FORWARD", "HAVE_NUMBA", "SMOOTH_EPS", "forces", "forces_power", "jacobian", "pack",
+           "positions"]

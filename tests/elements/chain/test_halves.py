@@ -191,7 +191,7 @@ def test_open_segment_under_end_tension_carries_it_in_every_link():
         R = ch.forces(q, v) + Qext
         if np.abs(R).max() < 1e-9 * T:
             break
-        K, _ = ch.jacobian(q, v, damping=False)        # central: forward differences diverge from the kinks here
+        K, _ = ch.jacobian(q, v, damping=False)        # exact link blocks (forward differences diverge here)
         q = q + np.linalg.lstsq(-K.toarray(), R, rcond=1e-12)[0]
     assert np.abs(ch.forces(q, v) + Qext).max() < 1e-9 * T
     out = ch.outputs(q)
