@@ -27,8 +27,9 @@ import numpy as np
 from cvtfem.errors import InputError
 from cvtfem.problems.base import Problem
 
-__all__ = ["PinForceProblem", "cvt_problem", "pin_force_problem", "output_component", "window_error", "jacobian_spectrum", "spectrum_with_v0",
-           "local_error_table", "block_scales", "baseline_time", "state_at", "ACCEPT_E"]
+__all__ = ["PinForceProblem", "cvt_problem", "pin_force_problem", "output_of", "output_component", "window_error",
+           "jacobian_spectrum", "spectrum_with_v0", "local_error_table", "block_scales", "baseline_time", "state_at",
+           "ACCEPT_E"]
 
 #: The source's acceptance of test 2.
 ACCEPT_E = 0.05

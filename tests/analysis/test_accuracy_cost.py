@@ -91,6 +91,15 @@ def test_effective_orders_on_the_chain_match_the_nominal_orders(study):
                 assert r["p_eff"] == pytest.approx(nominal, abs=0.1), (label, r)
 
 
+def test_the_output_component_names_the_pin_half():
+    """A5's half forces come as half - of every pin, then half + (``chain.pin_half_axial_force``)."""
+    half = {"output": ac.HALF_FORCE, "pins": 84}
+    assert ac.output_component({**half, "pin": 12}) == "pin 12, half -"
+    assert ac.output_component({**half, "pin": 84 + 12}) == "pin 12, half +"
+    assert ac.output_component({"output": ac.PIN_FORCE, "pin": 40}) == "pin 40"
+    assert ac.output_component({"output": ac.BAND_FORCE, "pin": 3}) == "Gauss node 3"
+
+
 def test_block_scales_weight_positions_velocities_and_states_apart():
     x0 = np.array([1e-3, -2e-3, 5.0, -50.0, 0.0, 0.0])
     assert ac.block_scales(x0, 2).tolist() == [2e-3, 2e-3, 50.0, 50.0, 1.0, 1.0]
@@ -139,6 +148,8 @@ def test_bad_local_arguments_are_refused_before_any_work(cli, args, needle):
     (("--fixed", "Radau"), "`--fixed`"),
     (("--reference", "Radau"), "`--reference`"),
     (("--spectrum-png", "x.svg"), "`--spectrum-png`"),
+    (("--settle", "2e-3"), "`--settle`"),          # after T1 (1e-3 by default)
+    (("--placed", "--window", "0:1e-6", "--sample", "2e-7"), "`--placed`"),   # chain-S2 has no placed state
 ])
 def test_bad_arguments_are_refused_before_any_work(cli, args, needle):
     res = cli("study", "accuracy-cost", "chain-S2", *args, timeout=60)
