@@ -62,6 +62,9 @@ for law in linear-saturated smoothed; do
       --adaptive rock4,dopri45 --rtols 1e-2,1e-3
     e2 "variant-e-$law-large" --fixed rk4,dopri45,gbs-smooth:stages=2,dumka3 --steps 5e-8,1e-7,2e-7,5e-7,1e-6 \
       --adaptive rock4,rodas5p,Radau --rtols 1e-1,1e-2
+    test2 "variant-e-$law-10us" "$(e_scene e $law)" --placed --skip-spectrum --window 2e-6:1e-5 --sample 5e-8 \
+      --repeats 1 --reference DOP853:1e-6 --check dopri78:1e-6 --fixed rk4,dopri45 --steps 5e-8,2e-7,1e-6,2e-6 \
+      --adaptive rock4,rodas5p --rtols 1e-2
     for at in 0 1e-6; do                       # test 1 from the placed state and from the state at 1 us
       tag="variant-e-$law-local$([[ $at == 0 ]] || echo 1us)"
       for kind in explicit implicit; do
