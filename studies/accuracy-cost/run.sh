@@ -65,6 +65,9 @@ for law in linear-saturated smoothed; do
     test2 "variant-e-$law-10us" "$(e_scene e $law)" --placed --skip-spectrum --window 2e-6:1e-5 --sample 5e-8 \
       --repeats 1 --reference DOP853:1e-6 --check dopri78:1e-6 --fixed rk4,dopri45 --steps 5e-8,2e-7,1e-6,2e-6 \
       --adaptive rock4,rodas5p --rtols 1e-2
+    test2 "variant-e-$law-5us" "$(e_scene e $law)" --placed --settle 5e-6 --window 5e-6:7e-6 --sample 1e-7 \
+      --repeats 1 --reference DOP853:1e-6 --check dopri78:1e-6 --fixed rk4 --steps 5e-8,1e-6 --adaptive rock4 \
+      --rtols 1e-2                             # with the spectra at 5 us (v0 and v0/10)
     for at in 0 1e-6; do                       # test 1 from the placed state and from the state at 1 us
       tag="variant-e-$law-local$([[ $at == 0 ]] || echo 1us)"
       for kind in explicit implicit; do
