@@ -12,25 +12,31 @@ Spec ``numerics-and-periodic.md`` section 9.  On a chain-CVT scene started in it
 * test 1 (section 9.4): the local error of one step of size ``h`` from a state of the run, in a norm weighted
   per state block (positions, velocities, first-order states: section 9.7), and the effective order (A:(2.8)).
 
-On a band model the output is the sheave normal force (N/m) at the Gauss node whose force varies most (the band
-has no pins); everything else is the same.
+On a chain with independent pin halves (A5: variants (e) and (zh)) the output is the axial force of one pin half,
+the source's quantity for (e); on a band model the sheave normal force (N/m) at the Gauss node whose force varies
+most (the band has no pins); everything else is the same.  Where the start is far from a steady state (A5's
+quasi-static solve can stall and leave the chain placed off balance), the study can start after a settling
+interval, from the state the reference method reaches there.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
 from cvtfem.errors import InputError
 from cvtfem.problems.base import Problem
 
-__all__ = ["PinForceProblem", "pin_force_problem", "window_error", "jacobian_spectrum", "spectrum_with_v0",
-           "local_error_table", "block_scales", "baseline_time", "state_at", "ACCEPT_E"]
+__all__ = ["PinForceProblem", "cvt_problem", "pin_force_problem", "output_of", "output_component", "window_error",
+           "jacobian_spectrum", "spectrum_with_v0", "local_error_table", "block_scales", "baseline_time", "state_at",
+           "ACCEPT_E"]
 
 #: The source's acceptance of test 2.
 ACCEPT_E = 0.05
 #: Output of the chain families whose global error test 2 measures.
 PIN_FORCE = "chain.pin_axial_force"
+#: Output of the chains with independent pin halves (A5): axial force of each half, N (half -, then half +).
+HALF_FORCE = "chain.pin_half_axial_force"
 #: Output of the band models measured instead (they have no pins): sheave normal force per Gauss node, N/m.
 BAND_FORCE = "band.normal_force"
 
@@ -66,7 +72,7 @@ class PinForceProblem(Problem):
         out = []
         for yi in np.asarray(y).T:
             q, v = self.loop.split(yi)[:2]
-            out.append(fam.outputs(q[:fam.size], v[:fam.size])[PIN_FORCE])
+            out.append(fam.outputs(q[:fam.size], v[:fam.size])[self.output])
         return np.array(out)
 
     def error(self, res) -> float:
@@ -75,32 +81,80 @@ class PinForceProblem(Problem):
         return window_error(self.pin_forces(res.y, res.t)[:, self.pin], self.p_ref)
 
 
+def output_of(scene, loop) -> str:
+    """The output test 2 measures on the scene's ``loop``: a pin half's axial force on A5, a pin's on the other
+    chains, the sheave normal force on a band model."""
+    if not scene.cvt.model.startswith("chain"):
+        return BAND_FORCE
+    names = {s.name for s in loop.family.output_specs}
+    return HALF_FORCE if HALF_FORCE in names else PIN_FORCE
+
+
+def output_component(report: dict) -> str:
+    """What component ``report["pin"]`` of the report's output is: ``"pin 40"``, ``"pin 12, half +"`` (A5's halves:
+    half ``-`` of every pin, then half ``+``), ``"Gauss node 3"``."""
+    k = report["pin"]
+    if report["output"] == HALF_FORCE:
+        return f"pin {k % report['pins']}, half {'-+'[k // report['pins']]}"
+    return f"Gauss node {k}" if report["output"] == BAND_FORCE else f"pin {k}"
+
+
+def cvt_problem(scene, t_end: float, settle: float = 0.0, settle_by: tuple[str, float] = ("Radau", 1e-8),
+                placed: bool = False) -> tuple[PinForceProblem, dict]:
+    """The scene's closed loop from its start state (``loop.start()``: quasi-static, or placed off balance where
+    that solve stalls) over ``[0, t_end]``, or, with ``settle > 0`` (s), from the state that ``settle_by`` (method,
+    rtol; ``atol = 1e-3 rtol``) reaches at ``settle``, over ``[settle, t_end]``; and a report of the start.
+    ``placed``: start from the chain placed on the sheaves (``placed_state``, A5 only) without trying the
+    quasi-static solve (which stalls at the chapter-2 regime after about 150 evaluations: docs/accuracy-cost.md)."""
+    from cvtfem.machines.cvt import closed_loop
+
+    if not (0 <= settle < t_end and np.isfinite(t_end)):
+        raise InputError("--settle", settle, f"must be a time in 0..{t_end:g} s (before the run's end)")
+    loop = closed_loop(scene)
+    if placed and not hasattr(loop, "placed_state"):
+        raise InputError("--placed", scene.cvt.model, "must be a chain with independent pin halves (chain-A5): only "
+                         "they have a placed start state")
+    if placed:
+        w1, _, ratio = loop.regime.targets(0.0)
+        x0, start = loop.placed_state(ratio, w1), {"kind": "placed on the sheaves, off balance (no quasi-static solve)"}
+    else:
+        x0, start = loop.start()
+    sparsity = loop.jac_sparsity() if callable(loop.jac_sparsity) else loop.jac_sparsity
+    problem = PinForceProblem(scene.cvt.model, loop.rhs, x0, (0.0, t_end), n2=loop.n2, jac=loop.jac,
+                              jac_sparsity=sparsity, loop=loop, output=output_of(scene, loop),
+                              info={"n": len(x0), "n2": loop.n2})
+    if settle > 0:
+        problem = replace(problem, y0=state_at(problem, settle, *settle_by), t_span=(settle, t_end))
+    report = {"start": start["kind"], "settle": settle,
+              "settled_by": f"{settle_by[0]} rtol {settle_by[1]:g}" if settle > 0 else None}
+    return problem, report
+
+
 def pin_force_problem(scene, window: tuple[float, float] = (1e-3, 5e-3), sample: float = 1e-5,
                       reference: tuple[str, float] = ("Radau", 1e-8),
-                      check: tuple[str, float] = ("rodas5p", 1e-8)) -> tuple[PinForceProblem, dict]:
+                      check: tuple[str, float] = ("rodas5p", 1e-8), settle: float = 0.0,
+                      placed: bool = False) -> tuple[PinForceProblem, dict]:
     """Test 2 of the protocol on a CVT scene: the problem, and a report of its reference.
 
-    The pin is the one whose axial force varies most over the window in the reference run (a pin entering or
-    leaving an arc: the sharply varying output of A:(2.9)); on a band model the Gauss node whose normal force
-    varies most.  ``reference`` and ``check`` are two methods with
-    their rtol (``atol = 1e-3 rtol``, analytic sparse Jacobian); the report holds the ``E`` between them.
+    The pin (or pin half, on A5) is the one whose axial force varies most over the window in the reference run (a
+    pin entering or leaving an arc: the sharply varying output of A:(2.9)); on a band model the Gauss node whose
+    normal force varies most.  ``reference`` and ``check`` are two methods with their rtol (``atol = 1e-3 rtol``,
+    analytic sparse Jacobian); the report holds the ``E`` between them.  The run starts as :func:`cvt_problem`
+    (``settle``: by the reference method; ``placed``), so both references share the start state.
     """
     from cvtfem.integrate import solve
-    from cvtfem.machines.cvt import closed_loop
 
     t1, t2 = (float(v) for v in window)
     if not (0 <= t1 < t2 and np.isfinite(t2)):
         raise InputError("--window", window, "must be two simulated times 0 <= t1 < t2, s")
     if not (0 < sample <= (t2 - t1) / 4):
         raise InputError("--sample", sample, f"must be positive and give at least 4 samples in {t2 - t1:g} s")
-    output = PIN_FORCE if scene.cvt.model.startswith("chain") else BAND_FORCE
-    loop = closed_loop(scene)
-    x0, start = loop.start()
+    if not 0 <= settle <= t1:
+        raise InputError("--settle", settle, f"must be a time in 0..{t1:g} s (T1 of --window)")
+    base, start = cvt_problem(scene, t2, settle, reference, placed)
     t_eval = np.arange(t1, t2 + 0.5 * sample, sample)
     t_eval = t_eval[t_eval <= t2]
-    sparsity = loop.jac_sparsity() if callable(loop.jac_sparsity) else loop.jac_sparsity
-    base = PinForceProblem(scene.cvt.model, loop.rhs, x0, (0.0, t2), n2=loop.n2, jac=loop.jac,
-                           jac_sparsity=sparsity, loop=loop, t_eval=t_eval, output=output)
+    base = replace(base, t_eval=t_eval)
     forces = {}
     for method, rtol in (reference, check):
         res = solve(**base.solve_kwargs(), method=method, rtol=rtol, atol=1e-3 * rtol, t_eval=t_eval)
@@ -109,10 +163,9 @@ def pin_force_problem(scene, window: tuple[float, float] = (1e-3, 5e-3), sample:
         forces[method] = base.pin_forces(res.y)
     p_all = forces[reference[0]]
     pin = int(np.argmax(np.ptp(p_all, axis=0)))
-    problem = PinForceProblem(scene.cvt.model, loop.rhs, x0, (0.0, t2), n2=loop.n2, jac=loop.jac,
-                              jac_sparsity=sparsity, loop=loop, pin=pin, t_eval=t_eval, p_ref=p_all[:, pin],
-                              output=output, info={"n": len(x0), "n2": loop.n2})
-    report = {"start": start["kind"], "output": output, "pin": pin, "samples": len(t_eval), "window": (t1, t2),
+    problem = replace(base, pin=pin, p_ref=p_all[:, pin])
+    report = {**start, "output": base.output, "pin": pin, "pins": getattr(base.loop.family, "n", 0),
+              "samples": len(t_eval), "window": (t1, t2),
               "reference": f"{reference[0]} rtol {reference[1]:g}", "check": f"{check[0]} rtol {check[1]:g}",
               "reference_E": window_error(forces[check[0]][:, pin], p_all[:, pin]),
               "force_range": (float(p_all[:, pin].min()), float(p_all[:, pin].max()))}
@@ -168,19 +221,21 @@ def speedups(rows: list[dict], baseline: dict | None, accept: float = ACCEPT_E) 
     return out
 
 
-def baseline_time(rows: list[dict], h: float, t_end: float) -> dict | None:
-    """The baseline of the speed-up table, RK4 at step ``h`` (s) over ``[0, t_end]``: its run if the study made
-    it, else its wall time estimated from the study's RK4 runs (a fixed-step RK4 run costs 4 RHS calls per step
-    and nothing else, so its wall time is ``4 t_end / h`` times the median wall time per RHS call of those runs;
-    ``estimated`` says which).  ``None`` without RK4 runs."""
+def baseline_time(rows: list[dict], h: float, span: float) -> dict | None:
+    """The baseline of the speed-up table, RK4 at step ``h`` (s) over a run of ``span`` s: its run if the study
+    made it and it completed, else its wall time estimated from the study's RK4 runs (a fixed-step RK4 run costs 4
+    RHS calls per step and nothing else, so its wall time is ``4 span / h`` times the median wall time per RHS call
+    of those runs; ``estimated`` says which, ``failed`` that the study ran it and it did not complete: unstable at
+    that step).  ``None`` without RK4 runs."""
     rk4 = [r for r in rows if r["method"] == "rk4" and "h" in r and np.isfinite(r["time"]) and r["nfev"] > 0]
     exact = [r for r in rk4 if abs(r["h"] - h) <= 1e-9 * h]
-    if exact:
-        return {"time": exact[0]["time"], "nfev": exact[0]["nfev"], "estimated": False}
+    if exact and np.isfinite(exact[0]["error"]):
+        return {"time": exact[0]["time"], "nfev": exact[0]["nfev"], "estimated": False, "failed": False}
     if not rk4:
         return None
-    nfev = 4 * int(round(t_end / h))
-    return {"time": nfev * float(np.median([r["time"] / r["nfev"] for r in rk4])), "nfev": nfev, "estimated": True}
+    nfev = 4 * int(round(span / h))
+    return {"time": nfev * float(np.median([r["time"] / r["nfev"] for r in rk4])), "nfev": nfev, "estimated": True,
+            "failed": bool(exact)}
 
 
 def block_scales(x0, n2: int) -> np.ndarray:

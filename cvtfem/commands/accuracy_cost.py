@@ -25,6 +25,11 @@ def add_subparser(s) -> None:
                                            "of a pin force, speed-up table; spec section 9)")
     e.add_argument("scene", metavar="SCENE", help="chain-CVT scene or preset, e.g. chain-S2,regime-chapter2")
     e.add_argument("--window", default="1e-3:5e-3", help="T1:T2, s: the error window (the run spans 0..T2)")
+    e.add_argument("--settle", type=float, default=0.0,
+                   help="start every run (and the spectra, test 1) at this time, from the state the --reference "
+                        "method reaches there, s (0: from the scene's start state; at most T1)")
+    e.add_argument("--placed", action="store_true",
+                   help="A5 chains: start from the chain placed on the sheaves without trying the quasi-static solve")
     e.add_argument("--sample", type=float, default=1e-5, help="output step in the window, s")
     e.add_argument("--fixed", default="rk4,dopri45,dumka3", help="fixed-step methods (comma-separated specs)")
     e.add_argument("--steps", default="5e-8,1e-7,2e-7,5e-7,1e-6", help="fixed steps h, s")
@@ -36,6 +41,8 @@ def add_subparser(s) -> None:
     e.add_argument("--png", default="out/studies/accuracy_cost.png", help="E against wall time and RHS calls")
     e.add_argument("--spectrum-png", default="out/studies/accuracy_cost_spectrum.png",
                    help="Jacobian eigenvalues at the window's start, with v0 and v0/10")
+    e.add_argument("--skip-spectrum", action="store_true",
+                   help="no spectra (two dense eigenvalue problems: minutes on A5's 3544 states)")
     e.add_argument("--csv", default="out/studies/accuracy_cost.csv", help="one row per run")
     e.add_argument("--json", default="out/studies/accuracy_cost.json", help="reference report and speed-up table")
     e.add_argument("--local", action="store_true",
@@ -130,12 +137,16 @@ def run_local(args: argparse.Namespace, window) -> int:
     t_at = window[0] if args.local_at is None else args.local_at
     if not (math.isfinite(t_at) and 0 <= t_at <= window[1]):
         raise InputError("--local-at", t_at, f"must be a time in 0..{window[1]:g} s (T2 of --window)")
+    if not args.settle <= t_at:
+        raise InputError("--settle", args.settle, f"must be at most the time of --local-at, {t_at:g} s")
     reference = _pair(args.reference, "--reference")
     scene = load_scene(args.scene)
-    problem, _ = ac.pin_force_problem(scene, (0.0, window[1]), window[1] / 4, reference, reference)
+    problem, start = ac.cvt_problem(scene, window[1], args.settle, reference, args.placed)
     x = ac.state_at(problem, t_at, *reference)
     rows = ac.local_error_table(dataclasses.replace(problem, y0=x, t_span=(t_at, window[1])), methods, hs)
-    print(f"{args.scene}: local error of one step from the state at t = {t_at:g} s ({len(x)} states; norm: max over "
+    print(f"{args.scene}: start {start['start']}" + (f", settled to {args.settle:g} s by {start['settled_by']}"
+                                                      if args.settle else ""))
+    print(f"local error of one step from the state at t = {t_at:g} s ({len(x)} states; norm: max over "
           f"components of |error| / block scale)")
     for label in dict.fromkeys(r["label"] for r in rows):
         mine = [r for r in rows if r["label"] == label]
@@ -155,12 +166,16 @@ def run(args: argparse.Namespace) -> int:
     from cvtfem.post.integrators import write_csv
     from cvtfem.scene.loader import load_scene
 
+    import numpy as np
+
     try:
         window = tuple(float(v) for v in args.window.split(":"))
     except ValueError:
         window = ()
     if len(window) != 2 or not (0 <= window[0] < window[1] <= 1.0):
         raise InputError("--window", args.window, "must be T1:T2 in s with 0 <= T1 < T2 <= 1")
+    if not (math.isfinite(args.settle) and 0 <= args.settle <= window[0]):
+        raise InputError("--settle", args.settle, f"must be a time in 0..{window[0]:g} s (T1 of --window)")
     if args.local:
         return run_local(args, window)
     fixed = [parse_method(m) for m in args.fixed.split(",") if m.strip()]
@@ -169,38 +184,56 @@ def run(args: argparse.Namespace) -> int:
     _check(args, fixed, steps, adaptive, rtols, window)
     reference, check = _pair(args.reference, "--reference"), _pair(args.check, "--check")
     scene = load_scene(args.scene)
-    problem, report = ac.pin_force_problem(scene, window, args.sample, reference, check)
-    what = ("pin {} axial force, N" if report["output"] == ac.PIN_FORCE else "Gauss node {} sheave normal force, N/m")
-    print(f"{args.scene}: {report['start']}; {what.format(report['pin'])} {report['force_range'][0]:.0f}.."
-          f"{report['force_range'][1]:.0f} over {window[0]:g}..{window[1]:g} s; references {report['reference']}"
-          f" and {report['check']} differ by E = {report['reference_E']:.2e}")
-    lam, lam_v0 = ac.spectrum_with_v0(scene, problem.y0)
-    v0 = scene.cvt.friction.v0
-    plots.plot_spectra({f"v0 = {v0:g} m/s": lam, f"v0 = {v0 / 10:g} m/s": lam_v0}, _out(args.spectrum_png),
-                       f"{args.scene}: Jacobian eigenvalues at the start state ({len(lam)} states)")
+    problem, report = ac.pin_force_problem(scene, window, args.sample, reference, check, args.settle, args.placed)
+    t0, span = problem.t_span[0], window[1] - problem.t_span[0]
+    unit = "N/m" if report["output"] == ac.BAND_FORCE else "N"
+    what = f"{ac.output_component(report)} {'sheave normal' if unit == 'N/m' else 'axial'} force, {unit}"
+    print(f"{args.scene}: start {report['start']}" + (f"; settled to {t0:g} s by {report['settled_by']}" if t0
+                                                       else ""))
+    print(f"{what} {report['force_range'][0]:.0f}..{report['force_range'][1]:.0f} over {window[0]:g}..{window[1]:g} s;"
+          f" references {report['reference']} and {report['check']} differ by E = {report['reference_E']:.2e}")
+    spectrum = None
+    if not args.skip_spectrum:
+        lam, lam_v0 = ac.spectrum_with_v0(scene, problem.y0, t=t0)
+        v0 = scene.cvt.friction.v0
+        plots.plot_spectra({f"v0 = {v0:g} m/s": lam, f"v0 = {v0 / 10:g} m/s": lam_v0}, _out(args.spectrum_png),
+                           f"{args.scene}: Jacobian eigenvalues at the state at t = {t0:g} s ({len(lam)} states)")
+        spectrum = spectrum_summary(lam, lam_v0)
+        print(f"spectrum at t = {t0:g} s: min Re {lam.real.min():.3g} 1/s ({lam_v0.real.min():.3g} with v0/10), max "
+              f"|Im| {np.abs(lam.imag).max():.3g} 1/s ({np.abs(lam_v0.imag).max():.3g}), max Re {lam.real.max():.3g}")
     rows = ac.measure(problem, fixed, steps, adaptive, rtols, args.repeats)
-    base = ac.baseline_time(rows, BASELINE_H, window[1])
+    base = ac.baseline_time(rows, BASELINE_H, span)
     table = ac.speedups(rows, base)
     how = ("none: no rk4 runs" if base is None else
            f"{base['time']:.1f} s, " + ("estimated from the rk4 runs' wall time per RHS call" if base["estimated"]
-                                        else "measured"))
+                                        else "measured") + (" (the study's run at that step failed)"
+                                                            if base.get("failed") else ""))
     print(f"cheapest run with E <= {ac.ACCEPT_E} per method; speed-up over rk4 at h = {BASELINE_H:g} s ({how})")
     for line in markdown_table(table):
         print(line)
     plots.plot_accuracy_cost(rows, _out(args.png), ac.ACCEPT_E,
-                             f"{args.scene}: E of {what.format(report['pin'])} over {window[0]:g}..{window[1]:g} s"
+                             f"{args.scene}: E of {what} over {window[0]:g}..{window[1]:g} s"
                              f" vs reference {report['reference']}")
     write_csv(rows, _out(args.csv))
     with open(_out(args.json), "w", encoding="utf-8") as fh:
         json.dump({"scene": args.scene, "machine": machine(), "reference": report, "baseline": base,
-                   "wall_per_simulated_s": wall_per_simulated_second(table, window[1]), "speedups": table}, fh, indent=1)
-    print(f"wrote {args.png}, {args.spectrum_png}, {args.csv}, {args.json}")
+                   "wall_per_simulated_s": wall_per_simulated_second(table, span), "speedups": table,
+                   "spectrum": spectrum}, fh, indent=1)
+    print(f"wrote {args.png}, " + ("" if args.skip_spectrum else f"{args.spectrum_png}, ") + f"{args.csv}, {args.json}")
     return 0
 
 
-def wall_per_simulated_second(table, t_end: float) -> dict:
-    """Wall time (s) per simulated second of each method's cheapest accepted run over ``[0, t_end]``."""
-    return {t["label"]: t["time"] / t_end for t in table if t["time"] is not None}
+def wall_per_simulated_second(table, span: float) -> dict:
+    """Wall time (s) per simulated second of each method's cheapest accepted run over ``span`` s."""
+    return {t["label"]: t["time"] / span for t in table if t["time"] is not None}
+
+
+def spectrum_summary(lam, lam_v0) -> dict:
+    """The extremes of the spectra with ``v0`` and ``v0/10``, 1/s, for the JSON report."""
+    import numpy as np
+
+    return {key: {"min_re": float(x.real.min()), "max_re": float(x.real.max()), "max_abs_im": float(np.abs(x.imag).max())}
+            for key, x in (("v0", lam), ("v0/10", lam_v0))}
 
 
 def markdown_table(table) -> list[str]:

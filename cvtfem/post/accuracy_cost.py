@@ -42,7 +42,7 @@ def plot_spectra(spectra: dict, path: str | Path, title: str = "") -> Path:
     ax.axhline(0.0, color="grey", lw=0.6)
     ax.set_xlabel("Re lambda, 1/s (signed log beyond 1)")
     ax.set_ylabel("Im lambda, 1/s (signed log beyond 1)")
-    ax.set_title(title or "Jacobian eigenvalues", fontsize=9)
+    ax.set_title(textwrap.fill(title or "Jacobian eigenvalues", 100), fontsize=9)
     ax.legend(fontsize=7, loc="upper left")
     ax.grid(alpha=0.3)
     fig.tight_layout()

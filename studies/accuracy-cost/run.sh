@@ -2,7 +2,7 @@
 # Regenerates every figure, CSV and JSON of studies/accuracy-cost/README.md (issue 16; spec
 # numerics-and-periodic section 9) into studies/accuracy-cost/results/.  Run from the repository root:
 #     bash studies/accuracy-cost/run.sh            # all (about 2 h of one core)
-#     bash studies/accuracy-cost/run.sh chain-S2   # the chain-S2 part only (also chain-A1, band, local)
+#     bash studies/accuracy-cost/run.sh chain-S2   # the chain-S2 part only (also chain-A1, band, local, variant-e)
 # Each test-2 run prints its speed-up table (Table 2.4 style); the logs go next to the results.
 set -euo pipefail
 cd "$(dirname "$0")/../.."
@@ -42,5 +42,46 @@ if [[ $part == all || $part == local ]]; then   # test 1: every playground metho
       --window 1e-3:5e-3 --hs 1e-8:1e-5:13 \
       --local-png "$out/chain-S2-$law-local.png" --local-csv "$out/chain-S2-$law-local.csv" \
       | tee "$out/chain-S2-$law-local.log"
+  done
+fi
+
+# Variant (e) (A5 + refined contact H2) and (zh) (A5 + H1) on rigid shafts, uniform chain, chapter-2 regime.  The
+# quasi-static start stalls there (0.069 / 0.023 of F2 after 151 evaluations, ~100 s), so the runs start placed on
+# the sheaves (--placed) and measure E over [1, 3] us after 1 us of settling (the source's 1..5 ms is out of reach at
+# today's cost: docs/accuracy-cost.md).  The spectra (two dense eigenvalue problems of 3544 states, 8-10 min each on
+# a loaded machine) come from a5_friction_spectra.py.  Once the elastic shafts of (e) run, the same lines with the
+# scenes' `shaft_elasticity = false` removed repeat the study on them.
+e_scene() { echo "studies/accuracy-cost/scenes/variant-$1-rigid-chapter2-$2.toml"; }
+EXPLICIT=euler,rk4,dopri45,dopri56,dopri78,euler-extrapolation,gbs,gbs-smooth,rkc,rock2,rock4,dumka3
+IMPLICIT=implicit-euler,theta,trapezoidal,sw24,w1,w1-extrapolation,rodas4,rodas5p,radau5
+for law in linear-saturated smoothed; do
+  if [[ $part == all || $part == variant-e || $part == "variant-e-$law" ]]; then
+    e2() { test2 "$1" "$(e_scene e $law)" --placed --skip-spectrum --window 1e-6:3e-6 --sample 2e-8 --repeats 1 \
+             --reference DOP853:1e-7 --check dopri78:1e-7 "${@:2}"; }
+    e2 "variant-e-$law" --fixed rk4,dopri45,gbs-smooth:stages=2,dumka3 --steps 1e-8,2e-8,5e-8 \
+      --adaptive rock4,dopri45 --rtols 1e-2,1e-3
+    e2 "variant-e-$law-large" --fixed rk4,dopri45,gbs-smooth:stages=2,dumka3 --steps 5e-8,1e-7,2e-7,5e-7,1e-6 \
+      --adaptive rock4,rodas5p,Radau --rtols 1e-1,1e-2
+    test2 "variant-e-$law-10us" "$(e_scene e $law)" --placed --skip-spectrum --window 2e-6:1e-5 --sample 5e-8 \
+      --repeats 1 --reference DOP853:1e-6 --check dopri78:1e-6 --fixed rk4,dopri45 --steps 5e-8,2e-7,1e-6,2e-6 \
+      --adaptive rock4,rodas5p --rtols 1e-2
+    test2 "variant-e-$law-5us" "$(e_scene e $law)" --placed --settle 5e-6 --window 5e-6:7e-6 --sample 1e-7 \
+      --repeats 1 --reference DOP853:1e-6 --check dopri78:1e-6 --fixed rk4 --steps 5e-8,1e-6 --adaptive rock4 \
+      --rtols 1e-2                             # with the spectra at 5 us (v0 and v0/10)
+    for at in 0 1e-6; do                       # test 1 from the placed state and from the state at 1 us
+      tag="variant-e-$law-local$([[ $at == 0 ]] || echo 1us)"
+      for kind in explicit implicit; do
+        methods=$([[ $kind == explicit ]] && echo $EXPLICIT || echo $IMPLICIT)
+        nice "$cvtfem" study accuracy-cost "$(e_scene e $law)" --placed --local --local-at $at --window 0:1e-5 \
+          --hs 5e-9:2e-7:7 --methods "$methods" --reference DOP853:1e-9 --local-png "$out/$tag-$kind.png" \
+          --local-csv "$out/$tag-$kind.csv" | tee "$out/$tag-$kind.log"
+      done
+    done
+  fi
+done
+if [[ $part == all || $part == variant-e || $part == variant-e-spectra ]]; then   # which friction is stiffest
+  for v in e zh; do
+    nice .venv/bin/python studies/accuracy-cost/a5_friction_spectra.py "$(e_scene $v linear-saturated)" \
+      "$out/variant-$v-linear-saturated-friction-spectra.png" | tee "$out/variant-$v-linear-saturated-friction-spectra.log"
   done
 fi
