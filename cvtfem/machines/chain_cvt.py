@@ -241,6 +241,9 @@ class ChainCVT(ModelBase):
         contacts = self._compiled_contact is not None
         return "numba" if family and contacts else "numba contacts" if contacts else "numba family" if family else "numpy"
 
+    #: The compiled contact module whose ``jacobian`` :meth:`_contact_jacobian` calls (H1; A5's H2 sets its own).
+    _contact_kernel: ClassVar = SK
+
     @cached_property
     def _compiled_contact(self) -> tuple | None:
         """Constants of the compiled H1 contact path (:mod:`~cvtfem.elements.chain.sheave_contact_kernel`) for a
@@ -301,7 +304,8 @@ class ChainCVT(ModelBase):
             size = cols.shape[0] * rows.shape[1] * cols.shape[1] * cols.shape[2] ** 2     # at most, all pairs near
             r, c, d = np.empty(size, np.int64), np.empty(size, np.int64), np.empty(size)
             dD = np.zeros(2 * self.n2)
-            k = SK.jacobian(np.concatenate([q, v, self._constants]), *table, *ck, SK.STEPS, 2 * self.n2, r, c, d, dD)
+            K = self._contact_kernel
+            k = K.jacobian(np.concatenate([q, v, self._constants]), *table, *ck, K.STEPS, 2 * self.n2, r, c, d, dD)
             return (r[:k], c[:k], d[:k]), dD
         _, shafts, ccols, coef, X, _ = self._contact_set(q, v)
         Jl = self.contact.local_jacobian(X, shafts)            # (m, outputs, inputs)

@@ -37,6 +37,8 @@ class ChainHalvesRefinedCVT(ChainHalvesCVT):
     (:mod:`~cvtfem.elements.chain.half_end_contact_kernel`, as H1's :mod:`sheave_contact_kernel`); ChainCVT's numpy
     path (``reference=True``, and for the mean slip of ``evaluate(slip=True)``) is their tested twin."""
 
+    _contact_kernel = HEK          # ChainCVT's compiled contact Jacobian runs this module's kernel
+
     @cached_property
     def _compiled_contact(self) -> tuple | None:
         """Constants of :mod:`~cvtfem.elements.chain.half_end_contact_kernel` (None without numba)."""
@@ -53,20 +55,6 @@ class ChainHalvesRefinedCVT(ChainHalvesCVT):
             raise NumericalError(f"H2 contact: a pin-half end on the shaft axis (pair {bad})",
                                  component="contact.refined")
         return Pf, None
-
-    def _contact_jacobian(self, q, v, reference: bool = False):
-        """``(rows, cols, values)`` of the contacts' ``dQ/dy`` and ``-d P_fr / dy`` (2 n2,), compiled unless
-        ``reference`` (ChainCVT's numpy path)."""
-        ck = self._compiled_contact
-        if reference or ck is None:
-            return super()._contact_jacobian(q, v, reference=True)
-        table = self._pair_table
-        cols, rows = table[0], table[3]
-        size = cols.shape[0] * rows.shape[1] * cols.shape[1] * cols.shape[2] ** 2     # at most, all pairs near
-        r, c, d = np.empty(size, np.int64), np.empty(size, np.int64), np.empty(size)
-        dD = np.zeros(2 * self.n2)
-        k = HEK.jacobian(np.concatenate([q, v, self._constants]), *table, *ck, HEK.STEPS, 2 * self.n2, r, c, d, dD)
-        return (r[:k], c[:k], d[:k]), dD
 
     def _link_chords(self, ends, d):
         """``(front, rear)`` (m, 2) coordinate positions of the ``u_0`` of the two halves of each end's link: ``p-``
