@@ -43,6 +43,7 @@ per pin end, ``U(xi_e) +- h_pin tau_p`` (1.210), and the exact virtual work of a
 """
 from __future__ import annotations
 
+import copy
 from types import SimpleNamespace
 
 import numpy as np
@@ -605,6 +606,14 @@ class ChainA5:
     def friction_forces(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
         """Friction forces by virtual work: axial (1.221) and on the rolling slip of the contacts."""
         return self._evaluate(q, v)["friction"]
+
+    def with_roll_tie(self, roll_tie: float) -> "ChainA5":
+        """The same chain with the rolling tie ``k_t`` (N/m^2) instead of its own (the quasi-static start of the chain
+        on the sheaves releases it in steps)."""
+        tied = copy.copy(self)
+        tied.k_tie = float(roll_tie)
+        tied._kernel_args = HK.pack(tied, CONTACTS)
+        return tied
 
     def forces(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
         """``Q = -dPi/dq - dPhi/dv + Q_friction`` in one pass (:func:`halves_kernel.forces` with ``use_numba``)."""
