@@ -219,9 +219,10 @@ class ChainHalvesCVT(ChainACVT):
     #: balances hold to 2e-5 there (docs/chain.md).
     static_residual_limit: ClassVar[float] = 1e-4
     #: The quasi-static start's continuation in the rolling tie ``k_t`` (N/m^2; :meth:`_static`), and the residual
-    #: (of F2) to which each tied stage is solved.
-    ROLL_TIES: ClassVar[tuple[float, ...]] = (1e10,)
-    TIED_RESIDUAL: ClassVar[float] = 1e-6
+    #: (of F2) to which each tied stage is solved (each converges quadratically to it in 2-6 Jacobians; below, the
+    #: span halves' axial positions, which nothing stiffens, make it crawl).
+    ROLL_TIES: ClassVar[tuple[float, ...]] = (1e10, 1e9, 1e8)
+    TIED_RESIDUAL: ClassVar[float] = 1e-4
 
     @property
     def n_ends(self) -> int:
@@ -254,23 +255,27 @@ class ChainHalvesCVT(ChainACVT):
         return tuple(specs)
 
     # ----- quasi-static start ----------------------------------------------------------------------
-    def _placement(self, ratio: float, tension: float = 0.0) -> "RollingPlacement":
+    def _placement(self, ratio: float, tension: float | None = None) -> "RollingPlacement":
         """Rolling points ``U_p`` of the pins on the path of ``ratio``, spaced so that with the halves of
         :meth:`_placed` every link carries ``tension`` (N; stretched by ``T / c_link``, the rolling faces pressed by
         ``T / (l k_roll)``): :func:`~cvtfem.elements.chain.halves_placement.rolling_spacing` (rolling shortens a link,
         and where the joint angles at its ends differ, as for links of unequal lengths on an arc, its direction is
-        not the chord of ``U``).  Fixed-point passes of the link directions until the spacing changes by less than
-        1e-12 m (three to five)."""
+        not the chord of ``U``).  Fixed-point passes of the link directions (each shrinks the change a
+        hundredfold) until the spacing changes by less than 1e-11 m (0.01 N in a link).  ``tension`` None: the pins
+        at their pitches on the path (ChainCVT's placement: the path's radii and span angle for the wedge
+        estimate)."""
+        if tension is None:
+            return super()._placement(ratio)
         fam, ch = self.family, self.family.chain
         R, h = ch.roll_radius, ch.h_pin
         stretch = tension / fam.geom.c_link
-        delta = tension / (ch.l * ch._arcs["roll"][5])
+        delta = tension / (ch.l * ch.roll_stiffness)
         spacing = fam.geom.L + stretch
         for _ in range(12):
             pl = place_on_path(spacing, ratio, self.contact.centres[0, 0])
             tau = rolling_link_directions(pl.u, R, h, delta)
             new = rolling_spacing(tau, fam.geom.L, R, delta, stretch)
-            if np.abs(new - spacing).max() < 1e-12:
+            if np.abs(new - spacing).max() < 1e-11:
                 return RollingPlacement(**vars(pl), tau=tau, delta=delta)
             spacing = new
         raise NumericalError(f"the rolling points did not settle on the path of ratio {ratio} (last change "

@@ -221,7 +221,7 @@ class ChainA5:
                           Rh - r, float(hole_stiffness)),
         }
         self._contact_w = {"roll": np.ones(n), "hole_next": link_w.copy(), "hole_prev": link_w[self._prev].copy()}
-        self.b_roll, self.k_tie = float(roll_damping), float(roll_tie)
+        self.roll_stiffness, self.b_roll, self.k_tie = float(roll_stiffness), float(roll_damping), float(roll_tie)
         self.k_stop, self.d_stop = float(stopper_stiffness), float(stopper_play)
         self.f0, self.v0, self.law = float(friction_coefficient), float(friction_speed), friction_law
         self.beta_ext, self.beta_shear = float(beta_plate_ext), float(beta_plate_shear)
