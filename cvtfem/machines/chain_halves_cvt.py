@@ -292,8 +292,11 @@ class ChainHalvesCVT(ChainACVT):
         tension (:meth:`_placement`), the pins compressed by their own wedge forces ``T d_p / (2 tan(gamma))``
         (``d_p`` the turn of the chain at the pin) and the sheaves moved to the half ends: on an arc both halves'
         axes run ``(R - h_pin) sin(d/2)`` inside the rolling points ``U`` (:meth:`_placed`), where the wedge is
-        narrower (``start_z`` where it is set)."""
-        free, _, z = super().wedge_guess(ratio, F2)
+        narrower.  With ``start_chain`` set (the stages of :meth:`_static`), ChainACVT's estimate on the plain
+        placement (``start_z`` where it is set)."""
+        free, u3, z = super().wedge_guess(ratio, F2)
+        if self.start_chain is not None:          # given coordinates: the plain placement serves loads and speeds
+            return free, u3, z
         faces = self.contact.faces
         tg = np.array([faces[k].tan_gamma(free.r[k]) for k in range(2)])
         T = F2 * tg[1] / (np.pi / 2 - free.phi)
