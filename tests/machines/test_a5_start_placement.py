@@ -38,8 +38,9 @@ def test_the_preset_chain_has_unequal_links(model):
 @pytest.mark.parametrize("tension", [0.0, 3000.0])
 def test_links_carry_the_placement_tension_and_the_faces_touch(model, placements, tension):
     """Every link at the half-axis distance ``L + T / c_link + 2 h_pin`` (to 1e-11 m, the placement's criterion) and
-    the model's link tension equals ``T`` to 1e-6 of F2 on all 84 links (arcs, spans and the transitions between them); every rolling contact
-    carries ``T`` (the faces pressed by ``T / (l k)``), so at ``T = 0`` they touch without pressure.  The former
+    the model's link tension equals ``T`` to 1e-6 of F2 on all 84 links (arcs, spans and the transitions between
+    them); every rolling contact carries ``T`` (the faces pressed by ``T / (l k)``), so at ``T = 0`` they touch
+    without pressure.  The former
     placement (link directions taken as the chords of the rolling points) pressed the faces of pins between a long
     and a short link on the arcs by up to 937 N and stretched the links at the arc ends to 7.4 kN."""
     fam = model.family
