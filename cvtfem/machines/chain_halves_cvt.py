@@ -223,6 +223,10 @@ class ChainHalvesCVT(ChainACVT):
     #: span halves' axial positions, which nothing stiffens, make it crawl).
     ROLL_TIES: ClassVar[tuple[float, ...]] = (1e10, 1e9, 1e8)
     TIED_RESIDUAL: ClassVar[float] = 1e-4
+    #: Lift floors and step lengths of the solves (:func:`lifted_newton`): besides its defaults the floor 1e-3 and the
+    #: steps 0.003, 0.001, without which the untied solve of variant (e) (H2) stopped at 2.7e-3 of F2.
+    LIFTS: ClassVar[tuple[float, ...]] = (1e-9, 1e-7, 1e-5, 1e-4, 1e-3)
+    STEPS: ClassVar[tuple[float, ...]] = (1.0, 0.5, 0.25, 0.1, 0.03, 0.01, 0.003, 0.001)
 
     @property
     def n_ends(self) -> int:
@@ -357,7 +361,7 @@ class ChainHalvesCVT(ChainACVT):
         """:func:`~cvtfem.machines.static_balance.lifted_newton` on the sparse Jacobian, its lifted Newton phase alone
         (the static stiffness of A5 is indefinite and singular; the damped phase 1 stalls at about 2e-2 of F2 without
         the tie and led the tied solve of the uniform chain astray, to 4.6e-2)."""
-        return lifted_newton(residual, jacobian, y0, tol, damped=0)
+        return lifted_newton(residual, jacobian, y0, tol, damped=0, lifts=self.LIFTS, steps=self.STEPS)
 
     def _placed(self, pl, u3):
         """Straight halves rolling on each other at ``pl.u`` (the rolling faces touch on the joint's bisector

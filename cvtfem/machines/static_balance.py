@@ -20,7 +20,8 @@ SMALLEST_STEP = 1e-13
 ACCEPT = 0.5
 
 
-def lifted_newton(residual, jacobian, y0, tol: float, damped: int = DAMPED_ITERATIONS) -> SimpleNamespace:
+def lifted_newton(residual, jacobian, y0, tol: float, damped: int = DAMPED_ITERATIONS, lifts=LIFTS,
+                  steps=STEPS) -> SimpleNamespace:
     """Solve ``residual(y) = 0`` from ``y0`` with ``jacobian(y)`` (dense or sparse ``dr/dy``) in two phases.
 
     1. Damped steps ``-(J - mu S)^-1 r`` (scipy ``splu``), ``S`` the Jacobian's diagonal magnitudes floored at 1e-9
@@ -32,8 +33,8 @@ def lifted_newton(residual, jacobian, y0, tol: float, damped: int = DAMPED_ITERA
        coordinates without stiffness of their own (a singular ``J``: A5's axial positions of the halves on the
        spans, which no force fixes, so ``r`` has no part along them); elsewhere the step is Newton's and so a
        descent direction of ``|r|^2`` however indefinite ``J`` is.  Each iteration takes the first full step
-       (floors ``f`` in :data:`LIFTS` in turn) that lowers ``|r|`` to :data:`ACCEPT` of it, else the best by ``|r|``
-       of the floors and step lengths in :data:`STEPS`, while that lowers ``|r|`` (a
+       (floors ``f`` in ``lifts``, default :data:`LIFTS`, in turn) that lowers ``|r|`` to :data:`ACCEPT` of it, else
+       the best by ``|r|`` of the floors and step lengths ``steps`` (:data:`STEPS`), while that lowers ``|r|`` (a
        Levenberg-Marquardt step ``-(J^T J + m D)^-1 J^T r`` where none does only crawled: A5 2.46e-5 of F2 after 3906
        evaluations against 2.34e-5 after 1623 without it).
 
@@ -62,7 +63,7 @@ def lifted_newton(residual, jacobian, y0, tol: float, damped: int = DAMPED_ITERA
             return SimpleNamespace(x=y, nfev=nfev, status=1, message="converged")
     message = "the iteration limit was reached"
     for _ in range(NEWTON_ITERATIONS):
-        dy, r_new, n = _lifted_step(residual, sp.csc_matrix(jacobian(y)), y, r)
+        dy, r_new, n = _lifted_step(residual, sp.csc_matrix(jacobian(y)), y, r, lifts, steps)
         nfev += n
         if dy is None:
             message = "no step lowered the residual"
@@ -73,16 +74,16 @@ def lifted_newton(residual, jacobian, y0, tol: float, damped: int = DAMPED_ITERA
     return SimpleNamespace(x=y, nfev=nfev, status=0, message=message)
 
 
-def _lifted_step(residual, J, y, r):
+def _lifted_step(residual, J, y, r, lifts, steps):
     """Phase 2's step from ``y`` (residual ``r``, Jacobian ``J``): the first full lifted Newton step that lowers
     ``|r|`` by :data:`ACCEPT` at least, else the best by ``|r|`` of all floors and step lengths; ``(dy, r(y + dy),
     evaluations)``, ``dy`` None where none lowers ``|r|``."""
     d = np.abs(J.diagonal())
     r0 = np.linalg.norm(r)
     best, nfev = (r0, None, None), 0
-    for f in LIFTS:
+    for f in lifts:
         dy = _solve(J - sp.diags(np.maximum(f * d.max() - d, 0.0)), -r)
-        for a in STEPS if dy is not None else ():
+        for a in steps if dy is not None else ():
             r_new = residual(y + a * dy)
             nfev += 1
             if np.linalg.norm(r_new) < best[0]:

@@ -1,5 +1,6 @@
-"""The quasi-static start of the preset chain-A5 (randomised long/short links, the scene's clamping forces) through
-:meth:`ChainHalvesCVT.start`, the run's own path (issue 13): converged, with the residual it reports recomputed."""
+"""The quasi-static start of the preset chain-A5 (randomised long/short links, the scene's clamping forces) and of
+variant (e) on rigid shafts (the same chain with H2 at the half ends), the runs' own models (issue 13): converged,
+with the residual they report recomputed."""
 import numpy as np
 import pytest
 
@@ -52,3 +53,18 @@ def test_randomised_chain_starts_balanced(solved):
     np.testing.assert_allclose(T, T.mean(), rtol=1.5e-2)
     np.testing.assert_allclose(out["chain.roll_force"], T.mean(), rtol=1.5e-2)
     assert np.all(o["contact.slip_speed"] < 1e-12)
+
+
+@pytest.mark.slow
+def test_variant_e_starts_balanced():
+    """Variant (e) on rigid shafts (``shaft_elasticity = false``; H2 at every half end): :meth:`start` is the
+    quasi-static balance, residual below 1e-4 of F2 and as recomputed (1e-9), the driven sheaves balanced to 1 %."""
+    scene = load_scene("variant-e").replace({"cvt": {"effects": {"shaft_elasticity": False}}})
+    model = chain_loop(scene)
+    w1, _, ratio = model.regime.targets(0.0)
+    x0, report = model.static_state(ratio, w1)
+    assert report["residual"] < 1e-4
+    assert _static_residual(model, w1, x0, report) == pytest.approx(report["residual"], rel=1e-9)
+    o = model.outputs(0.0, x0)
+    np.testing.assert_allclose(o["contact.sheave_axial_force"], [report["F1"], model.F_appl[1]], rtol=1e-4)
+    np.testing.assert_allclose(o["contact.fixed_sheave_axial_force"], o["contact.sheave_axial_force"], rtol=1e-2)
