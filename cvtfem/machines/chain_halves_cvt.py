@@ -13,6 +13,7 @@ dissipated work with the Rayleigh damping.
 """
 from __future__ import annotations
 
+from dataclasses import dataclass, replace
 from typing import ClassVar
 
 import numpy as np
@@ -20,7 +21,8 @@ import scipy.sparse as sp
 
 from cvtfem.elements.base import Block
 from cvtfem.elements.chain.halves import ChainA5
-from cvtfem.elements.chain.placement import place_on_path
+from cvtfem.elements.chain.halves_placement import half_centres, rolling_link_directions, rolling_spacing
+from cvtfem.elements.chain.placement import Placement, place_on_path
 from cvtfem.errors import InputError, NumericalError
 from cvtfem.machines.chain_a_cvt import PLATE_HEIGHT, PLATE_THICKNESS, POISSON, ChainACVT
 from cvtfem.machines.static_balance import lifted_newton
@@ -187,6 +189,15 @@ class HalvesFamily:
         return self.chain.outputs(q, v)
 
 
+@dataclass(frozen=True)
+class RollingPlacement(Placement):
+    """A :class:`~cvtfem.elements.chain.placement.Placement` of rolling points with the link directions ``tau``
+    (n, 2) of the halves around them and the pressing ``delta`` (m) of their rolling faces."""
+
+    tau: np.ndarray = None
+    delta: float = 0.0
+
+
 class _HalfCentres:
     """The in-plane positions ``u_0`` of both halves of every pin as one array: reading gives their mean (the pin
     centre), writing sets both (the quasi-static start places and moves whole pins)."""
@@ -210,6 +221,15 @@ class ChainHalvesCVT(ChainACVT):
     #: only the plates' station terms hold (no stiffness of their own: :func:`lifted_newton`); the sheaves' axial
     #: balances hold to 2e-5 there (docs/chain.md).
     static_residual_limit: ClassVar[float] = 1e-4
+    #: The quasi-static start's continuation in the rolling tie ``k_t`` (N/m^2; :meth:`_static`), and the residual
+    #: (of F2) to which each tied stage is solved (each converges quadratically to it in 2-6 Jacobians; below, the
+    #: span halves' axial positions, which nothing stiffens, make it crawl).
+    ROLL_TIES: ClassVar[tuple[float, ...]] = (1e10, 1e9, 1e8)
+    TIED_RESIDUAL: ClassVar[float] = 1e-4
+    #: Lift floors and step lengths of the solves (:func:`lifted_newton`): besides its defaults the floor 1e-3 and the
+    #: steps 0.003, 0.001, without which the untied solve of variant (e) (H2) stopped at 2.7e-3 of F2.
+    LIFTS: ClassVar[tuple[float, ...]] = (1e-9, 1e-7, 1e-5, 1e-4, 1e-3)
+    STEPS: ClassVar[tuple[float, ...]] = (1.0, 0.5, 0.25, 0.1, 0.03, 0.01, 0.003, 0.001)
 
     @property
     def n_ends(self) -> int:
@@ -242,40 +262,61 @@ class ChainHalvesCVT(ChainACVT):
         return tuple(specs)
 
     # ----- quasi-static start ----------------------------------------------------------------------
-    def _placement(self, ratio: float):
-        """Rolling points ``U_p`` of the pins on the path of ``ratio``, spaced so that every link is unstretched.
-
-        With the halves placed by :meth:`_placed`, link ``(p, p+1)`` is ``|U_{p+1} - U_p| + 2 h_pin - R_- (1 -
-        cos(d_p/2)) - R_+ (1 - cos(d_{p+1}/2))`` long (``d_p`` the joint angle at pin ``p``): rolling shortens
-        it.  Three fixed-point passes of the joint angles (each changes the spacing by a fraction of it)."""
-        fam = self.family
-        L = fam.geom.L
-        Rm, Rp = fam.chain.roll_radius
-        for _ in range(3):
-            pl = place_on_path(L, ratio, self.contact.centres[0, 0])
-            c = np.cos(0.5 * self._joint_angles(pl.u))
-            L = fam.geom.L + Rm * (1 - c) + Rp * (1 - c[fam.ip1])
-        return pl
+    def _placement(self, ratio: float, tension: float | None = None) -> "RollingPlacement":
+        """Rolling points ``U_p`` of the pins on the path of ``ratio``, spaced so that with the halves of
+        :meth:`_placed` every link carries ``tension`` (N; stretched by ``T / c_link``, the rolling faces pressed by
+        ``T / (l k_roll)``): :func:`~cvtfem.elements.chain.halves_placement.rolling_spacing` (rolling shortens a link,
+        and where the joint angles at its ends differ, as for links of unequal lengths on an arc, its direction is
+        not the chord of ``U``).  Fixed-point passes of the link directions (each shrinks the change a
+        hundredfold) until the spacing changes by less than 1e-11 m (0.01 N in a link).  ``tension`` None: the pins
+        at their pitches on the path (ChainCVT's placement: the path's radii and span angle for the wedge
+        estimate)."""
+        if tension is None:
+            return super()._placement(ratio)
+        fam, ch = self.family, self.family.chain
+        R, h = ch.roll_radius, ch.h_pin
+        stretch = tension / fam.geom.c_link
+        delta = tension / (ch.l * ch.roll_stiffness)
+        spacing = fam.geom.L + stretch
+        for _ in range(12):
+            pl = place_on_path(spacing, ratio, self.contact.centres[0, 0])
+            tau = rolling_link_directions(pl.u, R, h, delta)
+            new = rolling_spacing(tau, fam.geom.L, R, delta, stretch)
+            if np.abs(new - spacing).max() < 1e-11:
+                return RollingPlacement(**vars(pl), tau=tau, delta=delta)
+            spacing = new
+        raise NumericalError(f"the rolling points did not settle on the path of ratio {ratio} (last change "
+                             f"{np.abs(new - spacing).max():.3g} m)", component="ChainHalvesCVT placement")
 
     @staticmethod
-    def _joint_angles(U):
-        """Turn ``d_p`` (rad) of the chain at each pin of the closed polygon ``U (n, 2)``."""
-        t = np.roll(U, -1, 0) - U
-        t_prev = np.roll(t, 1, 0)
-        return np.abs(np.arctan2(t_prev[:, 0] * t[:, 1] - t_prev[:, 1] * t[:, 0], np.sum(t_prev * t, 1)))
+    def _joint_angles(tau):
+        """Turn ``d_p`` (rad) at each pin of the links of directions ``tau (n, 2)``."""
+        t_prev = np.roll(tau, 1, 0)
+        return np.abs(np.arctan2(t_prev[:, 0] * tau[:, 1] - t_prev[:, 1] * tau[:, 0], np.sum(t_prev * tau, 1)))
 
     def wedge_guess(self, ratio: float, F2: float):
-        """ChainCVT's wedge estimate with the sheaves moved to the half ends: on an arc both halves' axes run
-        ``(R - h_pin) sin(d/2)`` inside the rolling points ``U`` (:meth:`_placed`), where the wedge is narrower
-        (``start_z`` where it is set)."""
-        pl, u3, z = super().wedge_guess(ratio, F2)
-        R = np.mean(self.family.chain.roll_radius)
-        h = self.family.chain.h_pin
-        d = self._joint_angles(pl.u)
+        """ChainCVT's wedge estimate of the tension ``T`` and the sheave positions, then the halves placed at that
+        tension (:meth:`_placement`), the pins compressed by their own wedge forces ``T d_p / (2 tan(gamma))``
+        (``d_p`` the turn of the chain at the pin) and the sheaves moved to the half ends: on an arc both halves'
+        axes run ``(R - h_pin) sin(d/2)`` inside the rolling points ``U`` (:meth:`_placed`), where the wedge is
+        narrower.  With ``start_chain`` set (the stages of :meth:`_static`), ChainACVT's estimate on the plain
+        placement (``start_z`` where it is set)."""
+        free, u3, z = super().wedge_guess(ratio, F2)
+        if self.start_chain is not None:          # given coordinates: the plain placement serves loads and speeds
+            return free, u3, z
+        faces = self.contact.faces
+        tg = np.array([faces[k].tan_gamma(free.r[k]) for k in range(2)])
+        T = F2 * tg[1] / (np.pi / 2 - free.phi)
+        pl = self._placement(ratio, T)
+        fam = self.family
+        R, h = np.mean(fam.chain.roll_radius), fam.chain.h_pin
+        d = self._joint_angles(pl.tau)
+        u3 = np.full(fam.n, fam.geom.l / 2)
         for k in range(2):
-            r_half = pl.r[k] - (R - h) * np.sin(0.5 * np.median(d[pl.piece == k]))
-            face = self.contact.faces[k]
-            z[k] += face.lever(pl.r[k]) - face.lever(r_half)
+            on = pl.piece == k
+            u3[on] -= T * d[on] / (2 * tg[k]) / (2 * fam.geom.c_pin[on])
+            r_half = pl.r[k] - (R - h) * np.sin(0.5 * np.median(d[on]))
+            z[k] += faces[k].lever(free.r[k]) - faces[k].lever(r_half)
         return pl, u3, (z if self.start_z is None else np.array(self.start_z, float))
 
     def placed_state(self, ratio: float, w1: float) -> np.ndarray:
@@ -302,34 +343,49 @@ class ChainHalvesCVT(ChainACVT):
             w1, _, i = self.regime.targets(0.0)
             return self.placed_state(i, w1), {"kind": f"placed on the sheaves, off balance ({err})"}
 
+    def _static(self, ratio: float, w1: float, F2: float, tol: float):
+        """ChainCVT's quasi-static solve by continuation in the rolling tie: first with the halves' rolling held by
+        ties of the stiffnesses ``ROLL_TIES`` in turn (static friction as a holonomic no-slip constraint: it makes
+        stiff the relative slides and yaws of the halves whose negative stiffness under tension makes the frictionless
+        balance a saddle), each to ``TIED_RESIDUAL`` of F2 from the last, then the chain's own forces (no tie) from
+        there.  From ``start_chain`` where it is set: that last solve alone.  ``report["nfev"]`` counts all."""
+        if self.start_chain is not None or not self.ROLL_TIES:
+            return super()._static(ratio, w1, F2, tol)
+        start, nfev = {}, 0
+        for k in self.ROLL_TIES:
+            stage = replace(self, family=HalvesFamily(self.family.chain.with_roll_tie(k), self.family.geom), **start)
+            x, rep = ChainACVT._static(stage, ratio, w1, F2, 1e3 * self.TIED_RESIDUAL)
+            start, nfev = dict(start_chain=x[:self.family.size], start_z=x[self._idx[2]]), nfev + rep["nfev"]
+        x, report = replace(self, **start)._static(ratio, w1, F2, tol)
+        report["nfev"] += nfev
+        return x, report
+
     def _solve_balance(self, residual, jacobian, y0, tol: float):
-        """:func:`~cvtfem.machines.static_balance.lifted_newton` on the sparse Jacobian (the static stiffness of A5 is
-        indefinite and singular: its phase 1 alone stalls at about 2e-2 of F2), with central link differences: from
+        """:func:`~cvtfem.machines.static_balance.lifted_newton` on the sparse Jacobian, its lifted Newton phase alone
+        (the static stiffness of A5 is indefinite and singular; the damped phase 1 stalls at about 2e-2 of F2 without
+        the tie and led the tied solve of the uniform chain astray, to 4.6e-2), with central link differences: from
         the placement half the plates sit at the slack/taut kink, where the exact link blocks are one-sided, and the
-        lifted Newton stalled on them at 2.5e-2 of F2 (central differences average the two sides: 2.3e-5)."""
+        lifted Newton stalled on them at 2.5e-2 of F2 (central differences average the two sides)."""
         scheme, self.family.scheme = self.family.scheme, "central"
         try:
-            return lifted_newton(residual, jacobian, y0, tol)
+            return lifted_newton(residual, jacobian, y0, tol, damped=0, lifts=self.LIFTS, steps=self.STEPS)
         finally:
             self.family.scheme = scheme
 
     def _placed(self, pl, u3):
         """Straight halves rolling on each other at ``pl.u`` (the rolling faces touch on the joint's bisector
         ``b_p``): ``u-_p = U_p - R_- b_p - (h_pin - R_-) tau_p``, ``u+_p = U_p + R_+ b_p - (R_+ - h_pin) tau_{p-1}``,
-        ``tau`` the link directions; half lengths ``u3`` (n,) m, packs centred (``start_chain`` where it is set)."""
+        ``tau`` the directions of the links these halves make
+        (:func:`~cvtfem.elements.chain.halves_placement.rolling_link_directions`); half lengths ``u3`` (n,) m, packs
+        centred (``start_chain`` where it is set)."""
         if self.start_chain is not None:
             return np.array(self.start_chain, float)
         fam = self.family
-        Rm, Rp = fam.chain.roll_radius
-        h = fam.chain.h_pin
-        t = np.roll(pl.u, -1, 0) - pl.u
-        tau = t / np.linalg.norm(t, axis=1, keepdims=True)
-        tau_prev = np.roll(tau, 1, 0)
-        bis = (tau + tau_prev) / np.linalg.norm(tau + tau_prev, axis=1, keepdims=True)
+        R, h = fam.chain.roll_radius, fam.chain.h_pin
+        tau, delta = (pl.tau, pl.delta) if isinstance(pl, RollingPlacement) else (rolling_link_directions(pl.u, R, h),
+                                                                                 0.0)
         q = fam.chain.rest_state(pl.u, tau) + self._axial(u3)
-        u = fam.split(q)[0]
-        u[0, 0] = pl.u - Rm * bis - (h - Rm) * tau
-        u[1, 0] = pl.u + Rp * bis - (Rp - h) * tau_prev
+        fam.split(q)[0][:, 0] = half_centres(pl.u, tau, R, h, delta)
         return q
 
     def _axial(self, u3):

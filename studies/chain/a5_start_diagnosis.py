@@ -40,11 +40,13 @@ KINDS = {"u0 (in-plane position)": [0, 1, 10, 11], "u1 (in-plane tilt)": [2, 3, 
 
 
 class _Recorded(ChainHalvesCVT):
-    """ChainHalvesCVT that keeps the residual and Jacobian functions and the point where its solve (phase 1 alone:
-    ``static_balance.NEWTON_ITERATIONS = 0`` in :func:`main`) stopped."""
+    """ChainHalvesCVT that keeps the residual and Jacobian functions and the point where its solve (without the tie
+    continuation, phase 1 alone: ``static_balance.NEWTON_ITERATIONS = 0`` in :func:`main`) stopped."""
+
+    ROLL_TIES = ()
 
     def _solve_balance(self, residual, jacobian, y0, tol):
-        sol = super()._solve_balance(residual, jacobian, y0, tol)
+        sol = static_balance.lifted_newton(residual, jacobian, y0, tol)
         _Recorded.stall = (residual, jacobian, sol)
         return sol
 

@@ -43,6 +43,7 @@ per pin end, ``U(xi_e) +- h_pin tau_p`` (1.210), and the exact virtual work of a
 """
 from __future__ import annotations
 
+import copy
 from types import SimpleNamespace
 
 import numpy as np
@@ -220,7 +221,7 @@ class ChainA5:
                           Rh - r, float(hole_stiffness)),
         }
         self._contact_w = {"roll": np.ones(n), "hole_next": link_w.copy(), "hole_prev": link_w[self._prev].copy()}
-        self.b_roll, self.k_tie = float(roll_damping), float(roll_tie)
+        self.roll_stiffness, self.b_roll, self.k_tie = float(roll_stiffness), float(roll_damping), float(roll_tie)
         self.k_stop, self.d_stop = float(stopper_stiffness), float(stopper_play)
         self.f0, self.v0, self.law = float(friction_coefficient), float(friction_speed), friction_law
         self.beta_ext, self.beta_shear = float(beta_plate_ext), float(beta_plate_shear)
@@ -605,6 +606,14 @@ class ChainA5:
     def friction_forces(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
         """Friction forces by virtual work: axial (1.221) and on the rolling slip of the contacts."""
         return self._evaluate(q, v)["friction"]
+
+    def with_roll_tie(self, roll_tie: float) -> "ChainA5":
+        """The same chain with the rolling tie ``k_t`` (N/m^2) instead of its own (the quasi-static start of the chain
+        on the sheaves releases it in steps)."""
+        tied = copy.copy(self)
+        tied.k_tie = float(roll_tie)
+        tied._kernel_args = HK.pack(tied, CONTACTS)
+        return tied
 
     def forces(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
         """``Q = -dPi/dq - dPhi/dv + Q_friction`` in one pass (:func:`halves_kernel.forces` with ``use_numba``)."""
