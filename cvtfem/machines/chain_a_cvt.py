@@ -54,7 +54,12 @@ def whole_pin_family(model: str, geom, damping, E: float, plate_height: float = 
     (:class:`~cvtfem.elements.chain.symmetric.ChainDamping`): plates ``plate_height`` x ``plate_thickness``
     (m) of Young's modulus ``E`` (Pa) give the out-of-plane bending stiffness ``a = E b h^3 / 12`` (N m^2)
     and the torsion stiffness ``G b h^3 / (3 L)`` (N m/rad, chain-models-2 §2.4 [non-source]); the link
-    damping time serves extension, twist and shear (rule (1.86) with one time), pins as the S models."""
+    damping time serves extension, twist and shear (rule (1.86) with one time), pins as the S models.
+
+    A3's clamped plates keep pushing when compressed (``drop_compressed=False``; the source leaves it open, digest
+    §4.8): dropped at ``Delta = 0``, a plate with tilted ends would lose its bending energy ``psi C psi / 2`` and
+    moments at once (a force jump that breaks the energy balance of a run; H2's bent pins slacken the outer plates
+    on the small arc).  A4's slack state is continuous (its moments vanish with ``T h/2``)."""
     if model not in A_MODELS:
         raise InputError("cvt.model", model, "must be one of " + ", ".join(A_MODELS))
     b, h = plate_height, plate_thickness
@@ -70,8 +75,8 @@ def whole_pin_family(model: str, geom, damping, E: float, plate_height: float = 
     if A_MODELS[model] is None:
         return WholePinFamily(ChainA1(**args), geom)
     clamped = ChainPerPlate(model="A3", plate_thickness=h, **args) if A_MODELS[model] == "A4" else None
-    return WholePinFamily(ChainPerPlate(model=A_MODELS[model], plate_thickness=h, **args), geom,
-                          homogenised=ChainA1(**args), clamped=clamped)
+    chain = ChainPerPlate(model=A_MODELS[model], plate_thickness=h, drop_compressed=A_MODELS[model] == "A4", **args)
+    return WholePinFamily(chain, geom, homogenised=ChainA1(**args), clamped=clamped)
 
 
 class WholePinFamily:

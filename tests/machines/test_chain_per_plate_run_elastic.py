@@ -5,10 +5,11 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
+from cvtfem.integrate import solve
 from cvtfem.machines.chain_cvt_elastic import ElasticChainACVT
 from cvtfem.machines.cvt import chain_loop
 from cvtfem.scene.loader import load_scene
-from tests.machines.chain_checks import assert_energy_balance, assert_jacobian_columns
+from tests.machines.chain_checks import assert_jacobian_columns
 
 pytestmark = pytest.mark.slow          # the starts: A1, A3, A4 on rigid shafts, then on the elastic ones (~30-60 s)
 
@@ -83,10 +84,17 @@ def test_jacobian_against_differences_and_on_its_pattern(variant, variants):
 
 
 def test_energy_balance_over_a_short_run_of_variant_d(variants):
-    """Radau (rtol 1e-6) over 20 us from the start (driving clamping force its reaction): chain, shaft, sheave and
-    contact energy change by input - output + clamping - dissipated work to 1e-6 of the input work."""
+    """Radau (rtol 1e-6) over 10 us from the start (driving clamping force its reaction; plates on corners and slack on
+    the small arc, switching as the pins move): chain, shaft, sheave and contact energy change by input - output +
+    clamping - dissipated work to 1e-6 of the input work."""
     model, x0, rep = variants["d"]
-    assert_energy_balance(model.with_clamping([rep["F1"], rep["F2"]]), x0, 2e-5)
+    m = model.with_clamping([rep["F1"], rep["F2"]])
+    res = solve(m, (0.0, 1e-5), x0, method="Radau", rtol=1e-6, atol=1e-9, n2=m.n2, jac=m.jac,
+                jac_sparsity=m.jac_sparsity)
+    assert res.status == 0
+    W = m.split(res.y[:, -1])[3]
+    assert W[0] > 0.5 and W[2] > 0.0
+    assert m.energy(res.y[:, -1]) - m.energy(x0) == pytest.approx(W[0] - W[1] + W[3] - W[2], abs=1e-6 * W[0])
 
 
 @pytest.mark.parametrize("variant", ["variant-g", "variant-d"])
