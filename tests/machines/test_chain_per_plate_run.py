@@ -118,6 +118,24 @@ def test_plate_states_are_classified_exactly_one_each(balances):
 
 
 @pytest.mark.parametrize("name", ["chain-A3", "chain-A4"])
+def test_the_rhs_dissipated_power_is_the_plates_rayleigh_function(balances, name):
+    """The work integral's dissipated power uses ``Phi`` of the compiled plate forces (``-v . Q_d / 2``, Euler's identity);
+    it equals the numpy Rayleigh function of the plates and pins to 1e-10 with plates in all ten states, whether or
+    not the forces were just evaluated at that state."""
+    m, x0, _ = balances[name]
+    x = perturbed(m, x0, seed=3)
+    nc, n2 = m.family.size, m.n2
+    q, v = x[:nc], x[n2:n2 + nc]
+    if name == "chain-A4":
+        assert len(np.unique(m.outputs(0.0, x)["chain.plate_state"])) == 10
+    reference = float(m.family.chain.rayleigh(q, v))
+    assert reference > 1.0
+    assert m.family.rayleigh(q, v) == pytest.approx(reference, rel=1e-10)
+    m.family.forces(q, v)
+    assert m.family.rayleigh(q, v) == pytest.approx(reference, rel=1e-10)
+
+
+@pytest.mark.parametrize("name", ["chain-A3", "chain-A4"])
 def test_jacobian_against_differences_with_the_plate_blocks(balances, name):
     """``jac`` on its pattern and equal to central differences (1e-5 of each row's largest entry) on the coordinates
     and velocities of tilted pins and their neighbours (A4: plates in corner states, whose blocks use the state's
