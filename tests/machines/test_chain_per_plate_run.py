@@ -8,10 +8,11 @@ import pytest
 from cvtfem.elements.chain import plates as P
 from cvtfem.elements.chain.geometry import reference_geometry
 from cvtfem.errors import InputError
+from cvtfem.integrate import solve
 from cvtfem.machines.chain_a_cvt import ChainACVT
 from cvtfem.machines.chain_cvt import from_scene
 from cvtfem.scene.loader import load_scene
-from tests.machines.chain_checks import assert_energy_balance, assert_jacobian_columns, perturbed
+from tests.machines.chain_checks import assert_jacobian_columns, perturbed
 
 RATIO = 2.4
 F_APPL = np.array([30000.0, 35000.0])   # N per sheave, as the A1 tests
@@ -158,13 +159,18 @@ def test_jacobian_against_differences_with_the_plate_blocks(balances, name):
 @pytest.mark.slow
 def test_energy_balance_over_a_short_run_of_a4(balances):
     """A4 from its balance off balance by random offsets (0.6 um: a few plates start on a corner or slack and return to
-    line contact), 20 us of Radau at rtol 1e-6: ``E(t) - E(0)`` = input - output + clamping - dissipated work to 1e-6
-    of the input work."""
+    line contact), 10 us of Radau at rtol 1e-6: ``E(t) - E(0)`` = input - output + clamping - dissipated work to 1e-6
+    of the input work (40 s at load 8: the perturbation's fast transients need ~600 LU factorisations)."""
     m, x0, rep = balances["chain-A4"]
     m = m.with_clamping([rep["F1"], F_APPL[1]])
     x = perturbed(m, x0, seed=9, scale=np.full(m.family.size, 0.3))
     assert np.sum(m.outputs(0.0, x)["chain.plate_state"] != 1) >= 3
-    assert_energy_balance(m, x, 2e-5)
+    res = solve(m, (0.0, 1e-5), x, method="Radau", rtol=1e-6, atol=1e-9, n2=m.n2, jac=m.jac,
+                jac_sparsity=m.jac_sparsity)
+    assert res.status == 0
+    W = m.split(res.y[:, -1])[3]
+    assert W[0] > 0.5 and W[2] > 0.0
+    assert m.energy(res.y[:, -1]) - m.energy(x) == pytest.approx(W[0] - W[1] + W[3] - W[2], abs=1e-6 * W[0])
 
 
 def test_scene_path_runs_a3_and_a4_and_refuses_what_they_cannot_do():
