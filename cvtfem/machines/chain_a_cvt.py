@@ -40,6 +40,10 @@ PLATE_THICKNESS = 1.5e-3
 PLATE_HEIGHT = 8e-3
 #: Poisson's ratio of the steel plates (torsion stiffness ``G = E / (2 (1 + nu))``).
 POISSON = 0.3
+#: The per-plate chains' reduced plate moment output and its meaning on a running chain (WholePinFamily.outputs).
+REDUCED_MOMENT = "chain.plate_reduced_moment"
+REDUCED_MOMENT_DOC = ("Reduced bending moment m = 2M/(hT) at both ends of each plate (end 1, end 2; |m| <= 1 in A4, 1 at "
+                      "a corner; 0 for a slack plate).")
 #: The whole-pin models that run on the sheaves.
 A_MODELS = {"chain-A1": None, "chain-A2": None, "chain-A3": "A3", "chain-A4": "A4"}
 
@@ -50,7 +54,12 @@ def whole_pin_family(model: str, geom, damping, E: float, plate_height: float = 
     (:class:`~cvtfem.elements.chain.symmetric.ChainDamping`): plates ``plate_height`` x ``plate_thickness``
     (m) of Young's modulus ``E`` (Pa) give the out-of-plane bending stiffness ``a = E b h^3 / 12`` (N m^2)
     and the torsion stiffness ``G b h^3 / (3 L)`` (N m/rad, chain-models-2 §2.4 [non-source]); the link
-    damping time serves extension, twist and shear (rule (1.86) with one time), pins as the S models."""
+    damping time serves extension, twist and shear (rule (1.86) with one time), pins as the S models.
+
+    A3's clamped plates keep pushing when compressed (``drop_compressed=False``; the source leaves it open, digest
+    §4.8): dropped at ``Delta = 0``, a plate with tilted ends would lose its bending energy ``psi C psi / 2`` and
+    moments at once (a force jump that breaks the energy balance of a run; H2's bent pins slacken the outer plates
+    on the small arc).  A4's slack state is continuous (its moments vanish with ``T h/2``)."""
     if model not in A_MODELS:
         raise InputError("cvt.model", model, "must be one of " + ", ".join(A_MODELS))
     b, h = plate_height, plate_thickness
@@ -65,8 +74,9 @@ def whole_pin_family(model: str, geom, damping, E: float, plate_height: float = 
                 closed=geom.closed, use_numba=use_numba)
     if A_MODELS[model] is None:
         return WholePinFamily(ChainA1(**args), geom)
-    return WholePinFamily(ChainPerPlate(model=A_MODELS[model], plate_thickness=h, **args), geom,
-                          homogenised=ChainA1(**args))
+    clamped = ChainPerPlate(model="A3", plate_thickness=h, **args) if A_MODELS[model] == "A4" else None
+    chain = ChainPerPlate(model=A_MODELS[model], plate_thickness=h, drop_compressed=A_MODELS[model] == "A4", **args)
+    return WholePinFamily(chain, geom, homogenised=ChainA1(**args), clamped=clamped)
 
 
 class WholePinFamily:
@@ -78,9 +88,10 @@ class WholePinFamily:
 
     name = "chain"
 
-    def __init__(self, chain, geom, homogenised=None):
+    def __init__(self, chain, geom, homogenised=None, clamped=None):
         self.chain, self.geom = chain, geom
         self.homogenised = homogenised                # A3/A4: A1 of the same plates (the start's first step)
+        self.clamped = clamped                        # A4: A3 of the same plates (the start's second step)
         self._a1 = getattr(chain, "base", chain)        # the ChainA1 layout of A3/A4
         self.n, self.size = chain.n_pins, chain.n2
         self.dof_index = chain.dof_index
@@ -88,6 +99,7 @@ class WholePinFamily:
         self.on = geom.link_on
         self._free = FreeChainA(chain, np.zeros(chain.n2))
         self._last: tuple = (None, None, None)       # the blocks of the last state asked for
+        self._last_plates: tuple = (None, None, None)  # per-plate chains: the plate forces of the last forces()
 
     @property
     def blocks(self):
@@ -95,7 +107,9 @@ class WholePinFamily:
 
     @property
     def output_specs(self) -> tuple[OutputSpec, ...]:
-        return tuple(self.chain.output_specs)
+        """The chain's outputs; a per-plate chain's reduced moment is 0 for a slack plate (:meth:`outputs`)."""
+        return tuple(replace(s, doc=REDUCED_MOMENT_DOC) if s.name == REDUCED_MOMENT else s
+                     for s in self.chain.output_specs)
 
     @property
     def jac_sparsity(self) -> sp.csr_matrix:
@@ -110,13 +124,26 @@ class WholePinFamily:
         return self._a1.join(u, w)
 
     def forces(self, q, v):
-        return self.chain.forces(q, v)
+        if self.homogenised is None:
+            return self.chain.forces(q, v)
+        plates = self.chain.plate_forces(q, v)
+        self._last_plates = (q.tobytes(), v.tobytes(), plates)
+        return self.chain.base.forces(q, v) + plates
 
     def dissipative_forces(self, q, v):
         return self.chain.dissipative_forces(q, v)
 
     def rayleigh(self, q, v) -> float:
-        return float(self.chain.rayleigh(q, v))
+        """Rayleigh function (W).  A per-plate chain's plate part is ``-v . Q_d / 2`` (Euler's identity for ``Phi``
+        quadratic in ``v`` within the current plate states) with ``Q_d`` the compiled plate forces less their
+        elastic part (those of the last :meth:`forces` at the same state, as the RHS asks): the numpy plates'
+        Rayleigh function costs about 15 ms, the RHS 0.5 ms."""
+        if self.homogenised is None:
+            return float(self.chain.rayleigh(q, v))
+        key = self._last_plates
+        plates = key[2] if key[0] == q.tobytes() and key[1] == v.tobytes() else self.chain.plate_forces(q, v)
+        damping = plates - self.chain.plate_forces(q, None)
+        return float(self.chain.base.rayleigh(q, v) - 0.5 * v @ damping)
 
     def energy(self, q, v) -> float:
         """Kinetic plus elastic energy of the chain, J."""
@@ -147,7 +174,13 @@ class WholePinFamily:
         return tuple(sp.csr_matrix(dq if k == 0 else dv) for k in wrt)
 
     def outputs(self, q, v):
-        return self.chain.outputs(q, v)
+        """The chain's outputs; the reduced moment ``2M/(hT)`` of a slack plate (state 10, ``M = T = 0``: undefined, NaN
+        in the plate law's outputs) is written as 0, the moment it carries, since a results file takes a non-finite
+        value for a failed run."""
+        out = self.chain.outputs(q, v)
+        if REDUCED_MOMENT in out:
+            out[REDUCED_MOMENT] = np.nan_to_num(out[REDUCED_MOMENT], nan=0.0)
+        return out
 
 
 _ROT = np.array([[0.0, 1.0], [-1.0, 0.0]])      # a @ _ROT = k x a
@@ -295,14 +328,23 @@ class ChainACVT(ChainCVT):
     def _static(self, ratio, w1, F2, tol):
         """ChainCVT's quasi-static solve; a per-plate chain (A3, A4) first solves A1 of the same plates (the
         homogenised layer, ``family.homogenised``) and continues from that balance (its chain coordinates and movable
-        sheaves): from the placement guess the plate states make Levenberg–Marquardt stall (A3 at 1.1e-2 of F2)."""
-        a1 = self.family.homogenised
-        if a1 is None or self.start_chain is not None:
+        sheaves): from the placement guess the plate states make Levenberg–Marquardt stall (A3 at 1.1e-2 of F2).
+        A4 continues through the balance of A3 (``family.clamped``): where no plate bears on a corner (state 1
+        everywhere, as on the reference chain) A3's balance is A4's, and the A4 solve ends in a few evaluations
+        instead of about 1800 from A1's balance."""
+        fam = self.family
+        if fam.homogenised is None or self.start_chain is not None:
             return super()._static(ratio, w1, F2, tol)
-        homogenised = replace(self, family=WholePinFamily(a1, self.family.geom))
-        x1, _ = homogenised._static(ratio, w1, F2, tol)
-        start = replace(self, start_chain=x1[:self.family.size], start_z=x1[homogenised._idx[2]])
-        return start._static(ratio, w1, F2, tol)
+        x, _ = replace(self, family=WholePinFamily(fam.homogenised, fam.geom))._static(ratio, w1, F2, tol)
+        if fam.clamped is not None:
+            clamped = WholePinFamily(fam.clamped, fam.geom, homogenised=fam.homogenised)
+            x, _ = self._continued(x, clamped)._static(ratio, w1, F2, tol)
+        return self._continued(x, fam)._static(ratio, w1, F2, tol)
+
+    def _continued(self, x, family) -> "ChainACVT":
+        """This transmission with ``family`` whose quasi-static solve starts from the chain and movable sheaves of
+        ``x`` (a balance of another family of the same layout)."""
+        return replace(self, family=family, start_chain=x[:family.size], start_z=x[self._idx[2]])
 
     def _solve_balance(self, residual, jacobian, y0, tol: float):
         """A per-plate chain (A3, A4) from A1's balance: :func:`~cvtfem.machines.static_balance.lifted_newton` (scipy's

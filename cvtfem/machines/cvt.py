@@ -156,8 +156,11 @@ def chain_geometry(scene: Scene):
                  period=ch.lacing_period, c_pin=ch.pin_axial_stiffness)
 
 
+#: The per-plate whole-pin chains (A3: plates clamped to the pins, A4: the ten plate states); they run with H1 or H2 on
+#: rigid or elastic shafts (variants (g), (d)), :func:`_per_plate_refusal`.
+PER_PLATE_CHAINS = ("chain-A3", "chain-A4")
 #: Discrete-chain models that run as a transmission (the others exist as element families only).
-RUNNING_CHAINS = ("chain-S1", "chain-S2", "chain-S3", "chain-A1", "chain-A2", "chain-A5", "chain-A5-point")
+RUNNING_CHAINS = ("chain-S1", "chain-S2", "chain-S3", "chain-A1", "chain-A2", "chain-A5", "chain-A5-point") + PER_PLATE_CHAINS
 
 
 def band_model(scene: Scene, **overrides: Any):
@@ -239,6 +242,8 @@ def chain_refusal(scene: Scene) -> InputError | None:
     key), or None when it can."""
     cvt = scene.cvt
     model, eff = cvt.model, cvt.effects
+    if model in PER_PLATE_CHAINS:
+        return _per_plate_refusal(model, eff)
     if model not in RUNNING_CHAINS:
         return InputError("cvt.model", model, "must be a discrete chain that runs in time: " + ", ".join(RUNNING_CHAINS)
                           + " (the other chain models exist as element families only so far, docs/chain.md)")
@@ -284,6 +289,22 @@ def chain_refusal(scene: Scene) -> InputError | None:
     return None
 
 
+def _per_plate_refusal(model: str, eff) -> InputError | None:
+    """:func:`chain_refusal` for ``chain-A3``/``chain-A4``: pins that bend, Hertz contact (H1 or H2) and friction; rigid or
+    elastic shafts."""
+    if not eff.pin_bending:
+        return InputError("cvt.effects.pin_bending", False, f"must be true for `{model}` (its pins bend); "
+                          "without pin bending use `chain-S2`")
+    if eff.contact not in ("hertz", "hertz-refined"):
+        return InputError("cvt.effects.contact", eff.contact, f"must be 'hertz' or 'hertz-refined' for `{model}`: Hertz "
+                          "contact at the pin-axis end or refined (the rigid contact runs with `chain-S1` only, the "
+                          "impact at contact onset with `chain-S2`)")
+    if not eff.friction:
+        return InputError("cvt.effects.friction", False, "must be true for a chain transmission: the chain "
+                          "transmits torque only by pin-sheave friction")
+    return None
+
+
 def chain_loop(scene: Scene):
     """Scene -> :class:`~cvtfem.machines.chain_cvt.ChainCVT`: the chain of :func:`chain_geometry` on two rigid
     shafts with Hertz contact at the pin-axis ends (H1) or refined (H2, ``effects.contact = "hertz-refined"``),
@@ -296,8 +317,8 @@ def chain_loop(scene: Scene):
     :mod:`~cvtfem.machines.chain_a_cvt`, a fixed and a movable sheave per shaft; A2's coupled halves
     :mod:`~cvtfem.machines.chain_a2_cvt`), rigid shafts, ``effects.contact = "hertz"`` (S2, S3, A1) or
     ``"hertz-refined"`` (all four; variant (a) is A1 with it), friction on; with ``effects.shaft_elasticity`` S2, S3
-    and A1 with H1 on elastic shafts (:mod:`~cvtfem.machines.chain_cvt_elastic`).  (A3/A4 build through the same
-    interface; A3's start converges from A1's balance, A4's does not yet: docs/chain.md.)
+    and A1 with H1 on elastic shafts (:mod:`~cvtfem.machines.chain_cvt_elastic`).  The per-plate chains ``chain-A3`` and
+    ``chain-A4`` run as A1 does (H1 or H2, rigid or elastic shafts: variants (g), (d)), starting from A1's balance.
     """
     from cvtfem.control.clamping import Clamping
     from cvtfem.machines.chain_cvt import from_scene
@@ -350,6 +371,14 @@ def _contact_note(scene: Scene) -> str:
     return f"{'refined (H2)' if refined else 'Hertz (H1)'} contact{faces} at {where} with"
 
 
+def _plate_state_note(scene: Scene, model) -> str:
+    """``chain-A4``: where its plates' contact states live, for `describe`."""
+    if scene.cvt.model != "chain-A4":
+        return ""
+    return (f"; each of its {model.family.chain.n_plates} plates in one of 10 contact states, classified from its "
+            "strains inside the right-hand side (no events: the forces are continuous across the state boundaries)")
+
+
 def _running_chain_layout(scene: Scene) -> tuple[Layout, ...]:
     """Components of :func:`chain_loop`'s model with the outputs it writes, grouped by name prefix."""
     model = chain_loop(scene)
@@ -363,7 +392,7 @@ def _running_chain_layout(scene: Scene) -> tuple[Layout, ...]:
                     n1=getattr(model, "n_discrete", -1) + 1, discrete=getattr(model, "n_discrete", 0),
                     note=f"{n} pins x {per_pin}; {_contact_note(scene)} each shaft's sheaves "
                          + ("(discrete state per pin end and shaft, impact loss)" if hasattr(model, "n_discrete")
-                            else "(continuous: no discrete state)")),
+                            else "(continuous: no discrete state)") + _plate_state_note(scene, model)),
              *_pulley_layouts(model, outputs, sheave)]
     if scene.cvt.effects.stabilisation:
         parts.append(Layout("stabilisation", "speed-ratio-control", 0, n1=Stabilisation.size,

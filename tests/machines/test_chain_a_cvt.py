@@ -133,8 +133,7 @@ def test_scene_path_builds_a1_and_describes_its_outputs_once():
     listed = [o.name for part in layout(scene) for o in part.outputs]
     assert sorted(listed) == sorted(o.name for o in m.output_specs)
     assert sum(p.n2 for p in layout(scene)) == m.n2
-    with pytest.raises(InputError, match=r"cvt\.model"):
-        chain_loop(scene.replace({"cvt": {"model": "chain-A4"}}))
+    assert isinstance(chain_loop(scene.replace({"cvt": {"model": "chain-A4"}})), ChainACVT)   # runs (session 8)
     with pytest.raises(InputError, match=r"cvt\.effects\.pin_bending"):
         chain_loop(scene.replace({"cvt": {"effects": {"pin_bending": False}}}))
 

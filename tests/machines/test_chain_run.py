@@ -42,7 +42,7 @@ def test_describe_lists_every_output_of_the_running_chain_once():
 
 
 @pytest.mark.parametrize("override, key", [
-    ({"cvt": {"model": "chain-A4", "effects": {"pin_bending": True}}}, "cvt.model"),
+    ({"cvt": {"model": "chain-A4", "effects": {"pin_bending": False}}}, "cvt.effects.pin_bending"),
     ({"cvt": {"model": "chain-S3", "effects": {"pin_bending": True, "contact": "hertz-refined",
                                                "shaft_elasticity": True}}}, "cvt.effects.shaft_elasticity"),
     ({"cvt": {"model": "chain-A2", "effects": {"contact": "impact", "pin_bending": True}}}, "cvt.effects.contact"),
