@@ -160,7 +160,10 @@ def chain_geometry(scene: Scene):
 #: rigid or elastic shafts (variants (g), (d)), :func:`_per_plate_refusal`.
 PER_PLATE_CHAINS = ("chain-A3", "chain-A4")
 #: Discrete-chain models that run as a transmission (the others exist as element families only).
-RUNNING_CHAINS = ("chain-S1", "chain-S2", "chain-S3", "chain-A1", "chain-A2", "chain-A5", "chain-A5-point") + PER_PLATE_CHAINS
+RUNNING_CHAINS = ("chain-S1", "chain-S2", "chain-S3", "chain-A1", "chain-A2", "chain-A5", "chain-A5-point",
+                  *PER_PLATE_CHAINS)
+#: The chains that take the impact at contact onset (``effects.contact = "impact"``, rigid shafts).
+IMPACT_CHAINS = ("chain-S2", "chain-S3", "chain-A1")
 
 
 def band_model(scene: Scene, **overrides: Any):
@@ -250,14 +253,13 @@ def chain_refusal(scene: Scene) -> InputError | None:
     if model not in ("chain-S1", "chain-S2") and not eff.pin_bending:
         return InputError("cvt.effects.pin_bending", False, f"must be true for `{model}` (its pins bend); "
                           "without pin bending use `chain-S2`")
-    impact_chains = ("chain-S2", "chain-S3", "chain-A1")   # effects.contact = "impact" (rigid shafts)
     if model == "chain-S1" and eff.contact == "impact":
         return InputError("cvt.effects.contact", eff.contact, "must be 'rigid' for `chain-S1`: its pins carry no axial "
                           "inertia, so a pin end entering a sheave takes no impulse (chain-models-1 2.1); the impact "
-                          "at contact onset runs with " + ", ".join(impact_chains))
-    if eff.contact == "impact" and model not in impact_chains:
+                          "at contact onset runs with " + ", ".join(IMPACT_CHAINS))
+    if eff.contact == "impact" and model not in IMPACT_CHAINS:
         return InputError("cvt.effects.contact", eff.contact, f"must be 'hertz' or 'hertz-refined' for `{model}`: the "
-                          "impact at contact onset runs with " + ", ".join(impact_chains) + " only so far (rigid "
+                          "impact at contact onset runs with " + ", ".join(IMPACT_CHAINS) + " only so far (rigid "
                           "shafts)")
     if model == "chain-S1" and eff.contact != "rigid":
         return InputError("cvt.effects.contact", eff.contact, "must be 'rigid' for `chain-S1`: its pins have no axial "
@@ -276,7 +278,7 @@ def chain_refusal(scene: Scene) -> InputError | None:
     if model != "chain-S1" and eff.contact not in ("hertz", "hertz-refined", "impact"):
         return InputError("cvt.effects.contact", eff.contact, f"must be 'hertz' or 'hertz-refined' for `{model}`: "
                           "Hertz contact at the pin-axis end or refined (the rigid contact runs with `chain-S1` only, "
-                          "the impact at contact onset with " + ", ".join(impact_chains) + ")")
+                          "the impact at contact onset with " + ", ".join(IMPACT_CHAINS) + ")")
     if eff.contact == "hertz-refined" and model not in ("chain-S2", "chain-S3", "chain-A1", "chain-A2", "chain-A5"):
         return InputError("cvt.effects.contact", eff.contact, f"must be 'hertz' for `{model}`: the refined contact "
                           "runs with chain-S2, chain-S3, chain-A1, chain-A2 and chain-A5 only so far")
@@ -298,7 +300,7 @@ def _per_plate_refusal(model: str, eff) -> InputError | None:
     if eff.contact not in ("hertz", "hertz-refined"):
         return InputError("cvt.effects.contact", eff.contact, f"must be 'hertz' or 'hertz-refined' for `{model}`: Hertz "
                           "contact at the pin-axis end or refined (the rigid contact runs with `chain-S1` only, the "
-                          "impact at contact onset with `chain-S2`)")
+                          "impact at contact onset with " + ", ".join(IMPACT_CHAINS) + ")")
     if not eff.friction:
         return InputError("cvt.effects.friction", False, "must be true for a chain transmission: the chain "
                           "transmits torque only by pin-sheave friction")
