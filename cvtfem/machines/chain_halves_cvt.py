@@ -13,7 +13,9 @@ dissipated work with the Rayleigh damping.
 """
 from __future__ import annotations
 
+import copy
 from dataclasses import dataclass, replace
+from functools import lru_cache
 from typing import ClassVar
 
 import numpy as np
@@ -198,6 +200,32 @@ class RollingPlacement(Placement):
     delta: float = 0.0
 
 
+def _hashable(a):
+    """A float, or an array as a tuple (an argument of the cached :func:`_rolling_placement`)."""
+    a = np.asarray(a, float)
+    return float(a) if a.ndim == 0 else tuple(a.tolist())
+
+
+@lru_cache(maxsize=16)
+def _rolling_placement(L, ratio: float, L_c: float, R, h, delta, stretch) -> RollingPlacement:
+    """:meth:`ChainHalvesCVT._placement` at link lengths ``L`` (m), ``ratio``, centre distance ``L_c`` (m), roll
+    radius ``R`` and pin height ``h`` (m), face pressing ``delta`` and link stretch ``stretch`` (m): fixed-point
+    passes of the link directions (each shrinks the change a hundredfold) until the spacing changes by less than
+    1e-11 m.  Pure geometry, cached: a model's construction (the fixed sheaves' wedge estimate) and its start ask for
+    the same placement, about 1 s each."""
+    L, R, h, delta, stretch = (np.asarray(a) if isinstance(a, tuple) else a for a in (L, R, h, delta, stretch))
+    spacing = L + stretch
+    for _ in range(12):
+        pl = place_on_path(spacing, ratio, L_c)
+        tau = rolling_link_directions(pl.u, R, h, delta)
+        new = rolling_spacing(tau, L, R, delta, stretch)
+        if np.abs(new - spacing).max() < 1e-11:
+            return RollingPlacement(**vars(pl), tau=tau, delta=delta)
+        spacing = new
+    raise NumericalError(f"the rolling points did not settle on the path of ratio {ratio} (last change "
+                         f"{np.abs(new - spacing).max():.3g} m)", component="ChainHalvesCVT placement")
+
+
 class _HalfCentres:
     """The in-plane positions ``u_0`` of both halves of every pin as one array: reading gives their mean (the pin
     centre), writing sets both (the quasi-static start places and moves whole pins)."""
@@ -267,26 +295,21 @@ class ChainHalvesCVT(ChainACVT):
         :meth:`_placed` every link carries ``tension`` (N; stretched by ``T / c_link``, the rolling faces pressed by
         ``T / (l k_roll)``): :func:`~cvtfem.elements.chain.halves_placement.rolling_spacing` (rolling shortens a link,
         and where the joint angles at its ends differ, as for links of unequal lengths on an arc, its direction is
-        not the chord of ``U``).  Fixed-point passes of the link directions (each shrinks the change a
-        hundredfold) until the spacing changes by less than 1e-11 m (0.01 N in a link).  ``tension`` None: the pins
+        not the chord of ``U``; :func:`_rolling_placement`, to 1e-11 m: 0.01 N in a link).  ``tension`` None: the pins
         at their pitches on the path (ChainCVT's placement: the path's radii and span angle for the wedge
         estimate)."""
         if tension is None:
             return super()._placement(ratio)
         fam, ch = self.family, self.family.chain
-        R, h = ch.roll_radius, ch.h_pin
-        stretch = tension / fam.geom.c_link
-        delta = tension / (ch.l * ch.roll_stiffness)
-        spacing = fam.geom.L + stretch
-        for _ in range(12):
-            pl = place_on_path(spacing, ratio, self.contact.centres[0, 0])
-            tau = rolling_link_directions(pl.u, R, h, delta)
-            new = rolling_spacing(tau, fam.geom.L, R, delta, stretch)
-            if np.abs(new - spacing).max() < 1e-11:
-                return RollingPlacement(**vars(pl), tau=tau, delta=delta)
-            spacing = new
-        raise NumericalError(f"the rolling points did not settle on the path of ratio {ratio} (last change "
-                             f"{np.abs(new - spacing).max():.3g} m)", component="ChainHalvesCVT placement")
+        delta, R = tension / (ch.l * ch.roll_stiffness), float(np.min(ch.roll_radius))
+        if not delta < R:        # the rolling model's faces pressed through their radius: no placement exists
+            raise InputError("cvt.chain.pin_length", ch.l, f"must let the pin halves' rolling faces carry the wedge "
+                             f"tension {tension:.4g} N pressed by T / (l k_roll) = {delta:.3g} m, less than their "
+                             f"radius {R:.3g} m (k_roll {ch.roll_stiffness:.3g} N/m^2); or lower the clamping forces")
+        pl = _rolling_placement(*map(_hashable, (fam.geom.L, ratio, self.contact.centres[0, 0], ch.roll_radius,
+                                                 ch.h_pin, tension / (ch.l * ch.roll_stiffness),
+                                                 tension / fam.geom.c_link)))
+        return copy.deepcopy(pl)
 
     @staticmethod
     def _joint_angles(tau):

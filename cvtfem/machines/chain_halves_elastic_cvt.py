@@ -104,10 +104,12 @@ class ElasticChainHalvesCVT(ElasticChainACVT, ChainHalvesCVT):
             return self.rigid().placed_state(ratio, w1), {"placed": str(err)}
 
     def _solve_elastic_balance(self, residual, jacobian, y0, tol: float):
-        """:func:`~cvtfem.machines.static_balance.lifted_newton` (as the rigid A5 start: the span halves' axial
-        positions have no stiffness of their own, and the rolling halves make the static stiffness indefinite) on the
-        structure's tilts as arc lengths at :data:`TILT_ARM` (rotations and moments in the units of the rest: the
-        lift compares diagonal stiffnesses, which would lift the tilts in rad as if they had none)."""
+        """:func:`~cvtfem.machines.static_balance.lifted_newton` with the rigid A5 start's settings (its lifted phase
+        alone, the finer lifts and steps: the span halves' axial positions have no stiffness of their own, and the
+        rolling halves make the static stiffness indefinite; with the default damped phase the solve from the
+        tie-continued rigid balance stalled at 2.4e-2 of F2 for (zh), with these 3.6e-5) on the structure's tilts as
+        arc lengths at :data:`TILT_ARM` (rotations and moments in the units of the rest: the lift compares diagonal
+        stiffnesses, which would lift the tilts in rad as if they had none)."""
         nc, s = self._idx[0], self.structure
         held = np.concatenate([nc + np.flatnonzero(s.dof_kind == 5), self._idx[2][:1]])
         free = np.setdiff1d(np.arange(self.n2), held)                  # the unknowns of _elastic_static
@@ -115,7 +117,7 @@ class ElasticChainHalvesCVT(ElasticChainACVT, ChainHalvesCVT):
         scale = np.where(np.isin(free, tilts), 1.0 / TILT_ARM, 1.0)
         D = sp.diags(scale)
         sol = lifted_newton(lambda z: scale * residual(scale * z), lambda z: D @ jacobian(scale * z) @ D,
-                            np.asarray(y0) / scale, tol)
+                            np.asarray(y0) / scale, tol, damped=0, lifts=self.LIFTS, steps=self.STEPS)
         sol.x = scale * sol.x
         return sol
 

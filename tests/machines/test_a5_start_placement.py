@@ -91,3 +91,17 @@ def test_link_directions_are_the_directions_of_the_half_axes():
     np.testing.assert_allclose(rolling_link_directions(regular, R, h), chords / np.linalg.norm(chords, axis=1,
                                                                                                keepdims=True),
                                rtol=0, atol=1e-14)
+
+
+def test_rolling_faces_pressed_through_their_radius_are_refused_by_key(model):
+    """A pin 1e4 times too short presses the rolling faces by ``T / (l k_roll)`` more than their radius at the wedge
+    tension: no placement exists (the link directions' fixed point diverges), so building the model (`describe`,
+    found by the input fuzz test) names `cvt.chain.pin_length` instead of failing numerically; the same tension on
+    the preset's pins is placed."""
+    from cvtfem.errors import InputError
+
+    l = load_scene("chain-A5").cvt.chain.pin_length
+    short = load_scene("chain-A5", {"cvt": {"chain": {"pin_length": 1e-4 * l}}})
+    with pytest.raises(InputError, match=r"cvt\.chain\.pin_length"):
+        chain_loop(short)
+    assert model._placement(RATIO, 4000.0).delta < np.min(model.family.chain.roll_radius)

@@ -340,7 +340,9 @@ def test_energy_balance_over_a_short_run():
 @pytest.mark.slow
 def test_cvtfem_run_variant_e(cli, tmp_path):
     """`cvtfem run` of the variant-e preset (randomised chain, stationary regime, the preset's solver) for 2 us: the
-    start says it is the placement (the rigid A5 start does not converge for this chain), every output is finite,
+    start names the rigid A5 start of the randomised chain, converged below 1e-4 of F2 since the rolling-tie
+    continuation, and then the elastic solve from it (chain and structure together: 1.1e-3 of F2 after 5972
+    evaluations for this chain, so "off balance"; the uniform chain's converges, test below), every output is finite,
     the input speed stays at 3500 rpm and the work integrals close the energy balance to 1e-5 of the input work."""
     import json
 
@@ -360,7 +362,9 @@ def test_cvtfem_run_variant_e(cli, tmp_path):
         assert len(s["time"]) >= 4
         W, E, speed = s["work"][-1], s["energy"][:], s["driving.speed"][:]
         start = str(f["stats"].attrs["start"])
-    assert start.startswith("placed on the sheaves on undeformed elastic shafts") and "residual" in start
+    assert start.split(" on elastic shafts (residual")[0] in ("quasi-static",
+                                                            "off balance, the quasi-static solve not converged:")
+    assert float(start.split("rigid A5 start ")[1].split(")")[0]) < 1e-4
     assert np.abs(speed / (3500 * np.pi / 30) - 1).max() < 1e-3
     assert W[0] > 0.0 and abs(W[0] - W[1] - W[2] + W[3] - (E[-1] - E[0])) < 1e-5 * W[0]
 
@@ -368,8 +372,9 @@ def test_cvtfem_run_variant_e(cli, tmp_path):
 @pytest.mark.slow
 def test_start_of_variant_zh_on_elastic_shafts():
     """The uniform chain's start of variant (zh) (clamping 30 / 35 kN): the rigid A5 start (lifted Newton, 5e-5 of F2),
-    then chain and structure together; the lifted Newton ends at about 1.1e-4 of F2, just above the limit 1e-4, so
-    the start keeps the state it reached and says so.  There the pins push the movable sheaves with the clamping
+    then chain and structure together by the lifted Newton with the rigid start's settings, to below the limit 1e-4
+    of F2 (3.6e-5; 1.1e-4 with the default damped phase from the old rigid start, 2.4e-2 from the tie-continued one).
+    There the pins push the movable sheaves with the clamping
     forces (F1 the held sheave's reaction; 1e-3) and the fixed ones with nearly the same (2e-3), each shaft's
     bearings carry the resultant of the frictionless contact forces on its sheaves (1e-6), the sheaves of a pulley
     tilt opposite ways (their main components; the other is a thousandth of it), and F1 is within 2 % of the rigid
@@ -377,8 +382,8 @@ def test_start_of_variant_zh_on_elastic_shafts():
     rigid, model = _rigid("zh")
     w1, _, i = rigid.regime.targets(0.0)
     x0, rep = model.static_state(i, w1)
-    assert rep["rigid_residual"] < 1e-4 and rep["residual"] < 2e-4
-    assert (rep["unbalanced"] is None) == (rep["residual"] <= model.static_residual_limit)
+    assert rep["rigid_residual"] < 1e-4 and rep["residual"] < model.static_residual_limit == 1e-4
+    assert rep["unbalanced"] is None
     m = rep["model"]
     o = m.outputs(0.0, x0)
     F = np.array([rep["F1"], rep["F2"]])

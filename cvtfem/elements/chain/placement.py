@@ -9,7 +9,9 @@ counter-clockwise.
 """
 from __future__ import annotations
 
+import copy
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
 from scipy.optimize import brentq
@@ -54,7 +56,14 @@ def _march(L, length: float, phi: float, L_c: float) -> np.ndarray:
 
 
 def place_on_path(L, ratio: float, L_c: float) -> Placement:
-    """Pins with link lengths ``L`` (n,) m on the path of ``ratio = r2 / r1`` for the centre distance ``L_c`` (m)."""
+    """Pins with link lengths ``L`` (n,) m on the path of ``ratio = r2 / r1`` for the centre distance ``L_c`` (m).
+    Cached (about 0.3 s of scalar root finding; a model's construction and its start ask for the same one)."""
+    return copy.deepcopy(_place(tuple(np.asarray(L, float).tolist()), float(ratio), float(L_c)))
+
+
+@lru_cache(maxsize=16)
+def _place(L: tuple, ratio: float, L_c: float) -> Placement:
+    """:func:`place_on_path` for hashable arguments."""
     L = np.asarray(L, float)
     total = L.sum()
     phi_of = lambda length: phi_for_ratio(ratio, length, L_c)  # noqa: E731
