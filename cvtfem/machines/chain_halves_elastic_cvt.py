@@ -20,8 +20,9 @@ difference of two points at one ``x3``, is unchanged by the sheave's translation
 
 Start (:meth:`ElasticChainHalvesCVT.start`): the rigid A5 start (lifted Newton,
 :func:`~cvtfem.machines.static_balance.lifted_newton`), then chain and structure together (lifted Newton too:
-A5's static stiffness is indefinite and singular); where the rigid solve fails (the randomised reference chain)
-the rigid placement on undeformed shafts, off balance, and the start's ``kind`` says so.
+A5's static stiffness is indefinite and singular); where the rigid solve fails (it converges for the uniform and the
+randomised reference chain since its rolling-tie continuation) the rigid placement on undeformed shafts, off balance,
+and where the elastic solve ends above its limit the state it reached; the start's ``kind`` says which.
 """
 from __future__ import annotations
 
