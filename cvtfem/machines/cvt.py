@@ -12,7 +12,7 @@ from typing import Any
 
 from cvtfem.control.stabilisation import LOOP_OUTPUTS, Stabilisation
 from cvtfem.elements.base import Layout
-from cvtfem.errors import InputError
+from cvtfem.errors import InputError, NumericalError
 from cvtfem.outputs import OutputSpec
 from cvtfem.scene.loader import Scene
 
@@ -334,14 +334,20 @@ def chain_loop(scene: Scene):
     clamping = Clamping(band_params(scene), rg.clamping_safety, rg.clamping_split, rg.min_clamping_force)
     F_appl = clamping.forces(rg.torque, rg.ratio)
     overrides = {} if eff.damping else {"damping_ratio": 0.0}
-    if eff.shaft_elasticity:
-        from cvtfem.machines.chain_cvt_elastic import from_scene as elastic_from_scene
-        built = elastic_from_scene(scene, chain_geometry(scene), F_appl, model=model, contact=eff.contact, **overrides)
-    elif eff.contact == "impact":
-        from cvtfem.machines.chain_impact_cvt import from_scene as impact_from_scene
-        built = impact_from_scene(scene, chain_geometry(scene), F_appl, model=model, **overrides)
-    else:
-        built = from_scene(scene, chain_geometry(scene), F_appl, model=model, contact=eff.contact, **overrides)
+    geom = chain_geometry(scene)
+    try:    # building places the chain on the sheaves at the start ratio (the fixed sheaves' wedge estimate)
+        if eff.shaft_elasticity:
+            from cvtfem.machines.chain_cvt_elastic import from_scene as elastic_from_scene
+            built = elastic_from_scene(scene, geom, F_appl, model=model, contact=eff.contact, **overrides)
+        elif eff.contact == "impact":
+            from cvtfem.machines.chain_impact_cvt import from_scene as impact_from_scene
+            built = impact_from_scene(scene, geom, F_appl, model=model, **overrides)
+        else:
+            built = from_scene(scene, geom, F_appl, model=model, contact=eff.contact, **overrides)
+    except NumericalError as err:   # no placement exists: the scene's geometry and stiffnesses disagree
+        raise InputError("cvt.chain", f"{cvt.chain.n_pins} pins", f"must be placeable on the sheaves at the start "
+                         f"ratio {rg.ratio} with the clamping forces {F_appl[0]:.4g} / {F_appl[1]:.4g} N: {err}",
+                         "check the chain's lengths and stiffnesses against cvt.geometry") from None
     if scene.sheave is not None and scene.sheave.flexibility != "rigid":  # issue 20: faces that open under the pins
         from cvtfem.machines.chain_cvt_flexible import flexible_faces_model
         built = flexible_faces_model(scene, built)

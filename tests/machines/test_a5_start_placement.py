@@ -105,3 +105,14 @@ def test_rolling_faces_pressed_through_their_radius_are_refused_by_key(model):
     with pytest.raises(InputError, match=r"cvt\.chain\.pin_length"):
         chain_loop(short)
     assert model._placement(RATIO, 4000.0).delta < np.min(model.family.chain.roll_radius)
+
+
+def test_a_chain_that_cannot_close_on_the_path_is_refused_by_key():
+    """Links 1e4 times too soft stretch by ``T / c_link`` ~ 3 cm at the wedge tension: the stretched chain cannot
+    close on the path at the start ratio, so building the model (`describe`, found by the input fuzz test) names
+    `cvt.chain` with the placement's reason, as an input error, not a numerical failure."""
+    from cvtfem.errors import InputError
+
+    c = load_scene("variant-e").cvt.chain.link_stiffness
+    with pytest.raises(InputError, match=r"cvt\.chain.*does not close on the path"):
+        chain_loop(load_scene("variant-e", {"cvt": {"chain": {"link_stiffness": 1e-4 * c}}}))
