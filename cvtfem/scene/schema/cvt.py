@@ -37,12 +37,13 @@ GEOMETRY = Table("geometry", "Shaft centre distance and sheave faces.", (
 ), checks=(lambda t, p: _check_geometry(t, p),))
 
 CHAIN = Table("chain", "The chain (pins, plates, links) and its band abstraction.", (
-    Key("n_pins", "int", "Number of pins (= links); a multiple of the lacing period.", "-", ge=6),
+    Key("n_pins", "int", "Number of pins (= links); a multiple of the lacing period (at most 1000: CVT chains "
+        "have 60-130).", "-", ge=6, le=1000),
     Key("pitch_short", "float", "Length of a short link.", "m", gt=0.0),
     Key("pitch_long", "float", "Length of a long link.", "m", gt=0.0),
     Key("long_fraction", "float", "Fraction of long links in the randomised pattern (seeded by `seed`).",
         "-", ge=0.0, le=1.0),
-    Key("plates_per_link", "int", "Plates in one link.", "-", ge=1),
+    Key("plates_per_link", "int", "Plates in one link (at most 64: CVT chains have 10-20).", "-", ge=1, le=64),
     Key("lacing_period", "int", "Number of links after which the plate lacing repeats.", "-", ge=1),
     Key("mass", "float", "Total chain mass.", "kg", gt=0.0),
     Key("pin_length", "float", "Pin length (across the chain).", "m", gt=0.0),
