@@ -254,7 +254,10 @@ def test_run_events_switch_flags_and_close_the_energy_balance(model, x0):
 def test_cvtfem_run_of_an_impact_scene_closes_the_energy_balance(cli, tmp_path):
     """0.3 ms of the chain-S2 preset with ``effects.contact = "impact"`` through `cvtfem run` (rock4, rtol 1e-4): the
     results carry the discrete state and the impact loss, and the work integrals close the energy balance (input =
-    output + damping + friction + impact losses + change of energy - clamping work) to 1e-6 of the input work."""
+    output + damping + friction + impact losses + change of energy - clamping work) to 1e-6 of the input work.  The
+    loss has zero rate between events, but rock4's stage recurrence (``(1 + mu) x1 - mu x0 + ...``) carries a constant
+    component only to round-off, whose sign depends on the BLAS kernel (-1.1e-19 J on 7.3e-4 J at the last sample
+    with OPENBLAS_CORETYPE=Sandybridge): it never falls by more than round-off."""
     import h5py
 
     scene_file, h5 = tmp_path / "impact.toml", tmp_path / "impact.h5"
@@ -265,6 +268,6 @@ def test_cvtfem_run_of_an_impact_scene_closes_the_energy_balance(cli, tmp_path):
     with h5py.File(h5) as f:
         s = f["series"]
         W, E, loss, state = s["work"][-1], s["energy"][:], s["contact.impact_loss"][:], s["contact.state"][:]
-    assert loss[-1] > 0 and np.all(np.diff(loss.ravel()) >= 0)
+    assert loss[-1] > 0 and np.all(np.diff(loss.ravel()) >= -1e-12 * loss.max())
     assert set(np.unique(state)) <= {FREE, SLIDING, STUCK}
     assert W[0] > 10.0 and abs(W[0] - W[1] - W[2] + W[3] - (E[-1] - E[0])) < 1e-6 * W[0]

@@ -382,7 +382,8 @@ def test_cvtfem_run_closes_the_energy_balance_with_the_impact_losses(cli, tmp_pa
         s = f["series"]
         W, E, loss = s["work"][-1], s["energy"][:], s["contact.impact_loss"][:].ravel()
         state, pen = s["contact.state"][-1], s["contact.penetration"][-1]
-    assert loss[-1] > 0 and np.all(np.diff(loss) >= 0) and W[2] > loss[-1]
+    # zero rate between events, carried by rock4's stage recurrence to round-off only (test_chain_impact.py)
+    assert loss[-1] > 0 and np.all(np.diff(loss) >= -1e-12 * loss.max()) and W[2] > loss[-1]
     assert set(np.unique(state)) <= {FREE, SLIDING, STUCK}
     assert np.all(pen[state != FREE] > -HYSTERESIS) and np.all(pen[state == FREE] <= 0)
     assert W[0] > 10.0 and abs(W[0] - W[1] - W[2] + W[3] - (E[-1] - E[0])) < 1e-6 * W[0]
