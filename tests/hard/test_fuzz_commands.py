@@ -32,7 +32,11 @@ COMMANDS = {"run": ("band-4dof", ["--until", "0.002", "--results", "r.h5"]),
             "modes": ("friswell_5_9_1", []),
             "campbell": ("friswell_5_9_1", ["--speeds", "0:3000rpm:3"]),
             "periodic": ("engine_gear_train", ["--sweep", "12:13:2", "--harmonics", "6"])}
-BASES = {name: resolve_presets(tomllib.loads(preset_text(preset))) for name, (preset, _) in COMMANDS.items()}
+#: The presets resolved into whole documents, less the provenance key ``preset``: written back with it, a document whose
+#: mutation deletes a table would take that table from the preset again (band-4dof without its ``cvt`` became
+#: reference_cvt's variant (e) transmission, a legitimate run of hours: reported as a hang).
+BASES = {name: {k: v for k, v in resolve_presets(tomllib.loads(preset_text(preset))).items() if k != "preset"}
+         for name, (preset, _) in COMMANDS.items()}
 VALUES = st.one_of(st.sampled_from([0, -1, 10 ** 9, 1e300, 1e-300, -0.0, "x", True, [1, 2], {"a": 1}]),
                    st.floats(allow_nan=True, allow_infinity=True), st.integers(-10 ** 6, 10 ** 6))
 HANG = 60  # s: an example running longer is a hang
