@@ -39,8 +39,11 @@ from scipy.optimize import least_squares
 
 from cvtfem.assembly.model import StateLayout
 from cvtfem.elements.base import Block
+from cvtfem.elements.chain import mapped_contact_kernel as MCK
+from cvtfem.elements.chain.sheave_contact_refined import RefinedSheaveContact
 from cvtfem.elements.chain.sheave_contact import central_local_jacobian
 from cvtfem.elements.chain.symmetric import END_SLOPE_FACTOR
+from cvtfem.elements.jit import HAVE_NUMBA
 from cvtfem.errors import NumericalError
 from cvtfem.machines.chain_a2_cvt import ChainA2CVT
 from cvtfem.machines.chain_a_cvt import ChainACVT
@@ -225,6 +228,35 @@ class ElasticChainCVT(ChainCVT):
         """Per-contact constants :meth:`mapped_local` takes besides its inputs (none; A2: the half signs)."""
         return {}
 
+    def _compiled_mapped_forces(self, q, v, Q) -> float:
+        """:meth:`_mapped_forces` by :func:`~cvtfem.elements.chain.mapped_contact_kernel.forces`."""
+        Pf, bad = MCK.forces(np.concatenate([q, v]), *self._mapped_table, *self._compiled_mapped, Q)
+        if bad >= 0:
+            raise NumericalError(f"H2 contact on elastic shafts: a pin end on the shaft axis (pair {bad})",
+                                 component="contact.refined")
+        return Pf
+
+    def _mapped_contact_jacobian(self, q, v, reference: bool = False):
+        """``((rows, cols, values), dD)``: the entries of ``dQ/dy`` of the mapped contacts (``y = [q, v]``) and
+        ``-d P_fr / dy`` (2 n2,); compiled where :attr:`_compiled_mapped` offers it unless ``reference``, else per
+        contact central differences of :meth:`mapped_local` (the same steps)."""
+        ck = None if reference else self._compiled_mapped
+        if ck is None:
+            cols, coef, Jl = self._mapped_jacobian(q, v)
+            return self._contact_entries(cols, coef, Jl), self._contact_power_gradient(cols, coef, Jl)
+        table = self._mapped_table
+        cols, rows = table[0], table[4]
+        size = cols.shape[0] * rows.shape[1] * cols.shape[1] * cols.shape[2] ** 2
+        r, c, d = np.empty(size, np.int64), np.empty(size, np.int64), np.empty(size)
+        dD = np.zeros(2 * self.n2)
+        n_pos = (cols.shape[1] - 1) // 2
+        steps = np.concatenate([np.full(n_pos, 1e-9), np.full(n_pos, 1e-6), [1e-5]])
+        k, bad = MCK.jacobian(np.concatenate([q, v]), *table, *ck, steps, 2 * self.n2, r, c, d, dD)
+        if bad >= 0:
+            raise NumericalError(f"H2 contact on elastic shafts: a pin end on the shaft axis (pair {bad})",
+                                 component="contact.refined")
+        return (r[:k], c[:k], d[:k]), dD
+
     def _mapped_set(self, q, v, details: bool = False):
         e, k, j, cols, coef = self._mapped_pairs(q)
         Z = (coef * np.concatenate([q, v])[cols]).sum(axis=2)
@@ -239,24 +271,42 @@ class ElasticChainCVT(ChainCVT):
         """Generalized forces (N, N m) and the friction power (W); with ``slip`` also the contact-force-weighted
         mean slip speed on each shaft (m/s, 0 without contact), as ChainCVT's."""
         nc, iphi, iz, _ = self._idx
-        s = self.structure
         Q = np.zeros(self.n2)
         Q[:nc] = self.family.forces(q[:nc], v[:nc])
+        Pf, mean_slip = self._mapped_forces(q, v, Q, slip)
+        qs, vs = q[nc:], v[nc:]
+        Q[nc:] -= self._structure_operator @ np.concatenate([qs, vs, v[iphi[0]] * vs, v[iphi[1]] * vs])
+        Q[iphi] += M
+        side = self._sides[:, 1]
+        Q[iz] -= side * F
+        Q[self._movable_node_u3] += side * F
+        return (Q, Pf, mean_slip) if slip else (Q, Pf)
+
+    @cached_property
+    def _structure_operator(self) -> sp.csr_matrix:
+        """``[K, C, G_0, G_1]`` (n, 4 n): the structure's linear forces ``K q + (C + Omega_0 G_0 + Omega_1 G_1) v``
+        in one product with ``[q, v, Omega_0 v, Omega_1 v]``."""
+        s = self.structure
+        return sp.hstack([s.K, s.C, s.G[0], s.G[1]], format="csr")
+
+    #: Constants of the compiled mapped-contact path (None: the numpy path; ElasticChainACVT's H2 sets them).
+    _compiled_mapped: ClassVar = None
+
+    def _mapped_forces(self, q, v, Q, slip: bool = False, reference: bool = False):
+        """Add the mapped contacts' generalized forces to ``Q`` (n2,); return the friction power (W) and, with
+        ``slip``, the contact-force-weighted mean slip speed per shaft (m/s; else None).  Compiled where
+        :attr:`_compiled_mapped` offers it, unless ``reference`` or ``slip`` (the numpy path, its tested twin)."""
+        if not (reference or slip) and self._compiled_mapped is not None:
+            return self._compiled_mapped_forces(q, v, Q), None
         e, k, j, cols, coef, Z, Y = self._mapped_set(q, v, details=slip)
+        mean_slip = None
         if slip:
             Y, det = Y
             N = np.bincount(k, det["N"], 2)
             mean_slip = np.bincount(k, det["N"] * np.linalg.norm(det["slip"], axis=1), 2) / np.maximum(N, 1e-300)
         rows, wr = self._output_rows(cols, coef)
         Q += np.bincount(rows.ravel(), (wr * Y[:, :-1, None]).ravel(), self.n2)
-        qs, vs = q[nc:], v[nc:]
-        Q[nc:] -= s.K @ qs + s.damping_matrix(v[iphi]) @ vs
-        Q[iphi] += M
-        side = self._sides[:, 1]
-        Q[iz] -= side * F
-        Q[self._movable_node_u3] += side * F
-        Pf = float(Y[:, -1].sum())
-        return (Q, Pf, mean_slip) if slip else (Q, Pf)
+        return float(Y[:, -1].sum()), mean_slip
 
     @cached_property
     def _structure_inverse(self) -> np.ndarray:
@@ -316,8 +366,8 @@ class ElasticChainCVT(ChainCVT):
         parts = []
         for Mx, off in ((Kc.tocoo(), 0), (Cc.tocoo(), n2)):
             parts.append((Mx.row, Mx.col + off, Mx.data))
-        cols, coef, Jl = self._mapped_jacobian(q, v)
-        parts.append(self._contact_entries(cols, coef, Jl))
+        entries, dD_contact = self._mapped_contact_jacobian(q, v)
+        parts.append(entries)
         for Mx, off in ((-s.K).tocoo(), nc), ((-s.damping_matrix(w)).tocoo(), n2 + nc):
             parts.append((Mx.row + nc, Mx.col + off, Mx.data))
         vs = v[nc:]
@@ -336,7 +386,8 @@ class ElasticChainCVT(ChainCVT):
         Wr[0, n2 + iphi[0]] = M[0]
         Wr[1, in_cols] = -w[1] * G[2]
         Wr[1, n2 + iphi[1]] += -M[1]
-        dD = self._dissipation_gradient(q, v, cols, coef, Jl)
+        dD = self._chain_dissipation_gradient(q, v)
+        dD[:2 * n2] += dD_contact
         dD[n2 + nc:2 * n2] += 2 * (s.C @ vs)
         Wr[2, :] = dD
         Wr[3, n2 + iz] = -side * F
@@ -579,6 +630,32 @@ class ElasticChainACVT(ElasticChainCVT, ChainACVT):
     #: H2: the kernel's chain position inputs (without ``z``) and the slots of the end's ``X1, X2, X3`` among them.
     refined_chain_inputs: ClassVar[int] = N_REFINED_CHAIN
     refined_end_slots: ClassVar[tuple] = (2, 3, 6)
+
+    def _frame_maps(self) -> tuple:
+        """``(spread, gather, half_end)`` around A1's frame map (:mod:`~cvtfem.elements.chain.mapped_contact_kernel`):
+        the mapped positions to A1's fifteen frame inputs, the ten mapped kernel positions to the contact's, and
+        whether the contact is A5's half-end one (A1: identities)."""
+        return np.eye(MCK.N_FRAME), np.eye(MCK.N_KERNEL), False
+
+    @cached_property
+    def _compiled_mapped(self) -> tuple | None:
+        """Constants of :mod:`~cvtfem.elements.chain.mapped_contact_kernel` for H2 at whole-pin ends (A1) or
+        independent half ends (A5); None for H1, A2's coupled halves or without numba (the numpy path)."""
+        spread, gather, half_end = self._frame_maps()
+        kernel = self.contact.pair.pair if half_end else self.contact.pair
+        if not (HAVE_NUMBA and type(kernel) is RefinedSheaveContact):
+            return None
+        return MCK.pack(kernel, self._sides, self.structure.sheave_x3, self.face_ref, spread, gather,
+                        self.refined_end_slots[:2], half_end, 0.5 * self.kernel_share)
+
+    @cached_property
+    def _mapped_table(self) -> tuple:
+        """``(cols, coef, shafts, sheaves, rows, weights)`` of the mapped contact of every ``(end, shaft)`` pair (the
+        contact map and output rows, built once): the table the compiled path loops over."""
+        _, k, j, cols, coef = self._pairs_map(*self._all_pairs())
+        rows, w = self._output_rows(cols, coef)
+        return tuple(np.ascontiguousarray(a, t) for a, t in ((cols, np.int64), (coef, float), (k, np.int64),
+                                                               (j, np.int64), (rows, np.int64), (w, float)))
 
     def _sheave_of(self, ends, shafts) -> np.ndarray:
         """Sheave (0 fixed, 1 movable) an end on side ``+-1`` (odd ends: ``x3 > 0``) meets on each shaft."""

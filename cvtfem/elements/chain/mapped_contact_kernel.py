@@ -1,0 +1,290 @@
+"""Compiled (numba) H2 contact in the frames of displaced, tilted sheaves (chains on elastic shafts: variant (b),
+A1 with H2; variant (e), A5 half ends with H2): broad phase, gather, frame map, the refined kernel, the forces mapped
+back, scatter, and the contacts' Jacobian entries.
+
+A contact's mapped inputs ``Z`` (``2 n_p + 1``: ``n_p`` positions, their rates, the spin rate) are the chain
+positions of the kernel (mirrored frame) followed by the sheave's translation ``a`` (3), tilt ``theta`` (2) and the
+other sheave's axial position.  ``spread`` takes the positions to A1's fifteen frame inputs (three points at the end's
+offset, ``x3``, slope 2, the sheave's six; A1: identity), :func:`frame_a1` maps them into the sheave's frame
+(``X = o + (I - theta x)(x - o - a)``, the slope as a direction, the face at ``z_ref``) with its exact derivative
+``dK`` (10, 15), ``gather`` takes the ten mapped kernel positions to the contact's (A1: identity; A5: end, chord,
+``x3``, slope, ``z``).  The contact's rates are ``dK P'`` and its position forces act back through ``dK^T``.
+The numpy path of :class:`~cvtfem.machines.chain_cvt_elastic.ElasticChainACVT` (``mapped_local``,
+``_refined_frame``, ``reference=True``) is the tested twin (``tests/elements/chain/test_mapped_contact_kernel.py``).
+
+Arguments shared by the kernels: ``y = [q, v]``; the pair table ``cols``, ``coef`` (P, 2 n_p + 1, K), ``shaft``,
+``sheave`` (P,), output rows ``rows``, ``rw`` (P, n_p + 1, K) (``ChainCVT._output_rows``); the constants of
+:func:`pack`.  Units SI.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from cvtfem.elements.chain.half_end_contact import _gather as _half_gather
+from cvtfem.elements.chain.half_end_contact import _spread as _half_spread
+from cvtfem.elements.chain.sheave_contact_refined_kernel import refined_local_kernel
+from cvtfem.elements.chain.symmetric import END_SLOPE_FACTOR
+from cvtfem.elements.contact.kernels import LAW_CODES
+from cvtfem.elements.jit import njit
+
+#: A1's frame inputs (three points 6, ``x3``, slope 2, the sheave's translation 3, tilt 2, other axial position 1)
+#: and the H2 kernel's positions (three points 6, ``x3``, slope 2, ``z``).
+N_FRAME, N_KERNEL = 15, 10
+
+
+def sparse_rows(A) -> tuple[np.ndarray, np.ndarray]:
+    """``(index, weight)`` (n_rows, w) of a small constant matrix with at most ``w`` nonzeros per row (padded with
+    weight 0 on column 0): row ``i`` of ``A x`` is ``sum_a weight[i, a] x[index[i, a]]``."""
+    A = np.asarray(A, float)
+    width = max(1, int((A != 0).sum(axis=1).max()))
+    index, weight = np.zeros((len(A), width), np.int64), np.zeros((len(A), width))
+    for i, row in enumerate(A):
+        nz = np.flatnonzero(row)
+        index[i, :len(nz)], weight[i, :len(nz)] = nz, row[nz]
+    return index, weight
+
+
+def pack(pair, sides, sheave_x3, face_ref, spread, gather, end_slots, half_end: bool, scale: float) -> tuple:
+    """Kernel constants: ``pair`` the :class:`~cvtfem.elements.chain.sheave_contact_refined.RefinedSheaveContact`
+    (with slopes), ``sides``, ``sheave_x3`` (m), ``face_ref`` (m) (2, 2) per (shaft, sheave), ``spread`` (15, n_p),
+    ``gather`` (n_c, 10) the constant maps around A1's frame, ``end_slots`` the two mapped inputs holding the end's
+    in-plane position (broad phase), ``half_end`` the contact is :class:`HalfEndContact`'s (A5), ``scale`` the share
+    of the pair kernel's outputs one contact carries (0.5: one end)."""
+    if not pair.slopes:
+        raise ValueError("mapped_contact_kernel.pack: the H2 kernel on elastic shafts has slopes")
+    si, sw = sparse_rows(spread)
+    gi, gw = sparse_rows(gather)
+    frame = np.stack([np.asarray(sides, float), np.asarray(sheave_x3, float), np.asarray(face_ref, float)])
+    return (np.ascontiguousarray(pair.centres, float), float(pair.r_outer) ** 2, np.ascontiguousarray(frame),
+            si, sw, gi, gw, np.asarray(end_slots, np.int64)[:2], bool(half_end),
+            np.ascontiguousarray(pair._meridians, float), float(pair.face_radius), float(END_SLOPE_FACTOR),
+            np.ascontiguousarray(pair.c, float), np.array([pair.f0, pair.v0, pair.eps, scale]), LAW_CODES[pair.law])
+
+
+def _frame_pattern() -> tuple[np.ndarray, np.ndarray]:
+    """Rows and columns of the nonzeros of A1's frame derivative ``dK`` (10, 15), in :func:`frame_a1`'s order."""
+    rows, cols = [], []
+    for i in range(3):
+        rows += [2 * i] * 5 + [2 * i + 1] * 5
+        cols += [2 * i, 6, 9, 11, 13, 2 * i + 1, 6, 10, 11, 12]
+    rows += [6] * 8 + [7] * 4 + [8] * 4
+    cols += [2, 3, 6, 9, 10, 11, 12, 13] + [7, 8, 12, 13] * 2
+    return np.array(rows, np.int64), np.array(cols, np.int64)
+
+
+#: ``(rows, cols)`` of the nonzeros of the frame derivative (46): ``dK[PATTERN[0][e], PATTERN[1][e]] = dKc[e]``.
+PATTERN = _frame_pattern()
+N_PATTERN = len(PATTERN[0])
+_PAT_ROW, _PAT_COL = PATTERN
+
+
+@njit(cache=True)
+def frame_a1(P, s, c0, c1, o3, zf, K, dKc):
+    """A1's H2 frame map (``ElasticChainACVT._refined_frame``) of one contact: kernel positions ``K`` (10,) and the
+    nonzeros ``dKc`` (46,) of their exact derivative in the frame inputs ``P`` (15,) (:data:`PATTERN`), on the
+    sheave of side ``s`` with centre ``(c0, c1)``, pivot ``o3`` and face reference ``zf`` (m)."""
+    a0, a1, a2, t1, t2 = P[9], P[10], P[11], P[12], P[13]
+    d3 = s * P[6] - o3 - a2
+    for i in range(3):
+        d1, d2 = P[2 * i] - c0 - a0, P[2 * i + 1] - c1 - a1
+        K[2 * i] = c0 + d1 - t2 * d3
+        K[2 * i + 1] = c1 + d2 + t1 * d3
+        e = 10 * i
+        dKc[e], dKc[e + 1], dKc[e + 2], dKc[e + 3], dKc[e + 4] = 1.0, -s * t2, -1.0, t2, -d3
+        dKc[e + 5], dKc[e + 6], dKc[e + 7], dKc[e + 8], dKc[e + 9] = 1.0, s * t1, -1.0, -t1, d3
+        if i == 1:
+            K[6] = s * (o3 + d3 - t1 * d2 + t2 * d1)
+            dKc[30], dKc[31], dKc[32], dKc[33] = s * t2, -s * t1, s * s, -s * t2
+            dKc[34], dKc[35], dKc[36], dKc[37] = s * t1, -s, -s * d2, s * d1
+    e = END_SLOPE_FACTOR
+    g = s * e
+    sg1, sg2 = P[7], P[8]
+    n1, n2 = sg1 - s * t2 / e, sg2 + s * t1 / e
+    den = 1.0 + g * (t2 * sg1 - t1 * sg2)
+    K[7], K[8] = n1 / den, n2 / den
+    dd7, dd8, dd12, dd13 = g * t2, -g * t1, -g * sg2, g * sg1
+    dKc[38] = (1.0 - n1 * dd7 / den) / den
+    dKc[39] = (0.0 - n1 * dd8 / den) / den
+    dKc[40] = (0.0 - n1 * dd12 / den) / den
+    dKc[41] = (-s / e - n1 * dd13 / den) / den
+    dKc[42] = (0.0 - n2 * dd7 / den) / den
+    dKc[43] = (1.0 - n2 * dd8 / den) / den
+    dKc[44] = (s / e - n2 * dd12 / den) / den
+    dKc[45] = (0.0 - n2 * dd13 / den) / den
+    K[9] = zf
+
+
+@njit(cache=True)
+def _apply(index, weight, x, off, out):
+    """``out[i] = sum_a weight[i, a] x[off + index[i, a]]`` (a constant sparse map)."""
+    for i in range(index.shape[0]):
+        acc = 0.0
+        for a in range(index.shape[1]):
+            acc += weight[i, a] * x[off + index[i, a]]
+        out[i] = acc
+
+
+@njit(cache=True)
+def _apply_transpose(index, weight, x, out):
+    """``out = A^T x`` of the constant sparse map ``(index, weight)`` (``out`` zeroed here)."""
+    for j in range(out.shape[0]):
+        out[j] = 0.0
+    for i in range(index.shape[0]):
+        for a in range(index.shape[1]):
+            out[index[i, a]] += weight[i, a] * x[i]
+
+
+@njit(cache=True)
+def mapped_outputs(Z, sh, sv, centres, frame, si, sw, gi, gw, half_end, meridians, face_radius, slope_factor, c,
+                   par, law, R, dK):
+    """Outputs ``R`` (m, n_p + 2) of the mapped contacts with inputs ``Z`` (m, 2 n_p + 1) on shafts ``sh``, sheaves
+    ``sv``: the generalized forces on the ``n_p`` mapped positions, on the spin, the friction power (W), as
+    ``ElasticChainACVT.mapped_local``; ``dK`` (m, 46) scratch for the frame derivatives' nonzeros.  Returns the first
+    contact with its end on the shaft axis, or -1."""
+    m, n_p = Z.shape[0], (Z.shape[1] - 1) // 2
+    n_c = gi.shape[0]
+    P, V, K, Kd = np.empty(N_FRAME), np.empty(N_FRAME), np.empty(N_KERNEL), np.empty(N_KERNEL)
+    kin = np.empty((m, 2 * n_c + 1))
+    for t in range(m):
+        k, j = sh[t], sv[t]
+        _apply(si, sw, Z[t], 0, P)
+        _apply(si, sw, Z[t], n_p, V)
+        frame_a1(P, frame[0, k, j], centres[k, 0], centres[k, 1], frame[1, k, j], frame[2, k, j], K, dK[t])
+        for i in range(N_KERNEL):
+            Kd[i] = 0.0
+        for e in range(N_PATTERN):
+            Kd[_PAT_ROW[e]] += dK[t, e] * V[_PAT_COL[e]]
+        _apply(gi, gw, K, 0, kin[t, :n_c])
+        _apply(gi, gw, Kd, 0, kin[t, n_c:2 * n_c])
+        kin[t, 2 * n_c] = Z[t, 2 * n_p]
+    Yk = np.empty((m, N_KERNEL + 2))
+    slip, fr = np.empty((m, 3)), np.empty((m, 3))
+    if half_end:
+        Xk = np.empty((m, 2 * N_KERNEL + 1))
+        _half_spread(kin, Xk, N_KERNEL)
+        bad = refined_local_kernel(Xk, sh, centres, meridians, face_radius, True, slope_factor, c, par[0], par[1],
+                                   law, par[2], Yk, slip, fr)
+        Y = np.empty((m, n_c + 2))
+        _half_gather(Yk, Y)
+    else:
+        bad = refined_local_kernel(kin, sh, centres, meridians, face_radius, True, slope_factor, c, par[0], par[1],
+                                   law, par[2], Yk, slip, fr)
+        Y = Yk
+    Y10, F = np.empty(N_KERNEL), np.empty(N_FRAME)
+    Qp = np.empty(n_p)
+    for t in range(m):
+        _apply_transpose(gi, gw, Y[t, :n_c], Y10)
+        for b in range(N_FRAME):
+            F[b] = 0.0
+        for e in range(N_PATTERN):
+            F[_PAT_COL[e]] += dK[t, e] * Y10[_PAT_ROW[e]]
+        _apply_transpose(si, sw, F, Qp)
+        for o in range(n_p):
+            R[t, o] = par[3] * Qp[o]
+        R[t, n_p] = par[3] * Y[t, n_c]
+        R[t, n_p + 1] = par[3] * Y[t, n_c + 1]
+    return bad
+
+
+@njit(cache=True)
+def _candidates(y, cols, coef, shaft, centres, r2, ends, Zall, sh, pair):
+    """Broad phase and gather: the inputs ``Zall[:m]``, shafts ``sh[:m]`` and pair indices ``pair[:m]`` of the ``m``
+    (returned) pairs whose end (mapped inputs ``ends``) lies within the outer radius of its shaft."""
+    m = 0
+    K = cols.shape[2]
+    for i in range(cols.shape[0]):
+        k = shaft[i]
+        d0 = -centres[k, 0]
+        d1 = -centres[k, 1]
+        for a in range(K):
+            d0 += coef[i, ends[0], a] * y[cols[i, ends[0], a]]
+            d1 += coef[i, ends[1], a] * y[cols[i, ends[1], a]]
+        if not d0 * d0 + d1 * d1 < r2:
+            continue
+        for j in range(cols.shape[1]):
+            acc = 0.0
+            for a in range(K):
+                acc += coef[i, j, a] * y[cols[i, j, a]]
+            Zall[m, j] = acc
+        sh[m], pair[m] = k, i
+        m += 1
+    return m
+
+
+@njit(cache=True)
+def forces(y, cols, coef, shaft, sheave, rows, rw, centres, r2, frame, si, sw, gi, gw, ends, half_end, meridians,
+           face_radius, slope_factor, c, par, law, Q):
+    """Add the mapped contacts' generalized forces to ``Q`` (n2,); returns ``(friction power (W, <= 0), first pair
+    with its end on the shaft axis or -1)``."""
+    n_pairs, n_in = cols.shape[0], cols.shape[1]
+    Zall, sh, pair = np.empty((n_pairs, n_in)), np.empty(n_pairs, np.int64), np.empty(n_pairs, np.int64)
+    m = _candidates(y, cols, coef, shaft, centres, r2, ends, Zall, sh, pair)
+    sv = sheave[pair[:m]]
+    n_out = rows.shape[1] + 1
+    R, dK = np.empty((m, n_out)), np.empty((m, N_PATTERN))
+    bad = mapped_outputs(Zall[:m], sh[:m], sv, centres, frame, si, sw, gi, gw, half_end, meridians, face_radius,
+                         slope_factor, c, par, law, R, dK)
+    K, nf = cols.shape[2], rows.shape[1]
+    power = 0.0
+    for t in range(m):
+        i = pair[t]
+        for o in range(nf):
+            for a in range(K):
+                Q[rows[i, o, a]] += rw[i, o, a] * R[t, o]
+        power += R[t, nf]
+    return power, (pair[bad] if bad >= 0 else -1)
+
+
+@njit(cache=True)
+def jacobian(y, cols, coef, shaft, sheave, rows, rw, centres, r2, frame, si, sw, gi, gw, ends, half_end, meridians,
+             face_radius, slope_factor, c, par, law, steps, n_state, r_out, c_out, v_out, dD):
+    """Entries of ``dQ/dy`` of :func:`forces` (over ``y[:n_state]``) into ``r_out``, ``c_out``, ``v_out`` (their count
+    returned) and ``-d(friction power)/dy`` added to ``dD``: the mapped contacts' local Jacobians by central
+    differences with ``steps`` (one perturbed input column for all candidates at once, as
+    ``central_local_jacobian``), mapped on both sides ``R^T (dY/dZ) P``.  Returns ``(count, bad pair or -1)``."""
+    n_pairs, n_in = cols.shape[0], cols.shape[1]
+    Zall, sh, pair = np.empty((n_pairs, n_in)), np.empty(n_pairs, np.int64), np.empty(n_pairs, np.int64)
+    m = _candidates(y, cols, coef, shaft, centres, r2, ends, Zall, sh, pair)
+    Z0, sh = Zall[:m], sh[:m]
+    sv = sheave[pair[:m]]
+    n_out = rows.shape[1] + 1
+    Zs, Rp, Rm = Z0.copy(), np.empty((m, n_out)), np.empty((m, n_out))
+    dK = np.empty((m, N_PATTERN))
+    Jl = np.empty((m, n_out, n_in))
+    bad = -1
+    for j in range(n_in):
+        for t in range(m):
+            Zs[t, j] = Z0[t, j] + steps[j]
+        b1 = mapped_outputs(Zs, sh, sv, centres, frame, si, sw, gi, gw, half_end, meridians, face_radius,
+                            slope_factor, c, par, law, Rp, dK)
+        for t in range(m):
+            Zs[t, j] = Z0[t, j] - steps[j]
+        b2 = mapped_outputs(Zs, sh, sv, centres, frame, si, sw, gi, gw, half_end, meridians, face_radius,
+                            slope_factor, c, par, law, Rm, dK)
+        for t in range(m):
+            Zs[t, j] = Z0[t, j]
+        if bad < 0 and max(b1, b2) >= 0:
+            bad = pair[max(b1, b2)]
+        for t in range(m):
+            for o in range(n_out):
+                Jl[t, o, j] = (Rp[t, o] - Rm[t, o]) / (2 * steps[j])
+    K, nf = cols.shape[2], rows.shape[1]
+    n = 0
+    for t in range(m):
+        i = pair[t]
+        for j in range(n_in):
+            for b in range(K):
+                col, cw = cols[i, j, b], coef[i, j, b]
+                if col >= n_state or cw == 0.0:
+                    continue
+                dD[col] -= cw * Jl[t, nf, j]
+                for o in range(nf):
+                    for a in range(K):
+                        val = rw[i, o, a] * Jl[t, o, j] * cw
+                        if val != 0.0:
+                            r_out[n], c_out[n], v_out[n] = rows[i, o, a], col, val
+                            n += 1
+    return n, bad
+
+
+__all__ = ["N_FRAME", "N_KERNEL", "PATTERN", "forces", "frame_a1", "jacobian", "mapped_outputs", "pack", "sparse_rows"]
