@@ -355,21 +355,20 @@ class ElasticChainCVT(ChainCVT):
         q, v, zc, _ = self.split(x)
         nc, iphi, iz, _ = self._idx
         s = self.structure
-        n2, nz, N = self.n2, self.control.size, self.size
-        ctrl = 2 * n2 + np.arange(nz)
+        n2, N = self.n2, self.size
         w = v[iphi]
         F, M, G = self._loop_gradient(t, w, zc)
-        in_cols = np.concatenate([n2 + iphi, ctrl])
+        in_cols = np.concatenate([n2 + iphi, 2 * n2 + np.arange(self.control.size)])
         Kc, Cc = self.family.jacobian(q[:nc], v[:nc])
         side = self._sides[:, 1]
         mu3 = self._movable_node_u3
         parts = []
-        for Mx, off in ((Kc.tocoo(), 0), (Cc.tocoo(), n2)):
-            parts.append((Mx.row, Mx.col + off, Mx.data))
+        acc = self._family_accelerations(Kc, Cc)
+        if acc is None:                                      # the family's blocks on another pattern
+            for Mx, off in ((Kc.tocoo(), 0), (Cc.tocoo(), n2)):
+                parts.append((Mx.row, Mx.col + off, Mx.data))
         entries, dD_contact = self._mapped_contact_jacobian(q, v)
         parts.append(entries)
-        for Mx, off in ((-s.K).tocoo(), nc), ((-s.damping_matrix(w)).tocoo(), n2 + nc):
-            parts.append((Mx.row + nc, Mx.col + off, Mx.data))
         vs = v[nc:]
         for kk in range(2):
             gv = -(s.G[kk] @ vs)
@@ -381,20 +380,44 @@ class ElasticChainCVT(ChainCVT):
         parts.append((np.full(len(in_cols), iphi[1]), in_cols, G[2]))
         r, c, d = (np.concatenate([np.ravel(p[i]) for p in parts]) for i in range(3))
         dQ = sp.csr_matrix((d, (r, c)), shape=(n2, N))
-        acc = self._inv_mass @ dQ
-        Wr = sp.lil_matrix((4, N))
-        Wr[0, n2 + iphi[0]] = M[0]
-        Wr[1, in_cols] = -w[1] * G[2]
-        Wr[1, n2 + iphi[1]] += -M[1]
+        rest = self._inv_mass @ dQ + self._structure_accelerations(w)
+        acc = rest if acc is None else acc + rest
         dD = self._chain_dissipation_gradient(q, v)
         dD[:2 * n2] += dD_contact
         dD[n2 + nc:2 * n2] += 2 * (s.C @ vs)
-        Wr[2, :] = dD
+        Wr = np.zeros((4, N))
+        Wr[0, n2 + iphi[0]] = M[0]
+        Wr[1, in_cols] = -w[1] * G[2]
+        Wr[1, n2 + iphi[1]] += -M[1]
+        Wr[2] = dD
         Wr[3, n2 + iz] = -side * F
         Wr[3, n2 + mu3] = side * F
-        rel = v[iz] - v[mu3]
-        Wr[3, in_cols] = -((side * rel) @ G[:2])
-        return self._stacked_jacobian(acc, G, in_cols, Wr)
+        Wr[3, in_cols] = -((side * (v[iz] - v[mu3])) @ G[:2])
+        return self._stacked_jacobian(acc, G, in_cols, sp.csr_matrix(Wr))
+
+    @cached_property
+    def _structure_acceleration_parts(self) -> tuple:
+        """``(indices, indptr, data)``: ``M_s^-1 [-K, -C, -G_0, -G_1]`` of the structure placed in its rows and
+        position (``K``) or velocity columns, as four data arrays (4, nnz) on one sorted CSR pattern of ``n2`` rows
+        over the state (built once)."""
+        nc, n2, N, s = self._idx[0], self.n2, self.size, self.structure
+        Mi = sp.csr_matrix(self._structure_inverse)
+        blocks = [(Mi @ A).tocoo() for A in (s.K, s.C, s.G[0], s.G[1])]
+        keys = [(nc + B.row).astype(np.int64) * N + (nc if i == 0 else n2 + nc) + B.col for i, B in enumerate(blocks)]
+        uniq, where = np.unique(np.concatenate(keys), return_inverse=True)
+        data = np.zeros((4, len(uniq)))
+        start = np.cumsum([0] + [len(k) for k in keys])
+        for i, B in enumerate(blocks):
+            np.add.at(data[i], where[start[i]:start[i + 1]], -B.data)
+        indptr = np.searchsorted(uniq // N, np.arange(n2 + 1))
+        return (uniq % N).astype(np.int32), indptr.astype(np.int32), data
+
+    def _structure_accelerations(self, rates) -> sp.csr_matrix:
+        """``M_s^-1 (-K q - (C + Omega_0 G_0 + Omega_1 G_1) v)`` as rows of ``d rhs / dx`` (n2 x state) at the spin
+        rates ``rates`` (2,) rad/s."""
+        indices, indptr, data = self._structure_acceleration_parts
+        values = data[0] + data[1] + rates[0] * data[2] + rates[1] * data[3]
+        return sp.csr_matrix((values, indices, indptr), shape=(self.n2, self.size))
 
     @cached_property
     def jac_sparsity(self) -> sp.csr_matrix:
@@ -631,22 +654,19 @@ class ElasticChainACVT(ElasticChainCVT, ChainACVT):
     refined_chain_inputs: ClassVar[int] = N_REFINED_CHAIN
     refined_end_slots: ClassVar[tuple] = (2, 3, 6)
 
-    def _frame_maps(self) -> tuple:
-        """``(spread, gather, half_end)`` around A1's frame map (:mod:`~cvtfem.elements.chain.mapped_contact_kernel`):
-        the mapped positions to A1's fifteen frame inputs, the ten mapped kernel positions to the contact's, and
-        whether the contact is A5's half-end one (A1: identities)."""
-        return np.eye(MCK.N_FRAME), np.eye(MCK.N_KERNEL), False
+    #: The H2 contact is A5's half-end one (:mod:`~cvtfem.elements.chain.mapped_contact_kernel`'s maps around A1's
+    #: frame: the half end and chord spread to three points, gathered back); A1: the frame's own inputs.
+    half_end_frame: ClassVar[bool] = False
 
     @cached_property
     def _compiled_mapped(self) -> tuple | None:
         """Constants of :mod:`~cvtfem.elements.chain.mapped_contact_kernel` for H2 at whole-pin ends (A1) or
         independent half ends (A5); None for H1, A2's coupled halves or without numba (the numpy path)."""
-        spread, gather, half_end = self._frame_maps()
-        kernel = self.contact.pair.pair if half_end else self.contact.pair
+        kernel = self.contact.pair.pair if self.half_end_frame else self.contact.pair
         if not (HAVE_NUMBA and type(kernel) is RefinedSheaveContact):
             return None
-        return MCK.pack(kernel, self._sides, self.structure.sheave_x3, self.face_ref, spread, gather,
-                        self.refined_end_slots[:2], half_end, 0.5 * self.kernel_share)
+        return MCK.pack(kernel, self._sides, self.structure.sheave_x3, self.face_ref, self.refined_end_slots[:2],
+                        self.half_end_frame, 0.5 * self.kernel_share)
 
     @cached_property
     def _mapped_table(self) -> tuple:

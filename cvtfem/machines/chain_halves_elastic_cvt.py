@@ -191,10 +191,7 @@ class ElasticChainHalvesRefinedCVT(ElasticChainHalvesCVT, ChainHalvesRefinedCVT)
     refined_chain_inputs: ClassVar[int] = 7
     refined_end_slots: ClassVar[tuple] = (0, 1, 4)
 
-    def _frame_maps(self) -> tuple:
-        """The half end's positions spread to A1's frame inputs, the mapped points gathered back (:data:`SPREAD`,
-        :data:`GATHER`), the half-end contact."""
-        return SPREAD, GATHER, True
+    half_end_frame: ClassVar[bool] = True
 
     def _refined_frame(self, P, k, j):
         """``(K, dK/dP)``: the half-end contact's inputs (m, 8: end, chord, ``x3``, slope, ``z_ref``) in the frame of

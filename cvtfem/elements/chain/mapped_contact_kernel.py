@@ -32,33 +32,20 @@ from cvtfem.elements.jit import njit
 N_FRAME, N_KERNEL = 15, 10
 
 
-def sparse_rows(A) -> tuple[np.ndarray, np.ndarray]:
-    """``(index, weight)`` (n_rows, w) of a small constant matrix with at most ``w`` nonzeros per row (padded with
-    weight 0 on column 0): row ``i`` of ``A x`` is ``sum_a weight[i, a] x[index[i, a]]``."""
-    A = np.asarray(A, float)
-    width = max(1, int((A != 0).sum(axis=1).max()))
-    index, weight = np.zeros((len(A), width), np.int64), np.zeros((len(A), width))
-    for i, row in enumerate(A):
-        nz = np.flatnonzero(row)
-        index[i, :len(nz)], weight[i, :len(nz)] = nz, row[nz]
-    return index, weight
-
-
-def pack(pair, sides, sheave_x3, face_ref, spread, gather, end_slots, half_end: bool, scale: float) -> tuple:
+def pack(pair, sides, sheave_x3, face_ref, end_slots, half_end: bool, scale: float) -> tuple:
     """Kernel constants: ``pair`` the :class:`~cvtfem.elements.chain.sheave_contact_refined.RefinedSheaveContact`
-    (with slopes), ``sides``, ``sheave_x3`` (m), ``face_ref`` (m) (2, 2) per (shaft, sheave), ``spread`` (15, n_p),
-    ``gather`` (n_c, 10) the constant maps around A1's frame, ``end_slots`` the two mapped inputs holding the end's
-    in-plane position (broad phase), ``half_end`` the contact is :class:`HalfEndContact`'s (A5), ``scale`` the share
-    of the pair kernel's outputs one contact carries (0.5: one end)."""
+    (with slopes), ``sides``, ``sheave_x3`` (m), ``face_ref`` (m) (2, 2) per (shaft, sheave), ``end_slots`` the two
+    mapped inputs holding the end's in-plane position (broad phase), ``half_end`` the contact is
+    :class:`~cvtfem.elements.chain.half_end_contact.HalfEndContact`'s (A5: the maps :func:`_spread_half`,
+    :func:`_gather_half` around A1's frame; A1: none), ``scale`` the share of the pair kernel's outputs one
+    contact carries (0.5: one end)."""
     if not pair.slopes:
         raise ValueError("mapped_contact_kernel.pack: the H2 kernel on elastic shafts has slopes")
-    si, sw = sparse_rows(spread)
-    gi, gw = sparse_rows(gather)
     frame = np.stack([np.asarray(sides, float), np.asarray(sheave_x3, float), np.asarray(face_ref, float)])
     return (np.ascontiguousarray(pair.centres, float), float(pair.r_outer) ** 2, np.ascontiguousarray(frame),
-            si, sw, gi, gw, np.asarray(end_slots, np.int64)[:2], bool(half_end),
-            np.ascontiguousarray(pair._meridians, float), float(pair.face_radius), float(END_SLOPE_FACTOR),
-            np.ascontiguousarray(pair.c, float), np.array([pair.f0, pair.v0, pair.eps, scale]), LAW_CODES[pair.law])
+            np.asarray(end_slots, np.int64)[:2], bool(half_end), np.ascontiguousarray(pair._meridians, float),
+            float(pair.face_radius), float(END_SLOPE_FACTOR), np.ascontiguousarray(pair.c, float),
+            np.array([pair.f0, pair.v0, pair.eps, scale]), LAW_CODES[pair.law])
 
 
 def _frame_pattern() -> tuple[np.ndarray, np.ndarray]:
@@ -78,7 +65,7 @@ N_PATTERN = len(PATTERN[0])
 _PAT_ROW, _PAT_COL = PATTERN
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def frame_a1(P, s, c0, c1, o3, zf, K, dKc):
     """A1's H2 frame map (``ElasticChainACVT._refined_frame``) of one contact: kernel positions ``K`` (10,) and the
     nonzeros ``dKc`` (46,) of their exact derivative in the frame inputs ``P`` (15,) (:data:`PATTERN`), on the
@@ -114,48 +101,84 @@ def frame_a1(P, s, c0, c1, o3, zf, K, dKc):
     K[9] = zf
 
 
-@njit(cache=True)
-def _apply(index, weight, x, off, out):
-    """``out[i] = sum_a weight[i, a] x[off + index[i, a]]`` (a constant sparse map)."""
-    for i in range(index.shape[0]):
-        acc = 0.0
-        for a in range(index.shape[1]):
-            acc += weight[i, a] * x[off + index[i, a]]
-        out[i] = acc
+@njit(cache=True, inline="always")
+def _spread_in(Z, off, half_end, P):
+    """A1's frame inputs ``P`` (15,) from the mapped positions ``Z[off:off + n_p]``: A5 (``half_end``) the points
+    ``x - c, x, x + c`` of the half end ``x`` and its chord ``c``, then ``x3``, slope, the sheave's six
+    (``chain_halves_elastic_cvt.SPREAD``); A1 the same fifteen."""
+    if half_end:
+        P[0], P[1] = Z[off] - Z[off + 2], Z[off + 1] - Z[off + 3]
+        P[2], P[3] = Z[off], Z[off + 1]
+        P[4], P[5] = Z[off] + Z[off + 2], Z[off + 1] + Z[off + 3]
+        for i in range(9):
+            P[6 + i] = Z[off + 4 + i]
+    else:
+        for i in range(N_FRAME):
+            P[i] = Z[off + i]
+
+
+@njit(cache=True, inline="always")
+def _spread_back(F, half_end, Qp):
+    """Transpose of :func:`_spread_in`: the forces ``Qp`` (n_p,) on the mapped positions from those ``F`` (15,)."""
+    if half_end:
+        Qp[0], Qp[1] = F[0] + F[2] + F[4], F[1] + F[3] + F[5]
+        Qp[2], Qp[3] = F[4] - F[0], F[5] - F[1]
+        for i in range(9):
+            Qp[4 + i] = F[6 + i]
+    else:
+        for i in range(N_FRAME):
+            Qp[i] = F[i]
+
+
+@njit(cache=True, inline="always")
+def _gather_in(K, half_end, out):
+    """The contact's positions ``out`` from the ten mapped kernel positions ``K``: A5 the end, half the front less
+    the rear point (the chord), ``x3``, slope, ``z`` (``chain_halves_elastic_cvt.GATHER``); A1 the ten."""
+    if half_end:
+        out[0], out[1] = K[2], K[3]
+        out[2], out[3] = -0.5 * K[0] + 0.5 * K[4], -0.5 * K[1] + 0.5 * K[5]
+        for i in range(4):
+            out[4 + i] = K[6 + i]
+    else:
+        for i in range(N_KERNEL):
+            out[i] = K[i]
+
+
+@njit(cache=True, inline="always")
+def _gather_back(Y, half_end, Y10):
+    """Transpose of :func:`_gather_in`: the forces ``Y10`` (10,) on the mapped kernel positions from the contact's."""
+    if half_end:
+        Y10[0], Y10[1] = -0.5 * Y[2], -0.5 * Y[3]
+        Y10[2], Y10[3] = Y[0], Y[1]
+        Y10[4], Y10[5] = 0.5 * Y[2], 0.5 * Y[3]
+        for i in range(4):
+            Y10[6 + i] = Y[4 + i]
+    else:
+        for i in range(N_KERNEL):
+            Y10[i] = Y[i]
 
 
 @njit(cache=True)
-def _apply_transpose(index, weight, x, out):
-    """``out = A^T x`` of the constant sparse map ``(index, weight)`` (``out`` zeroed here)."""
-    for j in range(out.shape[0]):
-        out[j] = 0.0
-    for i in range(index.shape[0]):
-        for a in range(index.shape[1]):
-            out[index[i, a]] += weight[i, a] * x[i]
-
-
-@njit(cache=True)
-def mapped_outputs(Z, sh, sv, centres, frame, si, sw, gi, gw, half_end, meridians, face_radius, slope_factor, c,
-                   par, law, R, dK):
+def mapped_outputs(Z, sh, sv, centres, frame, half_end, meridians, face_radius, slope_factor, c, par, law, R, dK):
     """Outputs ``R`` (m, n_p + 2) of the mapped contacts with inputs ``Z`` (m, 2 n_p + 1) on shafts ``sh``, sheaves
     ``sv``: the generalized forces on the ``n_p`` mapped positions, on the spin, the friction power (W), as
     ``ElasticChainACVT.mapped_local``; ``dK`` (m, 46) scratch for the frame derivatives' nonzeros.  Returns the first
     contact with its end on the shaft axis, or -1."""
     m, n_p = Z.shape[0], (Z.shape[1] - 1) // 2
-    n_c = gi.shape[0]
+    n_c = 8 if half_end else N_KERNEL
     P, V, K, Kd = np.empty(N_FRAME), np.empty(N_FRAME), np.empty(N_KERNEL), np.empty(N_KERNEL)
     kin = np.empty((m, 2 * n_c + 1))
     for t in range(m):
         k, j = sh[t], sv[t]
-        _apply(si, sw, Z[t], 0, P)
-        _apply(si, sw, Z[t], n_p, V)
+        _spread_in(Z[t], 0, half_end, P)
+        _spread_in(Z[t], n_p, half_end, V)
         frame_a1(P, frame[0, k, j], centres[k, 0], centres[k, 1], frame[1, k, j], frame[2, k, j], K, dK[t])
         for i in range(N_KERNEL):
             Kd[i] = 0.0
         for e in range(N_PATTERN):
             Kd[_PAT_ROW[e]] += dK[t, e] * V[_PAT_COL[e]]
-        _apply(gi, gw, K, 0, kin[t, :n_c])
-        _apply(gi, gw, Kd, 0, kin[t, n_c:2 * n_c])
+        _gather_in(K, half_end, kin[t, :n_c])
+        _gather_in(Kd, half_end, kin[t, n_c:2 * n_c])
         kin[t, 2 * n_c] = Z[t, 2 * n_p]
     Yk = np.empty((m, N_KERNEL + 2))
     slip, fr = np.empty((m, 3)), np.empty((m, 3))
@@ -173,12 +196,12 @@ def mapped_outputs(Z, sh, sv, centres, frame, si, sw, gi, gw, half_end, meridian
     Y10, F = np.empty(N_KERNEL), np.empty(N_FRAME)
     Qp = np.empty(n_p)
     for t in range(m):
-        _apply_transpose(gi, gw, Y[t, :n_c], Y10)
+        _gather_back(Y[t], half_end, Y10)
         for b in range(N_FRAME):
             F[b] = 0.0
         for e in range(N_PATTERN):
             F[_PAT_COL[e]] += dK[t, e] * Y10[_PAT_ROW[e]]
-        _apply_transpose(si, sw, F, Qp)
+        _spread_back(F, half_end, Qp)
         for o in range(n_p):
             R[t, o] = par[3] * Qp[o]
         R[t, n_p] = par[3] * Y[t, n_c]
@@ -212,8 +235,8 @@ def _candidates(y, cols, coef, shaft, centres, r2, ends, Zall, sh, pair):
 
 
 @njit(cache=True)
-def forces(y, cols, coef, shaft, sheave, rows, rw, centres, r2, frame, si, sw, gi, gw, ends, half_end, meridians,
-           face_radius, slope_factor, c, par, law, Q):
+def forces(y, cols, coef, shaft, sheave, rows, rw, centres, r2, frame, ends, half_end, meridians, face_radius,
+           slope_factor, c, par, law, Q):
     """Add the mapped contacts' generalized forces to ``Q`` (n2,); returns ``(friction power (W, <= 0), first pair
     with its end on the shaft axis or -1)``."""
     n_pairs, n_in = cols.shape[0], cols.shape[1]
@@ -222,8 +245,8 @@ def forces(y, cols, coef, shaft, sheave, rows, rw, centres, r2, frame, si, sw, g
     sv = sheave[pair[:m]]
     n_out = rows.shape[1] + 1
     R, dK = np.empty((m, n_out)), np.empty((m, N_PATTERN))
-    bad = mapped_outputs(Zall[:m], sh[:m], sv, centres, frame, si, sw, gi, gw, half_end, meridians, face_radius,
-                         slope_factor, c, par, law, R, dK)
+    bad = mapped_outputs(Zall[:m], sh[:m], sv, centres, frame, half_end, meridians, face_radius, slope_factor, c,
+                         par, law, R, dK)
     K, nf = cols.shape[2], rows.shape[1]
     power = 0.0
     for t in range(m):
@@ -236,8 +259,8 @@ def forces(y, cols, coef, shaft, sheave, rows, rw, centres, r2, frame, si, sw, g
 
 
 @njit(cache=True)
-def jacobian(y, cols, coef, shaft, sheave, rows, rw, centres, r2, frame, si, sw, gi, gw, ends, half_end, meridians,
-             face_radius, slope_factor, c, par, law, steps, n_state, r_out, c_out, v_out, dD):
+def jacobian(y, cols, coef, shaft, sheave, rows, rw, centres, r2, frame, ends, half_end, meridians, face_radius,
+             slope_factor, c, par, law, steps, n_state, r_out, c_out, v_out, dD):
     """Entries of ``dQ/dy`` of :func:`forces` (over ``y[:n_state]``) into ``r_out``, ``c_out``, ``v_out`` (their count
     returned) and ``-d(friction power)/dy`` added to ``dD``: the mapped contacts' local Jacobians by central
     differences with ``steps`` (one perturbed input column for all candidates at once, as
@@ -255,12 +278,12 @@ def jacobian(y, cols, coef, shaft, sheave, rows, rw, centres, r2, frame, si, sw,
     for j in range(n_in):
         for t in range(m):
             Zs[t, j] = Z0[t, j] + steps[j]
-        b1 = mapped_outputs(Zs, sh, sv, centres, frame, si, sw, gi, gw, half_end, meridians, face_radius,
-                            slope_factor, c, par, law, Rp, dK)
+        b1 = mapped_outputs(Zs, sh, sv, centres, frame, half_end, meridians, face_radius, slope_factor, c, par,
+                            law, Rp, dK)
         for t in range(m):
             Zs[t, j] = Z0[t, j] - steps[j]
-        b2 = mapped_outputs(Zs, sh, sv, centres, frame, si, sw, gi, gw, half_end, meridians, face_radius,
-                            slope_factor, c, par, law, Rm, dK)
+        b2 = mapped_outputs(Zs, sh, sv, centres, frame, half_end, meridians, face_radius, slope_factor, c, par,
+                            law, Rm, dK)
         for t in range(m):
             Zs[t, j] = Z0[t, j]
         if bad < 0 and max(b1, b2) >= 0:
@@ -287,4 +310,4 @@ def jacobian(y, cols, coef, shaft, sheave, rows, rw, centres, r2, frame, si, sw,
     return n, bad
 
 
-__all__ = ["N_FRAME", "N_KERNEL", "PATTERN", "forces", "frame_a1", "jacobian", "mapped_outputs", "pack", "sparse_rows"]
+__all__ = ["N_FRAME", "N_KERNEL", "PATTERN", "forces", "frame_a1", "jacobian", "mapped_outputs", "pack"]
