@@ -41,7 +41,8 @@ from cvtfem.assembly.model import StateLayout
 from cvtfem.elements.base import Block
 from cvtfem.elements.chain import mapped_contact_kernel as MCK
 from cvtfem.elements.chain.sheave_contact_refined import RefinedSheaveContact
-from cvtfem.elements.chain.sheave_contact import central_local_jacobian
+from cvtfem.elements.chain.end_contact import EndContact
+from cvtfem.elements.chain.sheave_contact import SheaveContact, central_local_jacobian
 from cvtfem.elements.chain.symmetric import END_SLOPE_FACTOR
 from cvtfem.elements.jit import HAVE_NUMBA
 from cvtfem.errors import NumericalError
@@ -154,15 +155,38 @@ class ElasticChainCVT(ChainCVT):
     #: reached with the failure in ``report["unbalanced"]`` (True: a chain whose balance the solve may not reach).
     keeps_unbalanced_start: ClassVar[bool] = False
 
-    def _mapped_pairs(self, q):
-        """``(ends, shafts, sheaves, cols, coef)``: each broad-phase candidate with both sheaves (0 fixed,
-        1 movable) of its shaft, the state columns and weights (m, 19, k) of its mapped inputs in ``y = [q, v]``
-        (the contact map of :meth:`ChainCVT._contact_map`)."""
-        ends, shafts = self._candidates(q)
+    def _pairs_map(self, ends, shafts):
+        """``(ends, shafts, sheaves, cols, coef)``: each ``(end, shaft)`` pair with both sheaves (0 fixed, 1 movable) of
+        its shaft, the state columns and weights (m, 19, k) of its mapped inputs in ``y = [q, v]`` (the contact map
+        of :meth:`ChainCVT._contact_map`)."""
         e, k = np.repeat(ends, 2), np.repeat(shafts, 2)
         j = np.tile(np.arange(2), len(ends))
         dof3 = self._idx[3][e]
         return (e, k, j) + self._mapped_map(dof3[:, :, None], np.ones(dof3.shape + (1,)), k, j)
+
+    def _mapped_pairs(self, q):
+        """:meth:`_pairs_map` of the broad phase's candidates."""
+        return self._pairs_map(*self._candidates(q))
+
+    @cached_property
+    def _mapped_table(self) -> tuple:
+        """``(cols, coef, shafts, sheaves, rows, weights)`` of the mapped contact of every ``(end, shaft)`` pair (the
+        contact map and output rows, built once): the table the compiled path loops over."""
+        _, k, j, cols, coef = self._pairs_map(*self._all_pairs())
+        rows, w = self._output_rows(cols, coef)
+        return tuple(np.ascontiguousarray(a, t) for a, t in ((cols, np.int64), (coef, float), (k, np.int64),
+                                                               (j, np.int64), (rows, np.int64), (w, float)))
+
+    @cached_property
+    def _compiled_mapped(self) -> tuple | None:
+        """Constants of :mod:`~cvtfem.elements.chain.mapped_contact_kernel` for H1 (the symmetric chain's pair kernel,
+        or single ends in ``EndContact``); None without numba or for other kernels (the numpy path)."""
+        single = isinstance(self.contact, EndContact)
+        pair = self.contact.pair if single else self.contact
+        if not (HAVE_NUMBA and type(pair) is SheaveContact):
+            return None
+        return MCK.pack_point(pair, self._sides, self.structure.sheave_x3, self.face_ref, 0.5 if single else 1.0,
+                              self.kernel_share, self.axial_relative)
 
     def _mapped_map(self, end_cols, end_coef, k, j):
         """The mapped inputs' ``(cols, coef)`` (m, 2 (P + 6) + 1, K) from the chain positions' (m, P, K) in the
@@ -288,9 +312,6 @@ class ElasticChainCVT(ChainCVT):
         in one product with ``[q, v, Omega_0 v, Omega_1 v]``."""
         s = self.structure
         return sp.hstack([s.K, s.C, s.G[0], s.G[1]], format="csr")
-
-    #: Constants of the compiled mapped-contact path (None: the numpy path; ElasticChainACVT's H2 sets them).
-    _compiled_mapped: ClassVar = None
 
     def _mapped_forces(self, q, v, Q, slip: bool = False, reference: bool = False):
         """Add the mapped contacts' generalized forces to ``Q`` (n2,); return the friction power (W) and, with
@@ -460,10 +481,7 @@ class ElasticChainCVT(ChainCVT):
 
     def _all_mapped(self):
         """``(cols, coef)`` of every mapped contact the broad phase may return (the structural pattern)."""
-        ends, shafts = self._all_pairs()
-        e, k = np.repeat(ends, 2), np.repeat(shafts, 2)
-        dof3 = self._idx[3][e]
-        return self._mapped_map(dof3[:, :, None], np.ones(dof3.shape + (1,)), k, np.tile(np.arange(2), len(ends)))
+        return self._pairs_map(*self._all_pairs())[3:]
 
     # ----- energy and outputs ------------------------------------------------------------------
     def energy(self, x) -> float:
@@ -660,22 +678,15 @@ class ElasticChainACVT(ElasticChainCVT, ChainACVT):
 
     @cached_property
     def _compiled_mapped(self) -> tuple | None:
-        """Constants of :mod:`~cvtfem.elements.chain.mapped_contact_kernel` for H2 at whole-pin ends (A1) or
-        independent half ends (A5); None for H1, A2's coupled halves or without numba (the numpy path)."""
+        """Constants of :mod:`~cvtfem.elements.chain.mapped_contact_kernel`: H2 at whole-pin ends (A1) or independent
+        half ends (A5), H1 as :class:`ElasticChainCVT`'s; None for A2's coupled halves or without numba."""
+        if not self.contact.refined:
+            return super()._compiled_mapped
         kernel = self.contact.pair.pair if self.half_end_frame else self.contact.pair
         if not (HAVE_NUMBA and type(kernel) is RefinedSheaveContact):
             return None
-        return MCK.pack(kernel, self._sides, self.structure.sheave_x3, self.face_ref, self.refined_end_slots[:2],
-                        self.half_end_frame, 0.5 * self.kernel_share)
-
-    @cached_property
-    def _mapped_table(self) -> tuple:
-        """``(cols, coef, shafts, sheaves, rows, weights)`` of the mapped contact of every ``(end, shaft)`` pair (the
-        contact map and output rows, built once): the table the compiled path loops over."""
-        _, k, j, cols, coef = self._pairs_map(*self._all_pairs())
-        rows, w = self._output_rows(cols, coef)
-        return tuple(np.ascontiguousarray(a, t) for a, t in ((cols, np.int64), (coef, float), (k, np.int64),
-                                                               (j, np.int64), (rows, np.int64), (w, float)))
+        return MCK.pack_refined(kernel, self._sides, self.structure.sheave_x3, self.face_ref,
+                                self.refined_end_slots[:2], self.half_end_frame, 0.5 * self.kernel_share)
 
     def _sheave_of(self, ends, shafts) -> np.ndarray:
         """Sheave (0 fixed, 1 movable) an end on side ``+-1`` (odd ends: ``x3 > 0``) meets on each shaft."""
@@ -747,12 +758,6 @@ class ElasticChainACVT(ElasticChainCVT, ChainACVT):
             dK[:, row, [7, 8, 12, 13]] = np.column_stack([(dn - num * dd / den) / den for dn, dd in zip(dnum, dden)])
         K[:, 9] = self.face_ref[k, j]
         return K, dK
-
-    def _mapped_pairs(self, q):
-        return self._pairs_map(*self._candidates(q))
-
-    def _all_mapped(self):
-        return self._pairs_map(*self._all_pairs())[3:]
 
     def rigid(self) -> ChainACVT:
         return ChainACVT(self.family, self.contact, self.J, self.m_sheave, self.regime, self.F_appl, self.control,

@@ -1,8 +1,9 @@
 """The compiled mapped-contact path of the chains on elastic shafts (variant (b): A1 with H2; variant (e): A5 half ends
-with H2; :mod:`cvtfem.elements.chain.mapped_contact_kernel`) against its numpy twin (``ElasticChainACVT.mapped_local``
-and ``_refined_frame``, ``reference=True``): the frame map and its derivative, the generalized forces and friction
-power on random running states, the contacts' Jacobian entries; and the structure's forces and accelerations from
-their precomputed operators against the matrices they stand for."""
+with H2; variant (zh): A5 half ends with H1; :mod:`cvtfem.elements.chain.mapped_contact_kernel`) against its numpy twin
+(``ElasticChainCVT.mapped_local``, ``ElasticChainACVT._refined_frame``, ``reference=True``): the frame map and its
+derivative, the generalized forces and friction power on random running states, the contacts' Jacobian entries; and
+the structure's forces and accelerations from their precomputed operators against the matrices they stand for.  The
+symmetric chains' H1 path on elastic shafts runs compiled in ``test_chain_cvt_elastic.py`` (energy, Jacobian)."""
 from dataclasses import replace
 
 import numpy as np
@@ -17,8 +18,10 @@ from cvtfem.machines.shaft_structure import build_structure
 from cvtfem.scene.loader import load_scene
 
 F_APPL = np.array([30000.0, 35000.0])   # N per sheave
-SCENES = {"b": ("variant-b,regime-stationary,chain-uniform", "chain-A1"),
-          "e": ("variant-e,regime-stationary,chain-uniform", "chain-A5")}
+SCENES = {"b": ("variant-b,regime-stationary,chain-uniform", "chain-A1", "hertz-refined"),
+          "e": ("variant-e,regime-stationary,chain-uniform", "chain-A5", "hertz-refined"),
+          "zh": ("variant-zh,regime-stationary,chain-uniform", "chain-A5", "hertz")}
+KINDS = {"b": MCK.REFINED, "e": MCK.REFINED_HALF_END, "zh": MCK.POINT}
 #: Central-difference steps of the mapped inputs (positions, rates, spin rate), as ``_mapped_jacobian``.
 H_POS = 1e-9
 
@@ -27,9 +30,9 @@ H_POS = 1e-9
 def placed(request):
     """``(name, model, x0)``: the chain placed on the path at the start ratio (wedge estimate of the sheaves) on the
     undeformed elastic shafts, the faces' references there (no quasi-static solve)."""
-    name, model_name = SCENES[request.param]
+    name, model_name, contact = SCENES[request.param]
     scene = load_scene(name)
-    rigid = from_scene(scene, chain_geometry(scene), F_APPL, model=model_name, contact="hertz-refined", law="tanh")
+    rigid = from_scene(scene, chain_geometry(scene), F_APPL, model=model_name, contact=contact, law="tanh")
     model = elastic(rigid, build_structure(shaft_parameters(scene), scene.cvt.young_modulus))
     w1, _, ratio = rigid.regime.targets(0.0)
     pl, u3, z = rigid.wedge_guess(ratio, F_APPL[1])
@@ -62,10 +65,9 @@ def _qv(model, x):
 
 
 def test_compiled_path_is_taken(placed):
-    """(b) and (e) run the compiled path (numba is a dependency); (zh)'s H1 and (v)'s coupled halves are not offered."""
+    """(b), (e) and (zh) run the compiled path (numba is a dependency), each with its kernel."""
     name, model, _ = placed
-    assert model._compiled_mapped is not None
-    assert model._compiled_mapped[4] == (name == "e")                   # the half-end maps around A1's frame
+    assert model._compiled_mapped is not None and model._compiled_mapped[4] == KINDS[name]
 
 
 def test_frame_map_equals_numpy_twin(placed):
@@ -74,7 +76,9 @@ def test_frame_map_equals_numpy_twin(placed):
     has no nonzero off :data:`MCK.PATTERN`."""
     from cvtfem.machines.chain_cvt_elastic import ElasticChainACVT
 
-    _, model, _ = placed
+    name, model, _ = placed
+    if KINDS[name] == MCK.POINT:
+        pytest.skip("H1 maps the end point alone (no frame derivative)")
     rng = np.random.default_rng(5)
     m = 64
     k, j = rng.integers(0, 2, m), rng.integers(0, 2, m)

@@ -1,20 +1,22 @@
-"""Compiled (numba) H2 contact in the frames of displaced, tilted sheaves (chains on elastic shafts: variant (b),
-A1 with H2; variant (e), A5 half ends with H2): broad phase, gather, frame map, the refined kernel, the forces mapped
-back, scatter, and the contacts' Jacobian entries.
+"""Compiled (numba) contacts in the frames of displaced, tilted sheaves (chains on elastic shafts): broad phase, gather,
+frame map, the contact kernel, the forces mapped back, scatter, and the contacts' Jacobian entries.  H2 at whole-pin
+ends (variant (b)) or independent half ends (variant (e)); H1 at pin or half ends (variant (zh), A1 with H1) and at
+the symmetric chain's pin ends (S2, S3, both sheaves of a shaft per end).
 
 A contact's mapped inputs ``Z`` (``2 n_p + 1``: ``n_p`` positions, their rates, the spin rate) are the chain
 positions of the kernel (mirrored frame) followed by the sheave's translation ``a`` (3), tilt ``theta`` (2) and the
-other sheave's axial position.  ``spread`` takes the positions to A1's fifteen frame inputs (three points at the end's
-offset, ``x3``, slope 2, the sheave's six; A1: identity), :func:`frame_a1` maps them into the sheave's frame
+other sheave's axial position.  H2: the positions spread to A1's fifteen frame inputs (A5: the half end ``x`` and its
+chord ``c`` to the points ``x - c, x, x + c``), :func:`frame_a1` maps them into the sheave's frame
 (``X = o + (I - theta x)(x - o - a)``, the slope as a direction, the face at ``z_ref``) with its exact derivative
-``dK`` (10, 15), ``gather`` takes the ten mapped kernel positions to the contact's (A1: identity; A5: end, chord,
-``x3``, slope, ``z``).  The contact's rates are ``dK P'`` and its position forces act back through ``dK^T``.
-The numpy path of :class:`~cvtfem.machines.chain_cvt_elastic.ElasticChainACVT` (``mapped_local``,
-``_refined_frame``, ``reference=True``) is the tested twin (``tests/elements/chain/test_mapped_contact_kernel.py``).
+``dK`` (nonzeros :data:`PATTERN`), gathered back to the contact's positions (A5: end and chord); its rates are
+``dK P'`` and its position forces act back through ``dK^T``.  H1: the end ``x`` through the same map (first order in
+the tilt), its reaction on the sheave's translation, tilt and (symmetric chain) the pair's mid-plane.  The numpy path
+of :class:`~cvtfem.machines.chain_cvt_elastic.ElasticChainCVT` (``mapped_local``, ``_refined_frame``,
+``reference=True``) is the tested twin (``tests/machines/test_chain_elastic_compiled.py``).
 
 Arguments shared by the kernels: ``y = [q, v]``; the pair table ``cols``, ``coef`` (P, 2 n_p + 1, K), ``shaft``,
 ``sheave`` (P,), output rows ``rows``, ``rw`` (P, n_p + 1, K) (``ChainCVT._output_rows``); the constants of
-:func:`pack`.  Units SI.
+:func:`pack_refined` or :func:`pack_point`.  Units SI.
 """
 from __future__ import annotations
 
@@ -22,6 +24,8 @@ import numpy as np
 
 from cvtfem.elements.chain.half_end_contact import _gather as _half_gather
 from cvtfem.elements.chain.half_end_contact import _spread as _half_spread
+from cvtfem.elements.chain.sheave_contact_kernel import _local as _point_local
+from cvtfem.elements.chain.sheave_contact_kernel import pack as _pack_point_kernel
 from cvtfem.elements.chain.sheave_contact_refined_kernel import refined_local_kernel
 from cvtfem.elements.chain.symmetric import END_SLOPE_FACTOR
 from cvtfem.elements.contact.kernels import LAW_CODES
@@ -32,20 +36,38 @@ from cvtfem.elements.jit import njit
 N_FRAME, N_KERNEL = 15, 10
 
 
-def pack(pair, sides, sheave_x3, face_ref, end_slots, half_end: bool, scale: float) -> tuple:
-    """Kernel constants: ``pair`` the :class:`~cvtfem.elements.chain.sheave_contact_refined.RefinedSheaveContact`
-    (with slopes), ``sides``, ``sheave_x3`` (m), ``face_ref`` (m) (2, 2) per (shaft, sheave), ``end_slots`` the two
-    mapped inputs holding the end's in-plane position (broad phase), ``half_end`` the contact is
-    :class:`~cvtfem.elements.chain.half_end_contact.HalfEndContact`'s (A5: the maps :func:`_spread_half`,
-    :func:`_gather_half` around A1's frame; A1: none), ``scale`` the share of the pair kernel's outputs one
-    contact carries (0.5: one end)."""
+#: Kernel kinds: H2 at a whole-pin end (A1), H2 at an independent half's end (A5), H1 at a point (pin or half end).
+REFINED, REFINED_HALF_END, POINT = 0, 1, 2
+
+
+def _frame(sides, sheave_x3, face_ref) -> np.ndarray:
+    """``(3, 2, 2)``: side, pivot ``x3`` (m) and face reference (m) of every (shaft, sheave)."""
+    return np.ascontiguousarray(np.stack([np.asarray(a, float) for a in (sides, sheave_x3, face_ref)]))
+
+
+def pack_refined(pair, sides, sheave_x3, face_ref, end_slots, half_end: bool, scale: float) -> tuple:
+    """Constants of the H2 kernels: ``pair`` the :class:`~cvtfem.elements.chain.sheave_contact_refined.
+    RefinedSheaveContact` (with slopes), ``sides``, ``sheave_x3`` (m), ``face_ref`` (m) (2, 2) per (shaft, sheave),
+    ``end_slots`` the two mapped inputs holding the end's in-plane position (broad phase), ``half_end`` the contact
+    is :class:`~cvtfem.elements.chain.half_end_contact.HalfEndContact`'s (A5), ``scale`` the share of the pair
+    kernel's outputs one contact carries (0.5: one end)."""
     if not pair.slopes:
-        raise ValueError("mapped_contact_kernel.pack: the H2 kernel on elastic shafts has slopes")
-    frame = np.stack([np.asarray(sides, float), np.asarray(sheave_x3, float), np.asarray(face_ref, float)])
-    return (np.ascontiguousarray(pair.centres, float), float(pair.r_outer) ** 2, np.ascontiguousarray(frame),
-            np.asarray(end_slots, np.int64)[:2], bool(half_end), np.ascontiguousarray(pair._meridians, float),
+        raise ValueError("mapped_contact_kernel.pack_refined: the H2 kernel on elastic shafts has slopes")
+    return (np.ascontiguousarray(pair.centres, float), float(pair.r_outer) ** 2,
+            _frame(sides, sheave_x3, face_ref), np.asarray(end_slots, np.int64)[:2],
+            REFINED_HALF_END if half_end else REFINED, np.ascontiguousarray(pair._meridians, float),
             float(pair.face_radius), float(END_SLOPE_FACTOR), np.ascontiguousarray(pair.c, float),
-            np.array([pair.f0, pair.v0, pair.eps, scale]), LAW_CODES[pair.law])
+            np.array([pair.f0, pair.v0, pair.eps, scale]), LAW_CODES[pair.law], np.zeros((2, 3)), False, 1.0)
+
+
+def pack_point(pair, sides, sheave_x3, face_ref, scale: float, share: float, axial_relative: bool) -> tuple:
+    """Constants of the H1 kernel: ``pair`` the :class:`~cvtfem.elements.chain.sheave_contact.SheaveContact`,
+    ``scale`` the share of its outputs the contact object passes on (0.5 inside ``EndContact``, 1 alone), ``share``
+    the share one mapped evaluation carries (``kernel_share``), ``axial_relative`` the sheave's axial motion counts
+    from the pair's mid-plane (symmetric chain); the rest as :func:`pack_refined`'s."""
+    centres, r2, prof, c, par, law = _pack_point_kernel(pair, scale)
+    return (centres, r2, _frame(sides, sheave_x3, face_ref), np.array([0, 1], np.int64), POINT, np.zeros((2, 4)),
+            1.0, 1.0, c, par, law, prof, bool(axial_relative), float(share))
 
 
 def _frame_pattern() -> tuple[np.ndarray, np.ndarray]:
@@ -159,12 +181,10 @@ def _gather_back(Y, half_end, Y10):
 
 
 @njit(cache=True)
-def mapped_outputs(Z, sh, sv, centres, frame, half_end, meridians, face_radius, slope_factor, c, par, law, R, dK):
-    """Outputs ``R`` (m, n_p + 2) of the mapped contacts with inputs ``Z`` (m, 2 n_p + 1) on shafts ``sh``, sheaves
-    ``sv``: the generalized forces on the ``n_p`` mapped positions, on the spin, the friction power (W), as
-    ``ElasticChainACVT.mapped_local``; ``dK`` (m, 46) scratch for the frame derivatives' nonzeros.  Returns the first
-    contact with its end on the shaft axis, or -1."""
+def _refined_outputs(Z, sh, sv, centres, frame, kind, meridians, face_radius, slope_factor, c, par, law, R, dK):
+    """:func:`mapped_outputs` of H2 contacts (``ElasticChainACVT.mapped_local``)."""
     m, n_p = Z.shape[0], (Z.shape[1] - 1) // 2
+    half_end = kind == REFINED_HALF_END
     n_c = 8 if half_end else N_KERNEL
     P, V, K, Kd = np.empty(N_FRAME), np.empty(N_FRAME), np.empty(N_KERNEL), np.empty(N_KERNEL)
     kin = np.empty((m, 2 * n_c + 1))
@@ -210,6 +230,57 @@ def mapped_outputs(Z, sh, sv, centres, frame, half_end, meridians, face_radius, 
 
 
 @njit(cache=True)
+def _point_outputs(Z, sh, sv, centres, frame, c, par, law, prof, axial_relative, share, R):
+    """:func:`mapped_outputs` of H1 contacts (``ElasticChainCVT.mapped_local``): the end ``x`` (mirrored,
+    ``x3 -> s x3``) mapped to ``X = o + (I - theta x)(x - o - a)``, the kernel's force ``F`` back through
+    ``(I - theta x)^T`` on the end, minus it on the sheave's translation, ``-(d x F)`` on its tilt."""
+    Zk, Yk = np.zeros(9), np.zeros(6)
+    for t in range(Z.shape[0]):
+        k, j = sh[t], sv[t]
+        s, o0, o1, o2 = frame[0, k, j], centres[k, 0], centres[k, 1], frame[1, k, j]
+        t1, t2 = Z[t, 6], Z[t, 7]
+        a2, va2 = Z[t, 5], Z[t, 14]
+        if axial_relative:                                   # from the pair's mid-plane
+            a2, va2 = 0.5 * (Z[t, 5] - Z[t, 8]), 0.5 * (Z[t, 14] - Z[t, 17])
+        d0, d1, d2 = Z[t, 0] - o0 - Z[t, 3], Z[t, 1] - o1 - Z[t, 4], s * Z[t, 2] - o2 - a2
+        e0, e1, e2 = Z[t, 9] - Z[t, 12], Z[t, 10] - Z[t, 13], s * Z[t, 11] - va2
+        w1, w2 = Z[t, 15], Z[t, 16]
+        Zk[0] = o0 + d0 - t2 * d2
+        Zk[1] = o1 + d1 + t1 * d2
+        Zk[2] = s * (o2 + d2 - (t1 * d1 - t2 * d0))
+        Zk[3] = frame[2, k, j]
+        Zk[4] = e0 - t2 * e2 - w2 * d2
+        Zk[5] = e1 + t1 * e2 + w1 * d2
+        Zk[6] = s * (e2 - (t1 * e1 - t2 * e0) - (w1 * d1 - w2 * d0))
+        Zk[7], Zk[8] = 0.0, Z[t, 18]
+        _point_local(Zk, k, centres, prof, c, par, law, Yk)
+        F0, F1, F2 = share * Yk[0], share * Yk[1], s * share * Yk[2]
+        Q0, Q1, Q2 = F0 + t2 * F2, F1 - t1 * F2, F2 + t1 * F1 - t2 * F0
+        R[t, 0], R[t, 1], R[t, 2] = Q0, Q1, s * Q2
+        R[t, 3], R[t, 4], R[t, 5] = -Q0, -Q1, -Q2
+        R[t, 8] = 0.0
+        if axial_relative:
+            R[t, 5] = -0.5 * Q2
+            R[t, 8] = 0.5 * Q2
+        R[t, 6] = -(d1 * F2 - d2 * F1)
+        R[t, 7] = -(d2 * F0 - d0 * F2)
+        R[t, 9], R[t, 10] = share * Yk[4], share * Yk[5]
+    return -1
+
+
+@njit(cache=True)
+def mapped_outputs(Z, sh, sv, centres, frame, kind, meridians, face_radius, slope_factor, c, par, law, prof,
+                   axial_relative, share, R, dK):
+    """Outputs ``R`` (m, n_p + 2) of the mapped contacts with inputs ``Z`` (m, 2 n_p + 1) on shafts ``sh``, sheaves
+    ``sv``: the generalized forces on the ``n_p`` mapped positions, on the spin, the friction power (W), as
+    ``ElasticChainCVT.mapped_local``; ``dK`` (m, 46) scratch for H2's frame derivatives.  Returns the first contact
+    with its end on the shaft axis (H2), or -1."""
+    if kind == POINT:
+        return _point_outputs(Z, sh, sv, centres, frame, c, par, law, prof, axial_relative, share, R)
+    return _refined_outputs(Z, sh, sv, centres, frame, kind, meridians, face_radius, slope_factor, c, par, law, R, dK)
+
+
+@njit(cache=True)
 def _candidates(y, cols, coef, shaft, centres, r2, ends, Zall, sh, pair):
     """Broad phase and gather: the inputs ``Zall[:m]``, shafts ``sh[:m]`` and pair indices ``pair[:m]`` of the ``m``
     (returned) pairs whose end (mapped inputs ``ends``) lies within the outer radius of its shaft."""
@@ -235,8 +306,8 @@ def _candidates(y, cols, coef, shaft, centres, r2, ends, Zall, sh, pair):
 
 
 @njit(cache=True)
-def forces(y, cols, coef, shaft, sheave, rows, rw, centres, r2, frame, ends, half_end, meridians, face_radius,
-           slope_factor, c, par, law, Q):
+def forces(y, cols, coef, shaft, sheave, rows, rw, centres, r2, frame, ends, kind, meridians, face_radius,
+           slope_factor, c, par, law, prof, axial_relative, share, Q):
     """Add the mapped contacts' generalized forces to ``Q`` (n2,); returns ``(friction power (W, <= 0), first pair
     with its end on the shaft axis or -1)``."""
     n_pairs, n_in = cols.shape[0], cols.shape[1]
@@ -245,8 +316,8 @@ def forces(y, cols, coef, shaft, sheave, rows, rw, centres, r2, frame, ends, hal
     sv = sheave[pair[:m]]
     n_out = rows.shape[1] + 1
     R, dK = np.empty((m, n_out)), np.empty((m, N_PATTERN))
-    bad = mapped_outputs(Zall[:m], sh[:m], sv, centres, frame, half_end, meridians, face_radius, slope_factor, c,
-                         par, law, R, dK)
+    bad = mapped_outputs(Zall[:m], sh[:m], sv, centres, frame, kind, meridians, face_radius, slope_factor, c,
+                         par, law, prof, axial_relative, share, R, dK)
     K, nf = cols.shape[2], rows.shape[1]
     power = 0.0
     for t in range(m):
@@ -259,8 +330,8 @@ def forces(y, cols, coef, shaft, sheave, rows, rw, centres, r2, frame, ends, hal
 
 
 @njit(cache=True)
-def jacobian(y, cols, coef, shaft, sheave, rows, rw, centres, r2, frame, ends, half_end, meridians, face_radius,
-             slope_factor, c, par, law, steps, n_state, r_out, c_out, v_out, dD):
+def jacobian(y, cols, coef, shaft, sheave, rows, rw, centres, r2, frame, ends, kind, meridians, face_radius,
+             slope_factor, c, par, law, prof, axial_relative, share, steps, n_state, r_out, c_out, v_out, dD):
     """Entries of ``dQ/dy`` of :func:`forces` (over ``y[:n_state]``) into ``r_out``, ``c_out``, ``v_out`` (their count
     returned) and ``-d(friction power)/dy`` added to ``dD``: the mapped contacts' local Jacobians by central
     differences with ``steps`` (one perturbed input column for all candidates at once, as
@@ -278,12 +349,12 @@ def jacobian(y, cols, coef, shaft, sheave, rows, rw, centres, r2, frame, ends, h
     for j in range(n_in):
         for t in range(m):
             Zs[t, j] = Z0[t, j] + steps[j]
-        b1 = mapped_outputs(Zs, sh, sv, centres, frame, half_end, meridians, face_radius, slope_factor, c, par,
-                            law, Rp, dK)
+        b1 = mapped_outputs(Zs, sh, sv, centres, frame, kind, meridians, face_radius, slope_factor, c, par,
+                            law, prof, axial_relative, share, Rp, dK)
         for t in range(m):
             Zs[t, j] = Z0[t, j] - steps[j]
-        b2 = mapped_outputs(Zs, sh, sv, centres, frame, half_end, meridians, face_radius, slope_factor, c, par,
-                            law, Rm, dK)
+        b2 = mapped_outputs(Zs, sh, sv, centres, frame, kind, meridians, face_radius, slope_factor, c, par,
+                            law, prof, axial_relative, share, Rm, dK)
         for t in range(m):
             Zs[t, j] = Z0[t, j]
         if bad < 0 and max(b1, b2) >= 0:
@@ -310,4 +381,5 @@ def jacobian(y, cols, coef, shaft, sheave, rows, rw, centres, r2, frame, ends, h
     return n, bad
 
 
-__all__ = ["N_FRAME", "N_KERNEL", "PATTERN", "forces", "frame_a1", "jacobian", "mapped_outputs", "pack"]
+__all__ = ["N_FRAME", "N_KERNEL", "PATTERN", "POINT", "REFINED", "REFINED_HALF_END", "forces", "frame_a1", "jacobian",
+           "mapped_outputs", "pack_point", "pack_refined"]

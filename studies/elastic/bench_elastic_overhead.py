@@ -1,0 +1,158 @@
+"""What the elastic structure costs in variants (b), (e) and (zh): one RHS and one Jacobian on elastic against rigid
+shafts, the compiled mapped-contact pass against its numpy twin, and (``--runs``) `cvtfem run` per simulated ms.
+
+    OPENBLAS_NUM_THREADS=1 nice .venv/bin/python studies/elastic/bench_elastic_overhead.py [--calls 200]
+        [--jac-calls 6] [--scenes variant-b,regime-stationary:variant-e,regime-stationary:variant-zh,regime-stationary]
+        [--runs]
+
+Per scene the transmission on the scene's elastic shafts and on rigid shafts (its ``rigid()``), made running states
+(chain offsets 0.2 um, velocities 0.05 m/s, sheave tilts 0.2 mrad on the elastic shafts) from the rigid placement
+on the undeformed shafts (A5: ``placed``; A1 (b): the quasi-static start, whose rigid and elastic solves take some
+seconds); medians of the wall and CPU time (``time.process_time``) of single calls alternating between two states, so
+that no cached block is reused.  ``--runs``: `cvtfem run` of ``variant-e --until 2e-4`` and ``variant-b --until 1e-3``
+with the preset's rock4 and with fixed-step RK4 at 1e-6 s (``studies/elastic/variant-*-rk4.toml``), results file and
+outputs on; per run the wall and CPU time of the process (start included) and of the integration alone (the summary's
+``wall_time``), steps, RHS calls, and the projected wall time of 1 s.  The machine and its load are printed before
+and after.  docs/transmission.md, "Variant (b)" and "Variants (e) and (zh) on elastic shafts".
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import resource
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+from cvtfem.analysis.timing import machine
+from cvtfem.machines.cvt import chain_loop
+from cvtfem.scene.loader import load_scene
+
+HERE = Path(__file__).resolve().parent
+RUNS = (("variant-e", "2e-4"), (str(HERE / "variant-e-rk4.toml"), "2e-4"),
+        ("variant-b", "1e-3"), (str(HERE / "variant-b-rk4.toml"), "1e-3"))
+
+
+def running(model, x0, seed: int, tilt: float):
+    """``x0`` with random chain offsets (0.2 um), velocities (0.05 m/s) and, on elastic shafts, sheave tilts."""
+    rng = np.random.default_rng(seed)
+    x = x0.copy()
+    nc, n2 = model.family.size, model.n2
+    x[:nc] += rng.normal(0.0, 2e-7, nc)
+    x[n2:2 * n2] += rng.normal(0.0, 0.05, n2)
+    s = getattr(model, "structure", None)
+    if s is not None:
+        tilts = nc + s.sheave_dofs[:, :, 3:5].ravel()
+        x[tilts] += rng.normal(0.0, tilt, tilts.size)
+    return x
+
+
+def medians(fn, states, calls: int) -> tuple[float, float]:
+    """Median wall and CPU time (s) of ``calls`` single calls ``fn(state)`` alternating between ``states`` (after one
+    untimed call on each)."""
+    for x in states:
+        fn(x)
+    wall, cpu = np.empty(calls), np.empty(calls)
+    for k in range(calls):
+        x = states[k % len(states)]
+        c0, t0 = time.process_time(), time.perf_counter()
+        fn(x)
+        wall[k], cpu[k] = time.perf_counter() - t0, time.process_time() - c0
+    return float(np.median(wall)), float(np.median(cpu))
+
+
+def models(name: str):
+    """``(elastic, x0, rigid, x0r)``: the scene's transmission on elastic shafts with the faces' references of the
+    rigid placement (A5) or start (A1), and the same on rigid shafts."""
+    model = chain_loop(load_scene(name))
+    rigid = model.rigid()
+    w1, _, ratio = model.regime.targets(0.0)
+    if hasattr(model, "placed"):
+        elastic, x0 = model.placed(ratio, w1)
+        return elastic, x0, rigid, rigid.placed_state(ratio, w1)
+    x0, rep = model.start()
+    elastic = rep["model"]
+    return elastic, x0, rigid, elastic.rigid_start[2]
+
+
+def bench_scene(name: str, calls: int, jac_calls: int) -> None:
+    """Print the RHS and Jacobian medians on elastic and rigid shafts and the mapped contacts' two paths."""
+    elastic, x0, rigid, x0r = models(name)
+    print(f"\n{name} ({type(elastic).__name__}, {elastic.n2} coordinates; rigid {rigid.n2}):")
+    rows = {}
+    for label, model, x, tilt in (("elastic", elastic, x0, 2e-4), ("rigid", rigid, x0r, 0.0)):
+        states = [running(model, x, seed, tilt) for seed in (1, 2)]
+        rows[label] = (medians(lambda y: model.rhs(0.0, y), states, calls),
+                       medians(lambda y: model.jac(0.0, y), states, jac_calls))
+        if label == "elastic":
+            qv = [(y[:model.n2], y[model.n2:2 * model.n2]) for y in states]
+            contacts = len(model._candidates(qv[0][0])[0])
+            paths = {ref: medians(lambda s, r=ref: model._mapped_forces(*qv[s], np.zeros(model.n2), reference=r),
+                                  [0, 1], calls) for ref in (False, True)}
+            jpaths = {ref: medians(lambda s, r=ref: model._mapped_contact_jacobian(*qv[s], reference=r), [0, 1],
+                                   jac_calls) for ref in (False, True)}
+    for label, ((rw, rc), (jw, jc)) in rows.items():
+        print(f"  {label:8s} one RHS {1e6 * rw:7.0f} us wall, {1e6 * rc:7.0f} us CPU; one Jacobian {1e3 * jw:7.1f} ms "
+              f"wall, {1e3 * jc:7.1f} ms CPU")
+    (erw, erc), (ejw, ejc) = rows["elastic"]
+    (rrw, rrc), (rjw, rjc) = rows["rigid"]
+    print(f"  elastic - rigid: RHS {1e6 * (erc - rrc):+.0f} us CPU ({1e6 * (erw - rrw):+.0f} us wall); Jacobian "
+          f"{ejc / rjc:.2f}x CPU ({ejw / rjw:.2f}x wall)")
+    mapped = "compiled" if elastic._compiled_mapped is not None else "numpy (no compiled path)"
+    print(f"  mapped contacts ({contacts} candidates, {mapped}): forces {1e6 * paths[False][1]:.0f} us CPU against "
+          f"the numpy twin's {1e6 * paths[True][1]:.0f} us; local Jacobians and entries {1e3 * jpaths[False][1]:.1f} ms "
+          f"CPU against {1e3 * jpaths[True][1]:.1f} ms")
+
+
+def run_cost(scene: str, until: str, out: Path) -> None:
+    """`cvtfem run` of ``scene`` to ``until``: wall and CPU time of the process and of the integration, per simulated ms
+    and projected to 1 s."""
+    summary = out / (Path(scene).stem + ".json")
+    cmd = [sys.executable, "-m", "cvtfem.cli", "run", scene, "--until", until, "--overwrite",
+           "--results", str(out / (Path(scene).stem + ".h5")), "--summary-json", str(summary)]
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
+    t0 = time.perf_counter()
+    proc = subprocess.run(cmd, capture_output=True, text=True, env=dict(os.environ, OPENBLAS_NUM_THREADS="1"))
+    wall = time.perf_counter() - t0
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    cpu = after.ru_utime + after.ru_stime - before.ru_utime - before.ru_stime
+    if proc.returncode != 0:
+        print(f"  {scene}: exit {proc.returncode}\n{proc.stderr[-2000:]}")
+        return
+    s = json.loads(summary.read_text())
+    ms = 1e3 * float(until)
+    integ = s.get("wall_time", float("nan"))
+    share = integ / wall if wall else float("nan")
+    print(f"  {Path(scene).stem} --until {until}: process {wall:.1f} s wall, {cpu:.1f} s CPU; integration "
+          f"{integ:.1f} s wall ({s.get('method')}, {s.get('steps')} steps, {s.get('n_rhs')} RHS): per simulated ms "
+          f"{integ / ms:.1f} s wall, about {share * cpu / ms:.1f} s CPU (the process's CPU in the integration's share "
+          f"of its wall time), {s.get('n_rhs', 0) / ms:.0f} RHS; 1 s: {integ / ms * 1e3 / 3600:.2f} h wall, "
+          f"{share * cpu / ms * 1e3 / 3600:.2f} h CPU")
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--calls", type=int, default=200)
+    ap.add_argument("--jac-calls", type=int, default=6)
+    ap.add_argument("--scenes", default="variant-b,regime-stationary:variant-e,regime-stationary:"
+                                        "variant-zh,regime-stationary")
+    ap.add_argument("--runs", action="store_true", help="also time `cvtfem run` of (e) and (b), rock4 and RK4")
+    a = ap.parse_args()
+    print(f"machine: {machine()}")
+    for name in filter(None, a.scenes.split(":")):
+        bench_scene(name, a.calls, a.jac_calls)
+    if a.runs:
+        print("\ncvtfem run (results file and outputs on):")
+        with tempfile.TemporaryDirectory() as tmp:
+            for scene, until in RUNS:
+                run_cost(scene, until, Path(tmp))
+    print(f"\nmachine after: {machine()}")
+
+
+if __name__ == "__main__":
+    main()
