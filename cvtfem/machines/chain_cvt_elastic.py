@@ -41,15 +41,16 @@ from cvtfem.assembly.model import StateLayout
 from cvtfem.elements.base import Block
 from cvtfem.elements.chain import mapped_contact_kernel as MCK
 from cvtfem.elements.chain.sheave_contact_refined import RefinedSheaveContact
-from cvtfem.elements.chain.end_contact import EndContact
-from cvtfem.elements.chain.sheave_contact import SheaveContact, central_local_jacobian
+from cvtfem.elements.chain.sheave_contact import central_local_jacobian
 from cvtfem.elements.chain.symmetric import END_SLOPE_FACTOR
 from cvtfem.elements.jit import HAVE_NUMBA
 from cvtfem.errors import NumericalError
 from cvtfem.machines.chain_a2_cvt import ChainA2CVT
 from cvtfem.machines.chain_a_cvt import ChainACVT
 from cvtfem.machines.chain_cvt import ChainCVT
-from cvtfem.machines.shaft_structure import ShaftParameters, ShaftStructure, build_structure
+from cvtfem.machines.elastic_contact_compiled import CompiledMappedContacts, difference_steps
+from cvtfem.machines.shaft_structure import (ShaftParameters, ShaftStructure, acceleration_parts, build_structure,
+                                             force_operator)
 from cvtfem.outputs import OutputSpec
 
 
@@ -63,7 +64,7 @@ def _tilt(th):
 
 
 @dataclass(frozen=True, eq=False)
-class ElasticChainCVT(ChainCVT):
+class ElasticChainCVT(CompiledMappedContacts, ChainCVT):
     """ChainCVT on the elastic shafts of ``structure`` (:class:`~cvtfem.machines.shaft_structure.ShaftStructure`).
 
     Attributes (besides ChainCVT's; ``J`` and ``m_sheave`` are the structure's, kept for the loops)
@@ -144,6 +145,13 @@ class ElasticChainCVT(ChainCVT):
         rigid_only = ("driving.sheave_position", "driven.sheave_position")   # the rigid model's z: here sheave_shift
         return tuple(o for o in super().output_specs if o.name not in rigid_only) + tuple(new)
 
+    @property
+    def backend(self) -> str:
+        """ChainCVT's label (the run summary's) with this model's mapped contacts (:meth:`_mapped_kernel`)."""
+        family = super().backend in ("numba", "numba family")
+        contacts = HAVE_NUMBA and self._mapped_kernel() is not None
+        return "numba" if family and contacts else "numba contacts" if contacts else "numba family" if family else "numpy"
+
     # ----- contacts ----------------------------------------------------------------------------
     #: Share of the kernel's output that one evaluation carries (the S2/S3 kernel loads a mirrored pair: 1/2).
     kernel_share: ClassVar[float] = 0.5
@@ -167,26 +175,6 @@ class ElasticChainCVT(ChainCVT):
     def _mapped_pairs(self, q):
         """:meth:`_pairs_map` of the broad phase's candidates."""
         return self._pairs_map(*self._candidates(q))
-
-    @cached_property
-    def _mapped_table(self) -> tuple:
-        """``(cols, coef, shafts, sheaves, rows, weights)`` of the mapped contact of every ``(end, shaft)`` pair (the
-        contact map and output rows, built once): the table the compiled path loops over."""
-        _, k, j, cols, coef = self._pairs_map(*self._all_pairs())
-        rows, w = self._output_rows(cols, coef)
-        return tuple(np.ascontiguousarray(a, t) for a, t in ((cols, np.int64), (coef, float), (k, np.int64),
-                                                               (j, np.int64), (rows, np.int64), (w, float)))
-
-    @cached_property
-    def _compiled_mapped(self) -> tuple | None:
-        """Constants of :mod:`~cvtfem.elements.chain.mapped_contact_kernel` for H1 (the symmetric chain's pair kernel,
-        or single ends in ``EndContact``); None without numba or for other kernels (the numpy path)."""
-        single = isinstance(self.contact, EndContact)
-        pair = self.contact.pair if single else self.contact
-        if not (HAVE_NUMBA and type(pair) is SheaveContact):
-            return None
-        return MCK.pack_point(pair, self._sides, self.structure.sheave_x3, self.face_ref, 0.5 if single else 1.0,
-                              self.kernel_share, self.axial_relative)
 
     def _mapped_map(self, end_cols, end_coef, k, j):
         """The mapped inputs' ``(cols, coef)`` (m, 2 (P + 6) + 1, K) from the chain positions' (m, P, K) in the
@@ -252,14 +240,6 @@ class ElasticChainCVT(ChainCVT):
         """Per-contact constants :meth:`mapped_local` takes besides its inputs (none; A2: the half signs)."""
         return {}
 
-    def _compiled_mapped_forces(self, q, v, Q) -> float:
-        """:meth:`_mapped_forces` by :func:`~cvtfem.elements.chain.mapped_contact_kernel.forces`."""
-        Pf, bad = MCK.forces(np.concatenate([q, v]), *self._mapped_table, *self._compiled_mapped, Q)
-        if bad >= 0:
-            raise NumericalError(f"H2 contact on elastic shafts: a pin end on the shaft axis (pair {bad})",
-                                 component="contact.refined")
-        return Pf
-
     def _mapped_contact_jacobian(self, q, v, reference: bool = False):
         """``((rows, cols, values), dD)``: the entries of ``dQ/dy`` of the mapped contacts (``y = [q, v]``) and
         ``-d P_fr / dy`` (2 n2,); compiled where :attr:`_compiled_mapped` offers it unless ``reference``, else per
@@ -268,18 +248,7 @@ class ElasticChainCVT(ChainCVT):
         if ck is None:
             cols, coef, Jl = self._mapped_jacobian(q, v)
             return self._contact_entries(cols, coef, Jl), self._contact_power_gradient(cols, coef, Jl)
-        table = self._mapped_table
-        cols, rows = table[0], table[4]
-        size = cols.shape[0] * rows.shape[1] * cols.shape[1] * cols.shape[2] ** 2
-        r, c, d = np.empty(size, np.int64), np.empty(size, np.int64), np.empty(size)
-        dD = np.zeros(2 * self.n2)
-        n_pos = (cols.shape[1] - 1) // 2
-        steps = np.concatenate([np.full(n_pos, 1e-9), np.full(n_pos, 1e-6), [1e-5]])
-        k, bad = MCK.jacobian(np.concatenate([q, v]), *table, *ck, steps, 2 * self.n2, r, c, d, dD)
-        if bad >= 0:
-            raise NumericalError(f"H2 contact on elastic shafts: a pin end on the shaft axis (pair {bad})",
-                                 component="contact.refined")
-        return (r[:k], c[:k], d[:k]), dD
+        return self._compiled_contact_jacobian(q, v)
 
     def _mapped_set(self, q, v, details: bool = False):
         e, k, j, cols, coef = self._mapped_pairs(q)
@@ -308,10 +277,8 @@ class ElasticChainCVT(ChainCVT):
 
     @cached_property
     def _structure_operator(self) -> sp.csr_matrix:
-        """``[K, C, G_0, G_1]`` (n, 4 n): the structure's linear forces ``K q + (C + Omega_0 G_0 + Omega_1 G_1) v``
-        in one product with ``[q, v, Omega_0 v, Omega_1 v]``."""
-        s = self.structure
-        return sp.hstack([s.K, s.C, s.G[0], s.G[1]], format="csr")
+        """The structure's linear forces in one product (:func:`~cvtfem.machines.shaft_structure.force_operator`)."""
+        return force_operator(self.structure)
 
     def _mapped_forces(self, q, v, Q, slip: bool = False, reference: bool = False):
         """Add the mapped contacts' generalized forces to ``Q`` (n2,); return the friction power (W) and, with
@@ -361,7 +328,7 @@ class ElasticChainCVT(ChainCVT):
         """``(cols, coef, Jl)``: the contact map and the local Jacobians (m, 11, 19) of the mapped contacts."""
         e, k, j, cols, coef, Z, _ = self._mapped_set(q, v)
         n_pos = (Z.shape[1] - 1) // 2
-        steps = np.concatenate([np.full(n_pos, 1e-9), np.full(n_pos, 1e-6), [1e-5]])
+        steps = difference_steps(n_pos)
         const = self._local_constants(e)
         Jl = central_local_jacobian(lambda Zp, kk: self.mapped_local(Zp, kk, j, **const), Z, k, steps, n_pos + 2)
         return cols, coef, Jl
@@ -418,20 +385,9 @@ class ElasticChainCVT(ChainCVT):
 
     @cached_property
     def _structure_acceleration_parts(self) -> tuple:
-        """``(indices, indptr, data)``: ``M_s^-1 [-K, -C, -G_0, -G_1]`` of the structure placed in its rows and
-        position (``K``) or velocity columns, as four data arrays (4, nnz) on one sorted CSR pattern of ``n2`` rows
-        over the state (built once)."""
-        nc, n2, N, s = self._idx[0], self.n2, self.size, self.structure
-        Mi = sp.csr_matrix(self._structure_inverse)
-        blocks = [(Mi @ A).tocoo() for A in (s.K, s.C, s.G[0], s.G[1])]
-        keys = [(nc + B.row).astype(np.int64) * N + (nc if i == 0 else n2 + nc) + B.col for i, B in enumerate(blocks)]
-        uniq, where = np.unique(np.concatenate(keys), return_inverse=True)
-        data = np.zeros((4, len(uniq)))
-        start = np.cumsum([0] + [len(k) for k in keys])
-        for i, B in enumerate(blocks):
-            np.add.at(data[i], where[start[i]:start[i + 1]], -B.data)
-        indptr = np.searchsorted(uniq // N, np.arange(n2 + 1))
-        return (uniq % N).astype(np.int32), indptr.astype(np.int32), data
+        """:func:`~cvtfem.machines.shaft_structure.acceleration_parts` in this model's rows and columns."""
+        nc, n2 = self._idx[0], self.n2
+        return acceleration_parts(self.structure, self._structure_inverse, nc, (nc, n2 + nc), (n2, self.size))
 
     def _structure_accelerations(self, rates) -> sp.csr_matrix:
         """``M_s^-1 (-K q - (C + Omega_0 G_0 + Omega_1 G_1) v)`` as rows of ``d rhs / dx`` (n2 x state) at the spin
@@ -676,15 +632,21 @@ class ElasticChainACVT(ElasticChainCVT, ChainACVT):
     #: frame: the half end and chord spread to three points, gathered back); A1: the frame's own inputs.
     half_end_frame: ClassVar[bool] = False
 
+    def _mapped_kernel(self):
+        """The pair kernel the compiled path runs: H2's :class:`RefinedSheaveContact` at whole-pin ends (A1) or inside
+        the half-end contact (A5), H1 as :class:`ElasticChainCVT`'s; None for A2's coupled halves."""
+        if not self.contact.refined:
+            return super()._mapped_kernel()
+        kernel = self.contact.pair.pair if self.half_end_frame else self.contact.pair
+        return kernel if type(kernel) is RefinedSheaveContact else None
+
     @cached_property
     def _compiled_mapped(self) -> tuple | None:
-        """Constants of :mod:`~cvtfem.elements.chain.mapped_contact_kernel`: H2 at whole-pin ends (A1) or independent
-        half ends (A5), H1 as :class:`ElasticChainCVT`'s; None for A2's coupled halves or without numba."""
-        if not self.contact.refined:
+        """Constants of :mod:`~cvtfem.elements.chain.mapped_contact_kernel`: H2 (A1, A5 half ends) or H1
+        (:class:`ElasticChainCVT`'s); None for A2's coupled halves or without numba."""
+        kernel = self._mapped_kernel()
+        if not (self.contact.refined and HAVE_NUMBA and kernel is not None):
             return super()._compiled_mapped
-        kernel = self.contact.pair.pair if self.half_end_frame else self.contact.pair
-        if not (HAVE_NUMBA and type(kernel) is RefinedSheaveContact):
-            return None
         return MCK.pack_refined(kernel, self._sides, self.structure.sheave_x3, self.face_ref,
                                 self.refined_end_slots[:2], self.half_end_frame, 0.5 * self.kernel_share)
 

@@ -221,3 +221,26 @@ def build_structure(shafts, young_modulus: float, gyroscopic: bool = True, dampi
     return ShaftStructure(M, K, C, tuple(blocks_G), tuple(xs), np.array(offsets), np.array(sheave_dofs),
                           np.array(sheave_x3), np.array(node_of), np.array(spin), np.array(b_dofs),
                           np.array(b_K, float), np.array(b_C, float), tuple(shafts))
+
+
+def force_operator(s: ShaftStructure) -> sp.csr_matrix:
+    """``[K, C, G_0, G_1]`` (n, 4 n): ``K q + (C + Omega_0 G_0 + Omega_1 G_1) v`` of the structure ``s`` in one product
+    with ``[q, v, Omega_0 v, Omega_1 v]`` (N, N m)."""
+    return sp.hstack([s.K, s.C, s.G[0], s.G[1]], format="csr")
+
+
+def acceleration_parts(s: ShaftStructure, M_inv, row: int, cols: tuple, shape: tuple) -> tuple:
+    """``(indices, indptr, data)``: ``M^-1 [-K, -C, -G_0, -G_1]`` of the structure ``s`` (``M_inv`` its dense inverse
+    mass) placed at rows ``row + i`` and columns ``cols[0] + j`` (``K``: positions) or ``cols[1] + j`` (rates) of a
+    ``shape`` matrix, as four data arrays (4, nnz) on one sorted CSR pattern: the structure's acceleration rows of a
+    Jacobian at spin rates ``Omega`` are ``data[0] + data[1] + Omega_0 data[2] + Omega_1 data[3]`` there."""
+    n_rows, n_cols = shape
+    blocks = [(sp.csr_matrix(M_inv) @ A).tocoo() for A in (s.K, s.C, s.G[0], s.G[1])]
+    keys = [(row + B.row).astype(np.int64) * n_cols + cols[min(i, 1)] + B.col for i, B in enumerate(blocks)]
+    uniq, where = np.unique(np.concatenate(keys), return_inverse=True)
+    data = np.zeros((4, len(uniq)))
+    start = np.cumsum([0] + [len(k) for k in keys])
+    for i, B in enumerate(blocks):
+        np.add.at(data[i], where[start[i]:start[i + 1]], -B.data)
+    indptr = np.searchsorted(uniq // n_cols, np.arange(n_rows + 1))
+    return (uniq % n_cols).astype(np.int32), indptr.astype(np.int32), data

@@ -11,8 +11,8 @@ on the undeformed shafts (A5: ``placed``; A1 (b): the quasi-static start, whose 
 seconds); medians of the wall and CPU time (``time.process_time``) of single calls alternating between two states, so
 that no cached block is reused.  ``--runs``: `cvtfem run` of ``variant-e --until 2e-4`` and ``variant-b --until 1e-3``
 with the preset's rock4 and with fixed-step RK4 at 1e-6 s (``studies/elastic/variant-*-rk4.toml``), results file and
-outputs on; per run the wall and CPU time of the process (start included) and of the integration alone (the summary's
-``wall_time``), steps, RHS calls, and the projected wall time of 1 s.  The machine and its load are printed before
+outputs on; per run the wall and CPU time of the process, the integration's wall time (the summary's) and CPU time (the
+process's less that of a run to 1 us: start, build, imports), steps, RHS calls, and the projection to 1 s.  The machine and its load are printed before
 and after.  docs/transmission.md, "Variant (b)" and "Variants (e) and (zh) on elastic shafts".
 """
 from __future__ import annotations
@@ -34,8 +34,8 @@ from cvtfem.machines.cvt import chain_loop
 from cvtfem.scene.loader import load_scene
 
 HERE = Path(__file__).resolve().parent
-RUNS = (("variant-e", "2e-4"), (str(HERE / "variant-e-rk4.toml"), "2e-4"),
-        ("variant-b", "1e-3"), (str(HERE / "variant-b-rk4.toml"), "1e-3"))
+RUNS = (("variant-e", "2e-4", ("variant-e", str(HERE / "variant-e-rk4.toml"))),
+        ("variant-b", "1e-3", ("variant-b", str(HERE / "variant-b-rk4.toml"))))
 
 
 def running(model, x0, seed: int, tilt: float):
@@ -109,9 +109,8 @@ def bench_scene(name: str, calls: int, jac_calls: int) -> None:
           f"CPU against {1e3 * jpaths[True][1]:.1f} ms")
 
 
-def run_cost(scene: str, until: str, out: Path) -> None:
-    """`cvtfem run` of ``scene`` to ``until``: wall and CPU time of the process and of the integration, per simulated ms
-    and projected to 1 s."""
+def cli_run(scene: str, until: str, out: Path) -> tuple[float, float, dict]:
+    """`cvtfem run` of ``scene`` to ``until`` (s) with a results file: ``(wall s, CPU s, summary)`` of the process."""
     summary = out / (Path(scene).stem + ".json")
     cmd = [sys.executable, "-m", "cvtfem.cli", "run", scene, "--until", until, "--overwrite",
            "--results", str(out / (Path(scene).stem + ".h5")), "--summary-json", str(summary)]
@@ -120,19 +119,26 @@ def run_cost(scene: str, until: str, out: Path) -> None:
     proc = subprocess.run(cmd, capture_output=True, text=True, env=dict(os.environ, OPENBLAS_NUM_THREADS="1"))
     wall = time.perf_counter() - t0
     after = resource.getrusage(resource.RUSAGE_CHILDREN)
-    cpu = after.ru_utime + after.ru_stime - before.ru_utime - before.ru_stime
     if proc.returncode != 0:
-        print(f"  {scene}: exit {proc.returncode}\n{proc.stderr[-2000:]}")
-        return
-    s = json.loads(summary.read_text())
+        raise RuntimeError(f"{' '.join(cmd)}: exit {proc.returncode}\n{proc.stderr[-2000:]}")
+    return wall, after.ru_utime + after.ru_stime - before.ru_utime - before.ru_stime, json.loads(summary.read_text())
+
+
+def run_costs(preset: str, until: str, scenes, out: Path) -> None:
+    """Per scene of ``scenes`` (the preset and its RK4 study scene): `cvtfem run` to ``until``, the integration's
+    wall time (the summary's) and CPU time (the process's less that of a run of the preset to 1 us: the start, the
+    model build and the imports) per simulated ms and for 1 s."""
+    w0, c0, _ = cli_run(preset, "1e-6", out)
+    print(f"  {preset} --until 1e-6 (start, build, imports): {w0:.1f} s wall, {c0:.1f} s CPU")
     ms = 1e3 * float(until)
-    integ = s.get("wall_time", float("nan"))
-    share = integ / wall if wall else float("nan")
-    print(f"  {Path(scene).stem} --until {until}: process {wall:.1f} s wall, {cpu:.1f} s CPU; integration "
-          f"{integ:.1f} s wall ({s.get('method')}, {s.get('steps')} steps, {s.get('n_rhs')} RHS): per simulated ms "
-          f"{integ / ms:.1f} s wall, about {share * cpu / ms:.1f} s CPU (the process's CPU in the integration's share "
-          f"of its wall time), {s.get('n_rhs', 0) / ms:.0f} RHS; 1 s: {integ / ms * 1e3 / 3600:.2f} h wall, "
-          f"{share * cpu / ms * 1e3 / 3600:.2f} h CPU")
+    for scene in scenes:
+        wall, cpu, s = cli_run(scene, until, out)
+        sol, integ = s["solver"], s["wall_time_s"]
+        cpu_ms = (cpu - c0) / (ms - 1e-3)
+        print(f"  {Path(scene).stem} --until {until}: {sol['name']}, {sol['steps']} steps, {sol['nfev']} RHS; process "
+              f"{wall:.1f} s wall, {cpu:.1f} s CPU; per simulated ms {integ / ms:.1f} s wall (integration), "
+              f"{cpu_ms:.1f} s CPU, {sol['nfev'] / ms:.0f} RHS; 1 s: {integ / ms / 3.6:.2f} h wall, "
+              f"{cpu_ms / 3.6:.2f} h CPU")
 
 
 def main() -> None:
@@ -149,8 +155,8 @@ def main() -> None:
     if a.runs:
         print("\ncvtfem run (results file and outputs on):")
         with tempfile.TemporaryDirectory() as tmp:
-            for scene, until in RUNS:
-                run_cost(scene, until, Path(tmp))
+            for preset, until, scenes in RUNS:
+                run_costs(preset, until, scenes, Path(tmp))
     print(f"\nmachine after: {machine()}")
 
 
