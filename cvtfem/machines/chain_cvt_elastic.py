@@ -24,7 +24,9 @@ sheave (``zeta_k``) and its node; the torques act on the fixed sheave's node, wh
 
 Jacobian: the chain family's blocks, the structure's ``-K``, ``-(C + Omega G)`` and ``-G v`` on the spin
 rates, per-contact central differences of the mapped kernel (H1: 19 inputs, 11 outputs; H2: 31, 17; all contacts
-at once) scattered on both sides, and the loops' forward differences, as in ChainCVT.
+at once) scattered on both sides, and the loops' forward differences, as in ChainCVT.  The mapped contacts run
+compiled where :mod:`~cvtfem.machines.elastic_contact_compiled` offers it (H1, H2 at whole-pin and half ends); the
+numpy path here is its tested twin.
 """
 from __future__ import annotations
 
