@@ -12,7 +12,9 @@ seconds); medians of the wall and CPU time (``time.process_time``) of single cal
 that no cached block is reused.  ``--runs``: `cvtfem run` of ``variant-e --until 2e-4`` and ``variant-b --until 1e-3``
 with the preset's rock4 and with fixed-step RK4 at 1e-6 s (``studies/elastic/variant-*-rk4.toml``), results file and
 outputs on; per run the wall and CPU time of the process, the integration's wall time (the summary's) and CPU time (the
-process's less that of a run to 1 us: start, build, imports), steps, RHS calls, and the projection to 1 s.  The machine and its load are printed before
+process's less that of a run to 1 us: start, build, imports; and RHS calls times the benchmark's RHS CPU time where
+the scene was benchmarked: (e)'s start, 40 s CPU, swamps the difference of a 0.2 ms run), steps, RHS calls, and the
+projection to 1 s.  The machine and its load are printed before
 and after.  docs/transmission.md, "Variant (b)" and "Variants (e) and (zh) on elastic shafts".
 """
 from __future__ import annotations
@@ -80,8 +82,9 @@ def models(name: str):
     return elastic, x0, rigid, elastic.rigid_start[2]
 
 
-def bench_scene(name: str, calls: int, jac_calls: int) -> None:
-    """Print the RHS and Jacobian medians on elastic and rigid shafts and the mapped contacts' two paths."""
+def bench_scene(name: str, calls: int, jac_calls: int) -> float:
+    """Print the RHS and Jacobian medians on elastic and rigid shafts and the mapped contacts' two paths; return the
+    elastic RHS's median CPU time (s)."""
     elastic, x0, rigid, x0r = models(name)
     print(f"\n{name} ({type(elastic).__name__}, {elastic.n2} coordinates; rigid {rigid.n2}):")
     rows = {}
@@ -105,8 +108,9 @@ def bench_scene(name: str, calls: int, jac_calls: int) -> None:
           f"{ejc / rjc:.2f}x CPU ({ejw / rjw:.2f}x wall)")
     mapped = "compiled" if elastic._compiled_mapped is not None else "numpy (no compiled path)"
     print(f"  mapped contacts ({contacts} candidates, {mapped}): forces {1e6 * paths[False][1]:.0f} us CPU against "
-          f"the numpy twin's {1e6 * paths[True][1]:.0f} us; local Jacobians and entries {1e3 * jpaths[False][1]:.1f} ms "
-          f"CPU against {1e3 * jpaths[True][1]:.1f} ms")
+          f"the numpy twin's {1e6 * paths[True][1]:.0f} us; local Jacobians and entries "
+          f"{1e3 * jpaths[False][1]:.1f} ms CPU against {1e3 * jpaths[True][1]:.1f} ms")
+    return erc
 
 
 def cli_run(scene: str, until: str, out: Path) -> tuple[float, float, dict]:
@@ -124,10 +128,11 @@ def cli_run(scene: str, until: str, out: Path) -> tuple[float, float, dict]:
     return wall, after.ru_utime + after.ru_stime - before.ru_utime - before.ru_stime, json.loads(summary.read_text())
 
 
-def run_costs(preset: str, until: str, scenes, out: Path) -> None:
+def run_costs(preset: str, until: str, scenes, out: Path, rhs_cpu: float | None) -> None:
     """Per scene of ``scenes`` (the preset and its RK4 study scene): `cvtfem run` to ``until``, the integration's
-    wall time (the summary's) and CPU time (the process's less that of a run of the preset to 1 us: the start, the
-    model build and the imports) per simulated ms and for 1 s."""
+    wall time (the summary's) and CPU time per simulated ms and for 1 s: the process's less that of a run of the
+    preset to 1 us (the start, the model build and the imports; within the start's run-to-run noise where the start
+    dominates, as for (e)) and, with ``rhs_cpu`` (s, the benchmark's median), RHS calls times it."""
     w0, c0, _ = cli_run(preset, "1e-6", out)
     print(f"  {preset} --until 1e-6 (start, build, imports): {w0:.1f} s wall, {c0:.1f} s CPU")
     ms = 1e3 * float(until)
@@ -135,9 +140,11 @@ def run_costs(preset: str, until: str, scenes, out: Path) -> None:
         wall, cpu, s = cli_run(scene, until, out)
         sol, integ = s["solver"], s["wall_time_s"]
         cpu_ms = (cpu - c0) / (ms - 1e-3)
+        by_rhs = "" if rhs_cpu is None else f" (RHS calls x RHS CPU: {sol['nfev'] / ms * rhs_cpu:.1f} s, 1 s: " \
+            f"{sol['nfev'] / ms * rhs_cpu / 3.6:.2f} h)"
         print(f"  {Path(scene).stem} --until {until}: {sol['name']}, {sol['steps']} steps, {sol['nfev']} RHS; process "
               f"{wall:.1f} s wall, {cpu:.1f} s CPU; per simulated ms {integ / ms:.1f} s wall (integration), "
-              f"{cpu_ms:.1f} s CPU, {sol['nfev'] / ms:.0f} RHS; 1 s: {integ / ms / 3.6:.2f} h wall, "
+              f"{cpu_ms:.1f} s CPU{by_rhs}, {sol['nfev'] / ms:.0f} RHS; 1 s: {integ / ms / 3.6:.2f} h wall, "
               f"{cpu_ms / 3.6:.2f} h CPU")
 
 
@@ -150,13 +157,14 @@ def main() -> None:
     ap.add_argument("--runs", action="store_true", help="also time `cvtfem run` of (e) and (b), rock4 and RK4")
     a = ap.parse_args()
     print(f"machine: {machine()}")
+    rhs_cpu = {}
     for name in filter(None, a.scenes.split(":")):
-        bench_scene(name, a.calls, a.jac_calls)
+        rhs_cpu[name.split(",")[0]] = bench_scene(name, a.calls, a.jac_calls)
     if a.runs:
         print("\ncvtfem run (results file and outputs on):")
         with tempfile.TemporaryDirectory() as tmp:
             for preset, until, scenes in RUNS:
-                run_costs(preset, until, scenes, Path(tmp))
+                run_costs(preset, until, scenes, Path(tmp), rhs_cpu.get(preset))
     print(f"\nmachine after: {machine()}")
 
 
