@@ -42,8 +42,8 @@ from scipy.optimize import least_squares
 from cvtfem.assembly.model import StateLayout
 from cvtfem.elements.base import Block
 from cvtfem.elements.chain import mapped_contact_kernel as MCK
-from cvtfem.elements.chain.sheave_contact_refined import RefinedSheaveContact
 from cvtfem.elements.chain.sheave_contact import central_local_jacobian
+from cvtfem.elements.chain.sheave_contact_refined import RefinedSheaveContact
 from cvtfem.elements.chain.symmetric import END_SLOPE_FACTOR
 from cvtfem.elements.jit import HAVE_NUMBA
 from cvtfem.errors import NumericalError
