@@ -97,21 +97,42 @@ def runs(target: np.ndarray, indptr: np.ndarray) -> np.ndarray | None:
 
 
 @njit(cache=True)
-def add_mixed_entries(data, indptr, indices, row_offset, rows, cols, vals, b_indptr, b_indices, b_data):
+def add_mixed_entries(data, indptr, indices, row_offset, rows, cols, vals, b_indptr, b_indices, b_data, shared):
     """``data += B E`` of the COO entries ``E (rows, cols, vals)`` through the CSC map ``B (b_indptr, b_indices,
     b_data)`` (column ``r`` of ``B`` spreads row ``r`` of ``E``), into the rows ``row_offset + r'`` of the sorted CSR
-    pattern ``(indptr, indices)``.  Returns the number of nonzero entries' products that found no place in the pattern (0: all in)."""
+    pattern ``(indptr, indices)``; with ``shared`` the rows each column of ``B`` spreads to have one column list in the
+    pattern (:func:`shared_rows`), so one search serves them all.  Returns the number of nonzero entries that found no
+    place in the pattern (0: all in)."""
     missed = 0
     for i in range(rows.shape[0]):
         r, c, d = rows[i], cols[i], vals[i]
-        for k in range(b_indptr[r], b_indptr[r + 1]):
+        k0, k1 = b_indptr[r], b_indptr[r + 1]
+        if k0 == k1:
+            continue
+        r0 = row_offset + b_indices[k0]
+        p0 = _find(indices, indptr[r0], indptr[r0 + 1], c)
+        for k in range(k0, k1):
             rr = row_offset + b_indices[k]
-            p = _find(indices, indptr[rr], indptr[rr + 1], c)
-            if p >= 0:
+            p = p0 - indptr[r0] + indptr[rr] if shared else _find(indices, indptr[rr], indptr[rr + 1], c)
+            if p0 >= 0 and p >= 0:
                 data[p] += b_data[k] * d
             elif d != 0.0:
                 missed += 1
     return missed
 
 
-__all__ = ["add_mixed_entries", "add_mixed_rows", "add_mixed_runs", "csr_matvec_into", "positions", "runs"]
+def shared_rows(pattern: sp.csr_matrix, row_offset: int, b: sp.csc_matrix) -> bool:
+    """Whether the rows ``row_offset + r'`` of ``pattern`` that each column of ``b`` spreads to share one column list
+    (:func:`add_mixed_entries`'s ``shared``)."""
+    ptr, idx = pattern.indptr, pattern.indices
+    for r in range(b.shape[1]):
+        spread = row_offset + b.indices[b.indptr[r]:b.indptr[r + 1]]
+        if len(spread) > 1:
+            first = idx[ptr[spread[0]]:ptr[spread[0] + 1]]
+            if not all(np.array_equal(idx[ptr[s]:ptr[s + 1]], first) for s in spread[1:]):
+                return False
+    return True
+
+
+__all__ = ["add_mixed_entries", "add_mixed_rows", "add_mixed_runs", "csr_matvec_into", "positions", "runs",
+           "shared_rows"]

@@ -296,11 +296,12 @@ class ChainHalvesCVT(ChainACVT):
     @cached_property
     def _one_pass(self) -> bool:
         """Whether :meth:`rhs` and :meth:`jac` take their one-pass forms: the compiled chain pass of
-        :class:`HalvesFamily` and ChainCVT's own force, mass and evaluate steps (a subclass that changes them, as the
-        elastic shafts do, keeps ChainCVT's general path)."""
+        :class:`HalvesFamily` and ChainCVT's own state layout, force, mass, loop and evaluate steps (a subclass that
+        changes one of them, as the elastic shafts do, keeps ChainCVT's general path)."""
         cls = type(self)
         return (self.family.chain.backend == "numba" and type(self.family).forces is HalvesFamily.forces
-                and all(getattr(cls, f) is getattr(ChainCVT, f) for f in ("evaluate", "_forces", "solve_mass")))
+                and all(getattr(cls, f) is getattr(ChainCVT, f) for f in ("evaluate", "_forces", "solve_mass", "split",
+                                                                           "layout", "_idx", "_controls")))
 
     @cached_property
     def _chain_inverse_mass(self) -> tuple:
@@ -366,10 +367,11 @@ class ChainHalvesCVT(ChainACVT):
         Mc = sp.csc_matrix(self._inv_mass)
         Mc.sort_indices()
         runs = [FP.runs(t, fp.indptr) for t in (fam_q, fam_v)]
+        shared = FP.shared_rows(P, n2, Mc)
         return dict(P=P, fam=[(FP.add_mixed_rows, t) if r is None else (FP.add_mixed_runs, r)
                               for t, r in zip((fam_q, fam_v), runs)], ctrl=ctrl, top=top, in_cols=in_cols, work=(first, work_rows,
                     P.indices[first:].astype(np.int64)), mixing=(Mc.indptr.astype(np.int64),
-                    Mc.indices.astype(np.int64), Mc.data.astype(float)))
+                    Mc.indices.astype(np.int64), Mc.data.astype(float), shared))
 
     def jac(self, t: float, x) -> sp.csr_matrix:
         """Sparse ``d rhs / dx`` written into the data of the sorted :attr:`jac_sparsity` in place (explicit zeros where

@@ -57,14 +57,19 @@ def test_mixed_rows_and_mixed_entries_equal_the_sparse_products():
     FP.add_mixed_rows(data, FP.positions(P, off + srow, S.indices), S.data, S.indptr.astype(np.int64),
                       B.indptr.astype(np.int64), B.indices.astype(np.int64), B.data)
     Bc = sp.csc_matrix(B)
-    missed = FP.add_mixed_entries(data, P.indptr, P.indices, off, er, ec, ev, Bc.indptr.astype(np.int64),
-                                  Bc.indices.astype(np.int64), Bc.data)
-    got = sp.csr_matrix((data, P.indices, P.indptr), shape=P.shape).toarray()[off:]
-    assert missed == 0
-    assert np.abs(got - want).max() <= 1e-14 * np.abs(want).max()
+    mix = (Bc.indptr.astype(np.int64), Bc.indices.astype(np.int64), Bc.data)
+    assert FP.shared_rows(P, off, Bc)
+    rows_only = data.copy()
+    for shared in (False, True):
+        data = rows_only.copy()
+        missed = FP.add_mixed_entries(data, P.indptr, P.indices, off, er, ec, ev, *mix, shared)
+        got = sp.csr_matrix((data, P.indices, P.indptr), shape=P.shape).toarray()[off:]
+        assert missed == 0
+        assert np.abs(got - want).max() <= 1e-14 * np.abs(want).max()
     sparse_pattern = sp.csr_matrix(np.eye(n + off, n))
+    assert not FP.shared_rows(sparse_pattern, off, Bc)
     assert FP.add_mixed_entries(np.zeros(n + off), sparse_pattern.indptr, sparse_pattern.indices, off, er, ec, ev,
-                                Bc.indptr.astype(np.int64), Bc.indices.astype(np.int64), Bc.data) > 0
+                                *mix, False) > 0
 
 
 def test_runs_and_mixed_runs_equal_mixed_rows():
