@@ -1,11 +1,11 @@
 """Compiled (numba) kernels that write a model's sparse Jacobian into the data of a fixed, sorted CSR pattern.
 
 A model builds its pattern and the positions of its constant parts once; per call the kernels add values in place:
-:func:`add_mixed_rows` (a block-diagonal map ``B`` times a matrix whose rows in each block share one column list, as
-``M^-1 dQ/dq`` of a chain family), :func:`add_mixed_runs` (the same where each row lands on consecutive positions), :func:`add_mixed_entries`
-(``B`` times COO entries, located by binary search) and
-:func:`csr_matvec_into` (``B x`` into a slice).  Their numpy twin is scipy's sparse algebra
-(``tests/assembly/test_fixed_pattern.py``).
+:func:`add_mixed_rows` (a block-diagonal map ``B`` times a matrix whose rows in each block share one column list,
+as ``M^-1 dQ/dq`` of a chain family), :func:`add_mixed_runs` (the same where each row lands on consecutive
+positions), :func:`add_mixed_entries` (``B`` times COO entries, located by binary search) and
+:func:`csr_matvec_into` (``B x`` into a slice); :func:`compact` drops the entries left zero.  Their numpy twin is
+scipy's sparse algebra (``tests/assembly/test_fixed_pattern.py``).
 """
 from __future__ import annotations
 
@@ -121,6 +121,27 @@ def add_mixed_entries(data, indptr, indices, row_offset, rows, cols, vals, b_ind
     return missed
 
 
+@njit(cache=True)
+def compact(data, indptr, indices):
+    """New CSR arrays ``(data, indices, indptr)`` of the entries of ``data`` (on the pattern ``(indptr, indices)``)
+    that are not zero, in their order: what ``eliminate_zeros`` of a copy gives, in one pass."""
+    keep = 0
+    for k in range(data.shape[0]):
+        if data[k] != 0.0:
+            keep += 1
+    out_data, out_indices = np.empty(keep), np.empty(keep, indices.dtype)
+    out_indptr = np.empty(indptr.shape[0], indptr.dtype)
+    n = 0
+    out_indptr[0] = 0
+    for r in range(indptr.shape[0] - 1):
+        for k in range(indptr[r], indptr[r + 1]):
+            if data[k] != 0.0:
+                out_data[n], out_indices[n] = data[k], indices[k]
+                n += 1
+        out_indptr[r + 1] = n
+    return out_data, out_indices, out_indptr
+
+
 def shared_rows(pattern: sp.csr_matrix, row_offset: int, b: sp.csc_matrix) -> bool:
     """Whether the rows ``row_offset + r'`` of ``pattern`` that each column of ``b`` spreads to share one column list
     (:func:`add_mixed_entries`'s ``shared``)."""
@@ -134,5 +155,5 @@ def shared_rows(pattern: sp.csr_matrix, row_offset: int, b: sp.csc_matrix) -> bo
     return True
 
 
-__all__ = ["add_mixed_entries", "add_mixed_rows", "add_mixed_runs", "csr_matvec_into", "positions", "runs",
-           "shared_rows"]
+__all__ = ["add_mixed_entries", "add_mixed_rows", "add_mixed_runs", "compact", "csr_matvec_into", "positions",
+           "runs", "shared_rows"]

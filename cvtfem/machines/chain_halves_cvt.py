@@ -368,10 +368,10 @@ class ChainHalvesCVT(ChainACVT):
         Mc.sort_indices()
         runs = [FP.runs(t, fp.indptr) for t in (fam_q, fam_v)]
         shared = FP.shared_rows(P, n2, Mc)
-        return dict(P=P, fam=[(FP.add_mixed_rows, t) if r is None else (FP.add_mixed_runs, r)
-                              for t, r in zip((fam_q, fam_v), runs)], ctrl=ctrl, top=top, in_cols=in_cols, work=(first, work_rows,
-                    P.indices[first:].astype(np.int64)), mixing=(Mc.indptr.astype(np.int64),
-                    Mc.indices.astype(np.int64), Mc.data.astype(float), shared))
+        fam = [(FP.add_mixed_rows, t) if r is None else (FP.add_mixed_runs, r) for t, r in zip((fam_q, fam_v), runs)]
+        return dict(P=P, fam=fam, ctrl=ctrl, top=top, in_cols=in_cols,
+                    work=(first, work_rows, P.indices[first:].astype(np.int64)),
+                    mixing=(Mc.indptr.astype(np.int64), Mc.indices.astype(np.int64), Mc.data.astype(float), shared))
 
     def jac(self, t: float, x) -> sp.csr_matrix:
         """Sparse ``d rhs / dx`` written into the data of the sorted :attr:`jac_sparsity` in place (then compacted: the
@@ -413,9 +413,8 @@ class ChainHalvesCVT(ChainACVT):
             return super().jac(t, x)
         first, work_rows, work_cols = plan["work"]
         data[first:] = Wr[work_rows, work_cols]
-        J = sp.csr_matrix((data, P.indices.copy(), P.indptr.copy()), shape=(N, N))
-        J.eliminate_zeros()             # the idle entries out: the integrators' reduced matrices cost 2x with them
-        return J
+        # the idle entries out (new arrays): the integrators' reduced Newton matrices cost twice as much with them
+        return sp.csr_matrix(FP.compact(data, P.indptr, P.indices), shape=(N, N))
 
     # ----- quasi-static start ----------------------------------------------------------------------
     def _placement(self, ratio: float, tension: float | None = None) -> "RollingPlacement":

@@ -91,3 +91,17 @@ def test_runs_and_mixed_runs_equal_mixed_rows():
     gap = target.copy()
     gap[3] += 1
     assert FP.runs(gap, ptr) is None and FP.runs(np.zeros(0, np.int64), np.zeros(1, np.int64)) is None
+
+
+def test_compact_equals_eliminate_zeros_and_leaves_the_pattern():
+    rng = np.random.default_rng(8)
+    A = sp.random(30, 40, density=0.3, random_state=9, format="csr")
+    A.sort_indices()
+    A.data[rng.random(A.nnz) < 0.4] = 0.0
+    A.data[0] = 0.0
+    indices, indptr = A.indices.copy(), A.indptr.copy()
+    data, ci, cp = FP.compact(A.data, A.indptr, A.indices)
+    B = A.copy()
+    B.eliminate_zeros()
+    assert np.array_equal(data, B.data) and np.array_equal(ci, B.indices) and np.array_equal(cp, B.indptr)
+    assert np.array_equal(A.indices, indices) and np.array_equal(A.indptr, indptr)
