@@ -44,6 +44,10 @@ HALF_PARAMETERS = dict(h_pin=1.2e-3, roll_radius=(0.004, 0.004), roll_stiffness=
 #: The chains with independent halves that run on the sheaves (both with H1: the contact point on the half's axis).
 HALVES_MODELS = ("chain-A5", "chain-A5-point")
 _ROT = np.array([[0.0, 1.0], [-1.0, 0.0]])      # a @ _ROT = k x a
+#: ChainCVT's steps the one-pass ``rhs`` and ``jac`` of :class:`ChainHalvesCVT` stand in for: a subclass that overrides
+#: one of them keeps the general path.
+_GENERAL_STEPS = ("evaluate", "_forces", "solve_mass", "split", "layout", "_idx", "_controls", "_loop_gradient",
+                  "jac_sparsity")
 
 
 def halves_family(geom, damping, E: float, plate_model: str = "A4", use_numba: bool = True, **half_parameters) -> "HalvesFamily":
@@ -296,12 +300,12 @@ class ChainHalvesCVT(ChainACVT):
     @cached_property
     def _one_pass(self) -> bool:
         """Whether :meth:`rhs` and :meth:`jac` take their one-pass forms: the compiled chain pass of
-        :class:`HalvesFamily` and ChainCVT's own state layout, force, mass, loop and evaluate steps (a subclass that
-        changes one of them, as the elastic shafts do, keeps ChainCVT's general path)."""
+        :class:`HalvesFamily` and ChainCVT's own state layout, pattern, force, mass, loop and evaluate steps
+        (:data:`_GENERAL_STEPS`; a subclass that changes one of them, as the elastic shafts do, keeps the general
+        path)."""
         cls = type(self)
         return (self.family.chain.backend == "numba" and type(self.family).forces is HalvesFamily.forces
-                and all(getattr(cls, f) is getattr(ChainCVT, f) for f in ("evaluate", "_forces", "solve_mass", "split",
-                                                                           "layout", "_idx", "_controls")))
+                and all(getattr(cls, f) is getattr(ChainCVT, f) for f in _GENERAL_STEPS))
 
     @cached_property
     def _chain_inverse_mass(self) -> tuple:
