@@ -15,18 +15,21 @@ from __future__ import annotations
 
 import copy
 from dataclasses import dataclass, replace
-from functools import lru_cache
+from functools import cached_property, lru_cache
 from typing import ClassVar
 
 import numpy as np
 import scipy.sparse as sp
 
+from cvtfem.assembly import fixed_pattern as FP
 from cvtfem.elements.base import Block
+from cvtfem.elements.chain import halves_kernel as HK
 from cvtfem.elements.chain.halves import ChainA5
 from cvtfem.elements.chain.halves_placement import half_centres, rolling_link_directions, rolling_spacing
 from cvtfem.elements.chain.placement import Placement, place_on_path
 from cvtfem.errors import InputError, NumericalError
 from cvtfem.machines.chain_a_cvt import PLATE_HEIGHT, PLATE_THICKNESS, POISSON, ChainACVT
+from cvtfem.machines.chain_cvt import ChainCVT
 from cvtfem.machines.static_balance import lifted_newton
 from cvtfem.outputs import OutputSpec
 
@@ -41,6 +44,10 @@ HALF_PARAMETERS = dict(h_pin=1.2e-3, roll_radius=(0.004, 0.004), roll_stiffness=
 #: The chains with independent halves that run on the sheaves (both with H1: the contact point on the half's axis).
 HALVES_MODELS = ("chain-A5", "chain-A5-point")
 _ROT = np.array([[0.0, 1.0], [-1.0, 0.0]])      # a @ _ROT = k x a
+#: ChainCVT's steps the one-pass ``rhs`` and ``jac`` of :class:`ChainHalvesCVT` stand in for: a subclass that overrides
+#: one of them keeps the general path.
+_GENERAL_STEPS = ("evaluate", "_forces", "solve_mass", "split", "layout", "_idx", "_controls", "_loop_gradient",
+                  "jac_sparsity")
 
 
 def halves_family(geom, damping, E: float, plate_model: str = "A4", use_numba: bool = True, **half_parameters) -> "HalvesFamily":
@@ -288,6 +295,130 @@ class ChainHalvesCVT(ChainACVT):
                                                                      "half -, half +; x3 < 0, x3 > 0)"), s.size)
             specs.append(s)
         return tuple(specs)
+
+    # ----- one-pass right-hand side and Jacobian ---------------------------------------------------
+    @cached_property
+    def _one_pass(self) -> bool:
+        """Whether :meth:`rhs` and :meth:`jac` take their one-pass forms: the compiled chain pass of
+        :class:`HalvesFamily` and ChainCVT's own state layout, pattern, force, mass, loop and evaluate steps
+        (:data:`_GENERAL_STEPS`; a subclass that changes one of them, as the elastic shafts do, keeps the general
+        path)."""
+        cls = type(self)
+        return (self.family.chain.backend == "numba" and type(self.family).forces is HalvesFamily.forces
+                and all(getattr(cls, f) is getattr(ChainCVT, f) for f in _GENERAL_STEPS))
+
+    @cached_property
+    def _chain_inverse_mass(self) -> tuple:
+        """The CSR arrays ``(indptr, indices, data)`` of the chain's block-diagonal inverse mass (sorted)."""
+        Mi = sp.csr_matrix(self.family.chain.inverse_mass)
+        Mi.sort_indices()
+        return Mi.indptr.astype(np.int64), Mi.indices.astype(np.int64), Mi.data.astype(float)
+
+    def rhs(self, t: float, x):
+        """``dx/dt`` in one pass: ChainCVT's :meth:`evaluate` without its bookkeeping (the chain's compiled pass
+        writes its forces and dissipated power straight into the model's force vector, the mass solve is compiled);
+        equal to ``evaluate(t, x)[0]`` to round-off (``tests/machines/test_chain_halves_one_pass.py``)."""
+        if not self._one_pass:
+            return super().rhs(t, x)
+        n2, nz = self.n2, self.control.size
+        nc, iphi, iz, _ = self._idx
+        v = x[n2:2 * n2]
+        w = v[iphi]
+        F, M, dz, _ = self._controls(t, w, x[2 * n2:2 * n2 + nz])
+        Q = np.zeros(n2)
+        D = HK.add_forces_power(Q, x, v, *self.family.chain._kernel_args)
+        Pf = self._contact_forces(x[:n2], v, Q)[0]
+        Q[iphi] += M
+        Q[iz] -= self.sheaves_per_z * F
+        out = np.empty(self.size)
+        out[:n2] = v
+        FP.csr_matvec_into(out, n2, *self._chain_inverse_mass, Q)
+        out[n2 + iphi] = Q[iphi] / self.J
+        out[n2 + iz] = Q[iz] / self.m_sheave
+        out[2 * n2:2 * n2 + nz] = dz
+        out[2 * n2 + nz:] = (M[0] * w[0], -M[1] * w[1], D - Pf, -self.sheaves_per_z * float(F @ v[iz]))
+        return out
+
+    @cached_property
+    def _jac_plan(self) -> dict | None:
+        """Positions in the data of the sorted :attr:`jac_sparsity` of every constant part of :meth:`jac` (built once):
+        the ``x' = v`` rows, the chain family's entries after ``M^-1`` (the rows a mass block couples share the family
+        pattern's column list), the loops' rows and the work rows; None where the family's pattern does not allow
+        that (ChainCVT's general assembly then)."""
+        if not self._one_pass:
+            return None
+        P = sp.csr_matrix(self.jac_sparsity, dtype=bool, copy=True)
+        P.sort_indices()
+        n2, nz, N = self.n2, self.control.size, self.size
+        nc, iphi, _, _ = self._idx
+        fp = self.family.jac_sparsity
+        mi_ptr, mi_idx, _ = self._chain_inverse_mass
+        for r in range(nc):                       # rows a mass block couples: one column list
+            cols = fp.indices[fp.indptr[r]:fp.indptr[r + 1]]
+            for s in mi_idx[mi_ptr[r]:mi_ptr[r + 1]]:
+                if not np.array_equal(fp.indices[fp.indptr[s]:fp.indptr[s + 1]], cols):
+                    return None
+        rows = np.repeat(np.arange(nc), np.diff(fp.indptr))
+        fam_q = FP.positions(P, n2 + rows, fp.indices)
+        fam_v = FP.positions(P, n2 + rows, n2 + fp.indices)
+        in_cols = np.concatenate([n2 + iphi, 2 * n2 + np.arange(nz)])
+        ctrl = FP.positions(P, 2 * n2 + np.repeat(np.arange(nz), len(in_cols)), np.tile(in_cols, nz))
+        top = FP.positions(P, np.arange(n2), n2 + np.arange(n2))
+        if min(fam_q.min(), fam_v.min(), ctrl.min() if nz else 0, top.min()) < 0:
+            return None
+        first = P.indptr[2 * n2 + nz]
+        work_rows = np.repeat(np.arange(4), np.diff(P.indptr[2 * n2 + nz:]))
+        Mc = sp.csc_matrix(self._inv_mass)
+        Mc.sort_indices()
+        runs = [FP.runs(t, fp.indptr) for t in (fam_q, fam_v)]
+        shared = FP.shared_rows(P, n2, Mc)
+        fam = [(FP.add_mixed_rows, t) if r is None else (FP.add_mixed_runs, r) for t, r in zip((fam_q, fam_v), runs)]
+        return dict(P=P, fam=fam, ctrl=ctrl, top=top, in_cols=in_cols,
+                    work=(first, work_rows, P.indices[first:].astype(np.int64)),
+                    mixing=(Mc.indptr.astype(np.int64), Mc.indices.astype(np.int64), Mc.data.astype(float), shared))
+
+    def jac(self, t: float, x) -> sp.csr_matrix:
+        """Sparse ``d rhs / dx`` written into the data of the sorted :attr:`jac_sparsity` in place (then compacted: the
+        entries idle at ``x`` dropped), from the compiled chain Jacobian's data, the contacts' entries and the loops, as
+        ChainCVT's :meth:`~ChainCVT.jac` assembles them (its twin; it serves where a contact entry falls outside the
+        pattern or a subclass changes the path)."""
+        plan = self._jac_plan
+        if plan is None:
+            return super().jac(t, x)
+        q, v, zc, _ = self.split(x)
+        nc, iphi, iz, _ = self._idx
+        n2, N, P = self.n2, self.size, plan["P"]
+        w = v[iphi]
+        F, M, G = self._loop_gradient(t, w, zc)
+        in_cols = plan["in_cols"]
+        fam, mi = self.family, self._chain_inverse_mass
+        Jq, Jv, dDq, dDv = fam.chain.jacobian_data(q[:nc], v[:nc], fam.scheme)
+        data = np.zeros(P.nnz)
+        data[plan["top"]] = 1.0
+        for (add, where), J in zip(plan["fam"], (Jq, Jv)):
+            add(data, where, J, fam.jac_sparsity.indptr, *mi)
+        (r, c, d), dD_contact = self._contact_jacobian(q, v)
+        r = np.concatenate([r, np.repeat(iz, len(in_cols)), np.full(len(in_cols), iphi[1])])
+        c = np.concatenate([c, np.tile(in_cols, 2), in_cols])
+        d = np.concatenate([d, -self.sheaves_per_z * G[:2].ravel(), G[2]])
+        if FP.add_mixed_entries(data, P.indptr, P.indices, n2, r, c, d, *plan["mixing"]):
+            return super().jac(t, x)
+        data[plan["ctrl"]] = G[3:].ravel()
+        Wr = np.zeros((4, N))                           # work rates: [M1 w1, -M2 w2, 2 Phi - P_fr, -2 F.z']
+        Wr[0, n2 + iphi[0]] = M[0]
+        Wr[1, in_cols] = -w[1] * G[2]
+        Wr[1, n2 + iphi[1]] += -M[1]
+        Wr[2, :2 * n2] = dD_contact
+        Wr[2, :nc] += dDq
+        Wr[2, n2:n2 + nc] += dDv
+        Wr[3, n2 + iz] = -self.sheaves_per_z * F
+        Wr[3, in_cols] = -self.sheaves_per_z * (v[iz] @ G[:2])
+        if Wr[:, iphi].any():
+            return super().jac(t, x)
+        first, work_rows, work_cols = plan["work"]
+        data[first:] = Wr[work_rows, work_cols]
+        # the idle entries out (new arrays): the integrators' reduced Newton matrices cost twice as much with them
+        return sp.csr_matrix(FP.compact(data, P.indptr, P.indices), shape=(N, N))
 
     # ----- quasi-static start ----------------------------------------------------------------------
     def _placement(self, ratio: float, tension: float | None = None) -> "RollingPlacement":

@@ -711,8 +711,18 @@ class ChainA5:
         """``(dQ/dq, dQ/dv, dD/dq, dD/dv)`` of the compiled backend: :meth:`jacobian`'s matrices and the gradient
         (W/m, W s/m; arrays (21 n,)) of the dissipated power ``D`` of :meth:`forces_and_dissipation` from the same
         element passes (:func:`halves_kernel.jacobian`)."""
+        pat = self.jac_sparsity
+        Jq, Jv, dDq, dDv = self.jacobian_data(q, v, scheme)
+        out = [sp.csr_matrix((d[:-1], pat.indices, pat.indptr), shape=pat.shape) for d in (Jq, Jv)]
+        return out[0], out[1], dDq, dDv
+
+    def jacobian_data(self, q: np.ndarray, v: np.ndarray, scheme: str = "analytic") -> tuple:
+        """:meth:`jacobian_and_power_gradient` with the matrices as their CSR data on :attr:`jac_sparsity` (each
+        ``nnz + 1`` long: the last a spare slot of the kernel), for a caller that assembles them itself."""
         if self.backend != "numba":
             raise InputError("backend", self.backend, 'must be "numba" for the power gradient of the element passes')
+        if scheme not in ("analytic", "forward", "central"):
+            raise InputError("scheme", scheme, 'must be "analytic", "forward" or "central"')
         pat = self.jac_sparsity
         if self._positions is None:
             self._positions = HK.positions(self._kernel_args, self.dof_index, pat)
@@ -722,8 +732,7 @@ class ChainA5:
         link = {"forward": HK.FORWARD, "central": HK.CENTRAL, "analytic": HK.ANALYTIC}[scheme]
         HK.jacobian(np.asarray(q, float), np.asarray(v, float), *self._kernel_args, *self._positions, steps, link,
                     Jq, Jv, dDq, dDv)
-        out = [sp.csr_matrix((d[:-1], pat.indices, pat.indptr), shape=pat.shape) for d in (Jq, Jv)]
-        return out[0], out[1], dDq, dDv
+        return Jq, Jv, dDq, dDv
 
     def coloured_jacobian(self, q: np.ndarray, v: np.ndarray, step: float = 1e-7,
                           damping: bool = True) -> tuple[sp.csr_matrix, sp.csr_matrix | None]:

@@ -762,9 +762,20 @@ def forces_power(q, v, gl, gp, L, c_twist, b_joint, cs, plate_w, plate_d, plate_
                  sig, cw, par, ints):
     """``(Q, D)``: the forces of :func:`forces` and the power dissipated by their damping and friction parts,
     ``D = -(Q_d + Q_fr) . v = 2 Phi - P_fr`` (W, >= 0), summed element by element."""
+    Q = np.zeros(q.shape[0])
+    D = add_forces_power(Q, q, v, gl, gp, L, c_twist, b_joint, cs, plate_w, plate_d, plate_c, plate_c1, plate_c2,
+                         arc, idx, sig, cw, par, ints)
+    return Q, D
+
+
+@njit(cache=True)
+def add_forces_power(Q, q, v, gl, gp, L, c_twist, b_joint, cs, plate_w, plate_d, plate_c, plate_c1, plate_c2, arc,
+                     idx, sig, cw, par, ints):
+    """Add the forces of :func:`forces` to ``Q`` and return their dissipated power ``D`` (W) as :func:`forces_power`.
+    ``q``, ``v`` and ``Q`` may be longer than the chain's ``21 n`` (a model's state with the chain first): only the
+    entries the index tables name are read and written."""
     n = L.shape[0]
     law, kmodel = ints[0], ints[1]
-    Q = np.zeros(q.shape[0])
     T = np.zeros(n)
     x, xd, loc, Dv = np.zeros(22), np.zeros(22), np.zeros(22), np.zeros((1, 1))
     wk, none = _link_work(), _keep(0)
@@ -783,7 +794,7 @@ def forces_power(q, v, gl, gp, L, c_twist, b_joint, cs, plate_w, plate_d, plate_
         _pin(y, yd, p, T[p], T[(p - 1) % n], b_joint, cs, arc, idx, sig, cw, par, law, True, True, False, lp, pk)
         for j in range(29):
             Q[gp[p, j]] += lp[j]
-    return Q, -(wk[-1][0] + pk[-1][0])
+    return -(wk[-1][0] + pk[-1][0])
 
 
 @njit(cache=True)
@@ -920,5 +931,5 @@ def jacobian(q, v, gl, gp, L, c_twist, b_joint, cs, plate_w, plate_d, plate_c, p
                         Jq[pos_t[p, j, r, c]] += slopes[j, r] * dT[e, c]
 
 
-__all__ = ["ANALYTIC", "CENTRAL", "FORWARD", "HAVE_NUMBA", "SMOOTH_EPS", "forces", "forces_power", "jacobian", "pack",
-           "positions"]
+__all__ = ["ANALYTIC", "CENTRAL", "FORWARD", "HAVE_NUMBA", "SMOOTH_EPS", "add_forces_power", "forces", "forces_power",
+           "jacobian", "pack", "positions"]
