@@ -73,3 +73,46 @@ def test_a_start_beyond_the_saturation_band_is_named():
     with pytest.raises(InputError) as err:
         integral_start("secant", 1.0, F_APPL, 2.5)
     assert err.value.where == "cvt.control.ratio_loop_start"
+
+
+@pytest.mark.slow
+def test_s1_seeded_at_its_clamping_ratio_drifts_towards_the_target():
+    """S1 on rigid shafts (band-6+2n scene values, reference chain), stationary regime, loops on: started at its
+    measured clamping ratio F1/F2 = 1.00 (``studies/chain/clamping_ratio.py``, docs/chain.md) against the source's
+    zero start (the band's 0.8335).
+
+    Linearised, the ratio loop on a chain is ``e' = k (F1 - F1*)``, ``F1 = F1a + c_f0 e + F11``, ``F11' = c_f1 e``
+    (k ~ -6.8e-5 1/(s N) for S1, from the open-loop drifts +0.37 / -0.64 1/s at F1/F2 0.8335 / 1.25), and its
+    equilibrium is ``e = 0``, ``F11 = F1* - F1a``.  The zero start is 5.9 kN short of it: the ratio error grows
+    (drift away from the target) until the integral has moved F1 over ~0.3 s.  The seeded start is at the integral's
+    equilibrium; only the speed ratio's slip offset (w1/w2 ~ 2.415 at the geometric 2.4) is left, which the
+    proportional part turns into a drift towards the target.  Asserted over 5-12 ms of rock4 (rtol 1e-4): the seeded
+    run drifts towards 2.4 (drift and error of opposite signs), the zero start away from it; the seeded mean error is
+    the smaller and within 1 %; F1 stays within 5 % of the measured 1.00 F2 in the seeded run."""
+    from cvtfem.elements.chain.geometry import reference_geometry
+    from cvtfem.integrate import solve
+    from cvtfem.machines.chain_cvt import from_scene
+
+    scene = load_scene("band-6+2n")
+    band = build_model(scene)
+    o = band.outputs(0.0, band.initial_state())
+    F = np.array([o["driving.clamping_force"], o["driven.clamping_force"]])
+    rg = scene.cvt.regime
+    t_eval = np.linspace(5e-3, 12e-3, 281)
+    out = {}
+    for name, sc in (("zero", scene), ("seeded", seeded(scene, 1.0))):
+        m = from_scene(sc, reference_geometry(), F, model="chain-S1", contact="rigid")
+        x0, _ = m.static_state(rg.ratio, rg.input_speed)
+        res = solve(m, (0.0, t_eval[-1]), x0, method="rock4", rtol=1e-4, atol=1e-7, n2=m.n2, jac=m.jac,
+                    jac_sparsity=m.jac_sparsity, t_eval=t_eval)
+        assert res.status == 0
+        outs = [m.outputs(t, y) for t, y in zip(res.t, res.y.T)]
+        e = np.array([o["ratio"] for o in outs]) / rg.ratio - 1
+        F1 = np.array([o["driving.clamping_force"] for o in outs])
+        out[name] = (e.mean(), np.polyfit(res.t, e, 1)[0], F1)
+        print(f"{name}: mean ratio error {e.mean():+.4f}, drift {np.polyfit(res.t, e, 1)[0] * rg.ratio:+.3f} 1/s, "
+              f"F1 {F1.mean():.0f} N (F1/F2 {F1.mean() / F[1]:.4f})")
+    (e0, r0, _), (e1, r1, F1) = out["zero"], out["seeded"]
+    assert e0 * r0 > 0 and e1 * r1 < 0
+    assert abs(e1) < abs(e0) and abs(e1) < 0.01
+    np.testing.assert_allclose(F1 / F[1], 1.0, atol=0.05)
