@@ -9,10 +9,14 @@ Run:  .venv/bin/python studies/chain/clamping_ratio_variant.py [--scene variant-
    prescribed clamping forces F_appl (the estimate (1.13) x safety, the band's split) and its quasi-static start.
 2. For each F1/F2 in ``--ratios``: F2 = the scene's, F1 = ratio x F2 held, ``M2 = -b20 w2`` (the target point's
    resistance), a run from the quasi-static start to ``--t-end`` (states every 25 us cached in ``--states-dir``):
-   the speed ratio's drift (1/s, linear fit over the second half), the mean ratio, input speed and span tensions
-   over the second half.
+   the speed ratio's drift (1/s) and the movable sheaves' axial velocities (linear fits over the second half), the
+   mean ratio, input speed and span tensions over the second half.
 3. The no-drift F1/F2 by linear interpolation between the two bracketing ratios (or the secant through the two
-   nearest to zero drift when none brackets): the value for ``cvt.control.start_force_ratio``; against
+   nearest to zero drift when none brackets), of the speed ratio and of each sheave's axial position; and the F1/F2
+   at which the speed ratio's mean over the second half is the regime's ratio, the same interpolation: the ratio
+   loop's equilibrium, the value for ``cvt.control.start_force_ratio``.  Where the chain's speed ratio at its
+   geometric start ratio is off the target (A1 with H2: 2.485 at 2.4 within 2 ms), the two differ: the loop holds the
+   speed ratio, not the start geometry (docs/transmission.md, "Stationary start of the loops").  Against
    :func:`~cvtfem.elements.band.creep.held_arc`'s prediction with the H1 give (pin spring and Hertz) at the chain's
    span tensions and the band's arcs.
 Machine, load, wall and CPU times are printed; ``--png`` draws the speed ratio over time per F1/F2.
@@ -66,17 +70,19 @@ def run_held(m, x0, rq, t_end, method, rtol, atol, path):
 
 
 def drift(m, rq, t, Y):
-    """Speed ratio at the samples; over the second half: its drift 1/s (linear fit), the means of ratio, input speed
-    rpm and span tensions (tight, slack) N."""
+    """Speed ratio at the samples; over the second half: its drift 1/s (linear fit), the axial velocities (2,) m/s of
+    the movable sheaves (linear fits of their positions, outwards > 0), the means of ratio, input speed rpm and span
+    tensions (tight, slack) N."""
     mq = m.with_clamping(np.array([rq * m.F_appl[1], m.F_appl[1]]))
     outs = [mq.outputs(ti, Y[:, i]) for i, ti in enumerate(t)]
     ratio = np.array([o["ratio"] for o in outs])
+    z = np.array([[o["driving.sheave_position"], o["driven.sheave_position"]] for o in outs])
     half = t >= t[-1] / 2
     rate = np.polyfit(t[half], ratio[half], 1)[0]
-    w1 = np.array([o["driving.speed"] for o in outs]) if "driving.speed" in outs[0] else None
-    rpm = float(np.mean(w1[half]) * 30 / np.pi) if w1 is not None else np.nan
+    dz = np.polyfit(t[half], z[half], 1)[0]
+    rpm = float(np.mean([o["driving.speed"] for o in outs]) * 30 / np.pi)
     spans = np.nanmean([outs[i]["chain.span_tension"] for i in np.nonzero(half)[0]], axis=0)
-    return ratio, rate, float(np.mean(ratio[half])), rpm, spans
+    return ratio, rate, dz, float(np.mean(ratio[half])), rpm, spans
 
 
 def no_drift(rq, rates):
@@ -140,22 +146,30 @@ def main() -> None:
     for rq in [float(s) for s in a.ratios.split(",")]:
         path = os.path.join(a.states_dir, f"{tag}_open_F1F2_{rq:g}_{1e3 * a.t_end:g}ms_{method}_{rtol:g}.npz")
         t, Y, wall, cpu = run_held(m, x0, rq, a.t_end, method, rtol, atol, path)
-        ratio, rate, mean, rpm, spans = drift(m, rq, t, Y)
-        runs[rq] = (t, ratio, rate, mean, rpm, spans)
-        print(f"F1/F2 {rq:.4f}: ratio {ratio[0]:.4f} -> {ratio[-1]:.4f}, drift over the 2nd half {rate:+.4f} 1/s, "
-              f"mean {mean:.4f}, input {rpm:.0f} rpm; spans {spans[0]:.0f} / {spans[1]:.0f} N "
+        ratio, rate, dz, mean, rpm, spans = drift(m, rq, t, Y)
+        runs[rq] = (t, ratio, rate, dz, mean, rpm, spans)
+        print(f"F1/F2 {rq:.4f}: ratio {ratio[0]:.4f} -> {ratio[-1]:.4f}, over the 2nd half: drift {rate:+.4f} 1/s, "
+              f"sheaves {1e3 * dz[0]:+.2f} / {1e3 * dz[1]:+.2f} mm/s (driving / driven, outwards > 0), mean "
+              f"{mean:.4f}, input {rpm:.0f} rpm; spans {spans[0]:.0f} / {spans[1]:.0f} N "
               f"({wall / (1e3 * t[-1]):.1f} s wall, {cpu / (1e3 * t[-1]):.1f} s cpu per simulated ms)", flush=True)
     if len(runs) < 2:
         return
     rq = sorted(runs)
     zero, how = no_drift(rq, [runs[r][2] for r in rq])
-    print(f"{a.scene} holds its ratio (no drift) at F1/F2 = {zero:.4f} ({how}); the band's (F_appl) "
+    print(f"{a.scene}: the speed ratio does not drift at F1/F2 = {zero:.4f} ({how}); the band's (F_appl) "
           f"{m.F_appl[0] / m.F_appl[1]:.4f}")
+    for k, name in enumerate(("driving", "driven")):
+        zk, how = no_drift(rq, [runs[r][3][k] for r in rq])
+        print(f"  the {name} sheave stays at F1/F2 = {zk:.4f} ({how})")
+    i_d = scene.cvt.regime.ratio
+    level, how = no_drift(rq, [runs[r][4] - i_d for r in rq])
+    print(f"  the speed ratio's mean over the 2nd half is the target {i_d:g} at F1/F2 = {level:.4f} ({how}): the "
+          f"ratio loop's equilibrium (its integral's F11 = F1 - F1a at e = 0), the value for start_force_ratio")
     _, _, arcs = band_steady(scene.cvt.friction.v0)
     near = rq[int(np.argmin(np.abs(np.array(rq) - zero)))]
-    Fh, _ = held_forces(arcs, runs[near][5], **gives()["H1 (S2, A1): + Hertz"])
+    Fh, _ = held_forces(arcs, runs[near][6], **gives()["H1 (S2, A1): + Hertz"])
     print(f"held_arc (H1 give: pin spring + Hertz, with radial slip) at the spans of F1/F2 {near:g} "
-          f"({runs[near][5][0]:.0f} / {runs[near][5][1]:.0f} N): F1/F2 {Fh[0] / Fh[1]:.4f}")
+          f"({runs[near][6][0]:.0f} / {runs[near][6][1]:.0f} N): F1/F2 {Fh[0] / Fh[1]:.4f}")
     if a.png:
         plot(runs, zero, a.scene, a.png)
 

@@ -1,13 +1,14 @@
-"""Stationary runs with the loops on: the ratio loop started at zero (the source) against the chain's own clamping ratio.
+"""Stationary runs with the loops on: the ratio loop's integral started at zero (the source) or seeded.
 
 Run:  .venv/bin/python studies/chain/seeded_loop.py RESULTS.h5 [RESULTS.h5 ...] [--labels a,b] [--every 0.005]
       [--png out/studies/chain/seeded_loop_a.png]
 The results files come from ``cvtfem run`` (e.g. ``cvtfem run studies/chain/variant-a-seeded.toml --until 0.05``
 and the same scene with ``ratio_loop_start = "zero"``).  Per file: the ratio's and input speed's deviation from
 the targets (2.4, 3500 rpm) at every ``--every`` s and their largest value over the run's second half, the driving
-clamping force F1 and the ratio loop's integral F11 (from F1, the estimate's F1a and the stored ratio estimate), the drift of the ratio over the second half (1/s, linear fit),
-the run's energy balance (residual of input work = output work + losses + change of stored energy, of the input
-work) and whether any series holds a NaN.  ``--png`` draws ratio, input speed and F1 over time, one line per file.
+clamping force F1 and the ratio loop's integral F11 (from F1, the estimate's F1a and the stored ratio estimate), the
+drift of the ratio over the second half (1/s, linear fit), the run's energy balance (residual of input work +
+clamping work = output work + dissipated work + change of stored energy, of the input work) and whether any series
+holds a NaN.  ``--png`` draws ratio, input speed and F1 over time, one line per file.
 """
 from __future__ import annotations
 
@@ -45,7 +46,8 @@ def series(path):
     residual = (W[-1, 0] + W[-1, 3] - W[-1, 1] - W[-1, 2] - (E[-1] - E[0])) / W[-1, 0]
     nan = any(np.isnan(np.asarray(v, float)).any() for v in s.values() if np.asarray(v).dtype.kind == "f")
     return dict(t=t, ratio=ratio, rpm=w1 * RPM, F1=F1, F11=F11, residual=float(residual), nan=nan,
-                target=(rg.ratio, rg.input_speed * RPM), F2=float(np.asarray(s["driven.clamping_force"]).reshape(-1)[0]))
+                target=(rg.ratio, rg.input_speed * RPM),
+                F2=float(np.asarray(s["driven.clamping_force"]).reshape(-1)[0]))
 
 
 def report(label, d, every):
@@ -59,7 +61,8 @@ def report(label, d, every):
     print("   t ms   ratio  dev %    rpm   dev %      F1 N   F1/F2     F11 N")
     for tk in np.arange(0.0, t[-1] + 1e-12, every):
         k = int(np.argmin(np.abs(t - tk)))
-        print(f"  {1e3 * t[k]:5.1f}  {d['ratio'][k]:.4f} {100 * dev_i[k]:+5.2f}  {d['rpm'][k]:6.1f} {100 * dev_n[k]:+5.2f}"
+        print(f"  {1e3 * t[k]:5.1f}  {d['ratio'][k]:.4f} {100 * dev_i[k]:+5.2f}  {d['rpm'][k]:6.1f} "
+              f"{100 * dev_n[k]:+5.2f}"
               f"  {d['F1'][k]:8.0f}  {d['F1'][k] / d['F2']:.4f}  {d['F11'][k]:8.0f}")
     print(f"  second half: largest |ratio dev| {100 * np.abs(dev_i[half]).max():.2f} %, |speed dev| "
           f"{100 * np.abs(dev_n[half]).max():.2f} %; ratio drift {rate:+.3f} 1/s (towards the target if its sign is "

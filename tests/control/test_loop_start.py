@@ -86,9 +86,11 @@ def test_s1_seeded_at_its_clamping_ratio_drifts_towards_the_target():
     equilibrium is ``e = 0``, ``F11 = F1* - F1a``.  The zero start is 5.9 kN short of it: the ratio error grows
     (drift away from the target) until the integral has moved F1 over ~0.3 s.  The seeded start is at the integral's
     equilibrium; only the speed ratio's slip offset (w1/w2 ~ 2.415 at the geometric 2.4) is left, which the
-    proportional part turns into a drift towards the target.  Asserted over 5-12 ms of rock4 (rtol 1e-4): the seeded
-    run drifts towards 2.4 (drift and error of opposite signs), the zero start away from it; the seeded mean error is
-    the smaller and within 1 %; F1 stays within 5 % of the measured 1.00 F2 in the seeded run."""
+    proportional part turns into a drift towards the target.  Asserted over 5-10 ms of rock4 (rtol 1e-4; 170 s at
+    load 11): the seeded run drifts towards 2.4 (drift and error of opposite signs; observed -0.18 1/s at +0.56 %),
+    the zero start away from it (+0.22 1/s at +0.72 %); the seeded mean error is the smaller and within 1 %; the
+    integral (F1 less the proportional part) stays within 1 kN of its seeded start (it integrates c_f1 e, below
+    ~300 N over 10 ms at e < 1 %), while the zero start's is still more than 4 kN below that equilibrium."""
     from cvtfem.elements.chain.geometry import reference_geometry
     from cvtfem.integrate import solve
     from cvtfem.machines.chain_cvt import from_scene
@@ -98,7 +100,7 @@ def test_s1_seeded_at_its_clamping_ratio_drifts_towards_the_target():
     o = band.outputs(0.0, band.initial_state())
     F = np.array([o["driving.clamping_force"], o["driven.clamping_force"]])
     rg = scene.cvt.regime
-    t_eval = np.linspace(5e-3, 12e-3, 281)
+    t_eval = np.linspace(5e-3, 10e-3, 201)
     out = {}
     for name, sc in (("zero", scene), ("seeded", seeded(scene, 1.0))):
         m = from_scene(sc, reference_geometry(), F, model="chain-S1", contact="rigid")
@@ -109,10 +111,12 @@ def test_s1_seeded_at_its_clamping_ratio_drifts_towards_the_target():
         outs = [m.outputs(t, y) for t, y in zip(res.t, res.y.T)]
         e = np.array([o["ratio"] for o in outs]) / rg.ratio - 1
         F1 = np.array([o["driving.clamping_force"] for o in outs])
-        out[name] = (e.mean(), np.polyfit(res.t, e, 1)[0], F1)
+        F11 = F1 - F[0] - sc.cvt.control.c_f0 * (np.array([o["control.ratio_estimate"] for o in outs]) - rg.ratio)
+        out[name] = (e.mean(), np.polyfit(res.t, e, 1)[0], F11)
         print(f"{name}: mean ratio error {e.mean():+.4f}, drift {np.polyfit(res.t, e, 1)[0] * rg.ratio:+.3f} 1/s, "
-              f"F1 {F1.mean():.0f} N (F1/F2 {F1.mean() / F[1]:.4f})")
-    (e0, r0, _), (e1, r1, F1) = out["zero"], out["seeded"]
+              f"F1 {F1.mean():.0f} N (F1/F2 {F1.mean() / F[1]:.4f}), integral {F11[0]:.0f} -> {F11[-1]:.0f} N")
+    (e0, r0, F11_zero), (e1, r1, F11_seeded) = out["zero"], out["seeded"]
     assert e0 * r0 > 0 and e1 * r1 < 0
     assert abs(e1) < abs(e0) and abs(e1) < 0.01
-    np.testing.assert_allclose(F1 / F[1], 1.0, atol=0.05)
+    np.testing.assert_allclose(F11_seeded, F[1] - F[0], atol=1000.0)
+    assert np.all(F11_zero < F[1] - F[0] - 4000.0)
