@@ -99,9 +99,9 @@ CONTROL = Table("control", "Speed and ratio stabilisation systems (spec section 
     Key("ratio_loop_start", "str", "Start of the ratio loop's integral: zero (the source; F1 starts at its "
         "estimate) or at the driving clamping force `start_force_ratio` x F2.", "", "zero",
         choices=("zero", "force-ratio")),
-    Key("start_force_ratio", "float", "Clamping-force ratio F1/F2 at which the chain holds its ratio (its no-drift "
-        "ratio, studies/chain/clamping_ratio.py); used by ratio_loop_start = 'force-ratio' (0: unset).", "-", 0.0,
-        ge=0.0, le=10.0),
+    Key("start_force_ratio", "float", "Clamping-force ratio F1/F2 at which the chain runs at the target ratio (open "
+        "loop, studies/chain/clamping_ratio_variant.py); used by ratio_loop_start = 'force-ratio' (0: unset).", "-",
+        0.0, ge=0.0, le=10.0),
 ), checks=(lambda t, p: _check_ordered(t, p, "i_min", "i_max"), lambda t, p: _check_loop_start(t, p)))
 
 REGIME = Table("regime", "Operating regime of a run.", (
