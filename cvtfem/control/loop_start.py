@@ -3,7 +3,7 @@
 Spec: low-order digest section 5.3 sets ``F11(0) = 0``, so the driving clamping force starts at the prescribed
 ``F1a`` of the estimate (1.13) (the ``equilibrium`` split: the band's force ratio, 0.8335 at the stationary regime).
 A discrete chain runs at the target ratio at another force ratio (its pins give axially under load and run in a
-spiral along the driving arc: S1 needs F1/F2 = 1.00, S2 1.094, A1 with H2 1.31; docs/chain.md, docs/transmission.md),
+spiral along the driving arc: S1 needs F1/F2 = 1.00, S2 1.094, A1 with H2 ~0.9-1.3; docs/chain.md and transmission.md),
 and the integral (``c_f1`` ~1e6 N/s per unit ratio error) takes 0.3-0.5 s of simulated time to move ``F1`` there.
 Starting the integral at ``F11(0) = rho F2a - F1a``, the loop's equilibrium at zero ratio error, puts ``F1`` at
 ``rho F2a`` from the first step; ``rho`` is measured by open-loop runs at held forces
