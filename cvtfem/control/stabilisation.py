@@ -54,6 +54,9 @@ class StabilisationParams:
         Desired transient time and damping ratio of the driven-speed loop.
     J_sigma : float, kg m^2
         Inertia reduced to the driven shaft ``J1 i^2 + J2 + m_ch r2^2`` at the target ratio.
+    F11_start : float, N
+        Start value of the ratio loop's integral (0 in the source; :func:`~cvtfem.control.loop_start.integral_start`
+        seeds the chain's own clamping ratio).
     """
 
     tau_omega: float = 0.002
@@ -67,6 +70,7 @@ class StabilisationParams:
     tau: float = 0.01
     nu: float = 0.8
     J_sigma: float = 0.1
+    F11_start: float = 0.0
 
     def speed_gains(self, b20: float, w2d: float) -> tuple[float, float]:
         """``c_b0 = (2 J / tau - b20) / w2d`` and ``c_b1 = J / ((tau nu)^2 w2d)`` (section 5.4)."""
@@ -85,8 +89,9 @@ class Stabilisation:
     output_specs = LOOP_OUTPUTS
 
     def initial_state(self, w1: float, w2: float) -> np.ndarray:
-        """``z(0) = [w1, w2, 0, 0]`` (filters start at the measured speeds, integrals at zero)."""
-        return np.array([w1, w2, 0.0, 0.0])
+        """``z(0) = [w1, w2, F11_start, 0]`` (filters start at the measured speeds, the b2 integral at zero, the F1
+        integral at :attr:`StabilisationParams.F11_start`, zero unless seeded)."""
+        return np.array([w1, w2, self.p.F11_start, 0.0])
 
     def outputs(self, w, z, i_d: float, w2d: float, M1: float, F_appl):
         """Control forces and state derivatives (section 5.5).

@@ -31,6 +31,7 @@ import scipy.sparse.linalg as spla
 from scipy.optimize import least_squares
 
 from cvtfem.assembly.model import Linearization, ModelBase, StateLayout
+from cvtfem.control.loop_start import integral_start
 from cvtfem.control.regimes import Regime
 from cvtfem.control.stabilisation import OpenLoop, Stabilisation, StabilisationParams
 from cvtfem.elements.band.geometry import Sheave
@@ -828,7 +829,8 @@ def from_scene(scene, geom, F_appl, model: str = "chain-S2", **overrides) -> Cha
     r2 = radii(phi_for_ratio(rg.ratio, geom.length, g.centre_distance), geom.length, g.centre_distance)[0][1]
     J = tuple(s.inertia for s in shafts)
     loop = StabilisationParams(c.tau_omega, c.eps, c.i_min, c.i_max, c.k_sat, c.c_f0, c.c_f1, c.c_sat, c.tau, c.nu,
-                               J[0] * rg.ratio ** 2 + J[1] + cvt.chain.mass * r2 ** 2)
+                               J[0] * rg.ratio ** 2 + J[1] + cvt.chain.mass * r2 ** 2,
+                               integral_start(c.ratio_loop_start, c.start_force_ratio, F_appl, c.k_sat))
     kw = dict(model=model, centre_distance=g.centre_distance,
               face=Sheave(g.sheave_profile, g.flank_angle, g.torus_radius, g.torus_offset),
               r_outer=g.sheave_outer_radius, J=J, m_sheave=tuple(s.sheave_mass for s in shafts),

@@ -215,6 +215,7 @@ def closed_loop(scene: Scene, **overrides: Any):
     """Scene -> :class:`~cvtfem.machines.band_cvt.BandCVT` (band family, clamping schedule, regime, control
     family and the components with their outputs), in one pass; ``overrides`` replace band parameters."""
     from cvtfem.control.clamping import Clamping
+    from cvtfem.control.loop_start import integral_start
     from cvtfem.control.regimes import Regime
     from cvtfem.control.stabilisation import OpenLoop, StabilisationParams
     from cvtfem.elements.band.geometry import phi_for_ratio, radii
@@ -235,7 +236,9 @@ def closed_loop(scene: Scene, **overrides: Any):
         r2 = radii(phi_for_ratio(rg.ratio, p.length, p.L), p.length, p.L)[0][1]
         J_sigma = p.J[0] * rg.ratio ** 2 + p.J[1] + p.mass * r2 ** 2
         control = Stabilisation(StabilisationParams(c.tau_omega, c.eps, c.i_min, c.i_max, c.k_sat, c.c_f0, c.c_f1,
-                                                    c.c_sat, c.tau, c.nu, J_sigma))
+                                                    c.c_sat, c.tau, c.nu, J_sigma,
+                                                    integral_start(c.ratio_loop_start, c.start_force_ratio,
+                                                                   clamping.forces(rg.torque, rg.ratio), c.k_sat)))
     parts = _components(scene, _band(cvt.model, p.n_ritz, p.n_gauss))
     return BandCVT(model, clamping, regime, control, parts)
 

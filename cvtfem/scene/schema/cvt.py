@@ -96,7 +96,13 @@ CONTROL = Table("control", "Speed and ratio stabilisation systems (spec section 
     Key("c_sat", "float", "Saturation of the resistance coefficient, in units of its static part.", "-", gt=1.0),
     Key("tau", "float", "Time constant of the driven-speed loop.", "s", gt=0.0),
     Key("nu", "float", "Damping ratio of the driven-speed loop.", "-", gt=0.0),
-), checks=(lambda t, p: _check_ordered(t, p, "i_min", "i_max"),))
+    Key("ratio_loop_start", "str", "Start of the ratio loop's integral: zero (the source; F1 starts at its "
+        "estimate) or at the driving clamping force `start_force_ratio` x F2.", "", "zero",
+        choices=("zero", "force-ratio")),
+    Key("start_force_ratio", "float", "Clamping-force ratio F1/F2 at which the chain runs at the target ratio (open "
+        "loop, studies/chain/clamping_ratio_variant.py); used by ratio_loop_start = 'force-ratio' (0: unset).", "-",
+        0.0, ge=0.0, le=10.0),
+), checks=(lambda t, p: _check_ordered(t, p, "i_min", "i_max"), lambda t, p: _check_loop_start(t, p)))
 
 REGIME = Table("regime", "Operating regime of a run.", (
     Key("kind", "str", "Regime type.", "", "stationary",
@@ -150,6 +156,16 @@ CVT = Table("cvt", "A chain CVT: two shafts with sheave pairs and a chain.", (
 def _check_ordered(table: Mapping[str, Any], path: str, low: str, high: str) -> None:
     if table[low] >= table[high]:
         raise InputError(f"{path}.{high}", table[high], f"must be greater than `{low}` = {table[low]:g}")
+
+
+def _check_loop_start(t: Mapping[str, Any], path: str) -> None:
+    seeded, rho = t["ratio_loop_start"] == "force-ratio", t["start_force_ratio"]
+    if seeded and rho == 0.0:
+        raise InputError(f"{path}.start_force_ratio", rho, "must be set (> 0: the F1/F2 the chain holds its ratio "
+                         "at) when `ratio_loop_start` = 'force-ratio'")
+    if not seeded and rho != 0.0:
+        raise InputError(f"{path}.start_force_ratio", rho, "must stay unset (0) unless `ratio_loop_start` = "
+                         f"'force-ratio' (it is '{t['ratio_loop_start']}'): the value would be ignored")
 
 
 def _check_geometry(t: Mapping[str, Any], path: str) -> None:
