@@ -20,7 +20,10 @@ interval, from the state the reference method reaches there.
 """
 from __future__ import annotations
 
+import json
+import time
 from dataclasses import dataclass, field, replace
+from pathlib import Path
 
 import numpy as np
 
@@ -29,7 +32,7 @@ from cvtfem.problems.base import Problem
 
 __all__ = ["PinForceProblem", "cvt_problem", "pin_force_problem", "output_of", "output_component", "window_error",
            "jacobian_spectrum", "spectrum_with_v0", "local_error_table", "block_scales", "baseline_time", "state_at",
-           "ACCEPT_E"]
+           "StudyCache", "ACCEPT_E"]
 
 #: The source's acceptance of test 2.
 ACCEPT_E = 0.05
@@ -79,6 +82,56 @@ class PinForceProblem(Problem):
         if not res.success or len(res.t) != len(self.t_eval):
             return float("inf")
         return window_error(self.pin_forces(res.y, res.t)[:, self.pin], self.p_ref)
+
+
+class StudyCache:
+    """Runs of one study kept in a directory, so that a long study can be resumed or split over processes: the
+    reference runs' outputs (``reference-METHOD-RTOL.npy``, every component at every sample) and the rows of test 2
+    (``runs.json``, wall and CPU times as measured when they ran).  ``key`` names the study (scene, window, samples,
+    start); a directory holding another study's runs is refused."""
+
+    def __init__(self, path, key: str):
+        self.path = Path(path)
+        self.path.mkdir(parents=True, exist_ok=True)
+        stamp = self.path / "key.txt"
+        if stamp.exists() and stamp.read_text(encoding="utf-8") != key:
+            raise InputError("--cache", str(path), f"must hold runs of this study ({key}), not of "
+                                                   f"{stamp.read_text(encoding='utf-8')}: use another directory")
+        stamp.write_text(key, encoding="utf-8")
+        runs = self.path / "runs.json"
+        self.rows: dict = json.loads(runs.read_text(encoding="utf-8")) if runs.exists() else {}
+
+    def _file(self, method: str, rtol: float, suffix: str) -> Path:
+        return self.path / f"reference-{method}-{rtol:g}.{suffix}"
+
+    def reference(self, method: str, rtol: float, wait: bool = False):
+        """The cached output (samples, components) of a reference run, or ``None``; ``wait``: for the run another
+        process has marked running (polls every 10 s)."""
+        while wait and not self._file(method, rtol, "npy").exists() and self.running(method, rtol):
+            time.sleep(10)
+        f = self._file(method, rtol, "npy")
+        return np.load(f) if f.exists() else None
+
+    def running(self, method: str, rtol: float) -> bool:
+        """True while a process computes this reference run (its mark is removed when the run is kept)."""
+        return self._file(method, rtol, "running").exists()
+
+    def mark_running(self, method: str, rtol: float) -> None:
+        self._file(method, rtol, "running").touch()
+
+    def clear_running(self, method: str, rtol: float) -> None:
+        self._file(method, rtol, "running").unlink(missing_ok=True)
+
+    def keep_reference(self, method: str, rtol: float, p) -> None:
+        np.save(self._file(method, rtol, "tmp.npy"), np.asarray(p))      # complete before it appears
+        self._file(method, rtol, "tmp.npy").replace(self._file(method, rtol, "npy"))
+
+    def keep_row(self, key: str, row: dict) -> None:
+        """Keep a row of test 2 (re-reading the file first: another process may have added rows)."""
+        runs = self.path / "runs.json"
+        self.rows = json.loads(runs.read_text(encoding="utf-8")) if runs.exists() else {}
+        self.rows[key] = {k: (float(v) if isinstance(v, (np.floating, float)) else v) for k, v in row.items()}
+        runs.write_text(json.dumps(self.rows, indent=0), encoding="utf-8")
 
 
 def output_of(scene, loop) -> str:
@@ -133,14 +186,15 @@ def cvt_problem(scene, t_end: float, settle: float = 0.0, settle_by: tuple[str, 
 def pin_force_problem(scene, window: tuple[float, float] = (1e-3, 5e-3), sample: float = 1e-5,
                       reference: tuple[str, float] = ("Radau", 1e-8),
                       check: tuple[str, float] = ("rodas5p", 1e-8), settle: float = 0.0,
-                      placed: bool = False) -> tuple[PinForceProblem, dict]:
+                      placed: bool = False, cache: StudyCache | None = None) -> tuple[PinForceProblem, dict]:
     """Test 2 of the protocol on a CVT scene: the problem, and a report of its reference.
 
     The pin (or pin half, on A5) is the one whose axial force varies most over the window in the reference run (a
     pin entering or leaving an arc: the sharply varying output of A:(2.9)); on a band model the Gauss node whose
     normal force varies most.  ``reference`` and ``check`` are two methods with their rtol (``atol = 1e-3 rtol``,
     analytic sparse Jacobian); the report holds the ``E`` between them.  The run starts as :func:`cvt_problem`
-    (``settle``: by the reference method; ``placed``), so both references share the start state.
+    (``settle``: by the reference method; ``placed``), so both references share the start state.  ``cache``: take
+    the reference outputs from there where it holds them, and keep those computed.
     """
     from cvtfem.integrate import solve
 
@@ -156,11 +210,12 @@ def pin_force_problem(scene, window: tuple[float, float] = (1e-3, 5e-3), sample:
     t_eval = t_eval[t_eval <= t2]
     base = replace(base, t_eval=t_eval)
     forces = {}
-    for method, rtol in (reference, check):
-        res = solve(**base.solve_kwargs(), method=method, rtol=rtol, atol=1e-3 * rtol, t_eval=t_eval)
-        if not res.success:
-            raise InputError("reference", method, f"must complete the reference run: {res.message}")
-        forces[method] = base.pin_forces(res.y)
+    for method, rtol in sorted((reference, check), key=lambda mr: cache is not None and cache.running(*mr)):
+        forces[method] = cache.reference(method, rtol, wait=False) if cache is not None else None
+        if forces[method] is None and cache is not None and cache.running(method, rtol):
+            forces[method] = cache.reference(method, rtol, wait=True)      # another process computes it
+        if forces[method] is None:
+            forces[method] = _reference_run(base, method, rtol, cache)
     p_all = forces[reference[0]]
     pin = int(np.argmax(np.ptp(p_all, axis=0)))
     problem = replace(base, pin=pin, p_ref=p_all[:, pin])
@@ -170,6 +225,25 @@ def pin_force_problem(scene, window: tuple[float, float] = (1e-3, 5e-3), sample:
               "reference_E": window_error(forces[check[0]][:, pin], p_all[:, pin]),
               "force_range": (float(p_all[:, pin].min()), float(p_all[:, pin].max()))}
     return problem, report
+
+
+def _reference_run(base: PinForceProblem, method: str, rtol: float, cache: StudyCache | None) -> np.ndarray:
+    """The output (samples, components) of ``base`` run by ``method`` at ``rtol``, kept in ``cache``."""
+    from cvtfem.integrate import solve
+
+    if cache is not None:
+        cache.mark_running(method, rtol)
+    try:
+        res = solve(**base.solve_kwargs(), method=method, rtol=rtol, atol=1e-3 * rtol, t_eval=base.t_eval)
+        if not res.success:
+            raise InputError("reference", method, f"must complete the reference run: {res.message}")
+        p = base.pin_forces(res.y)
+        if cache is not None:
+            cache.keep_reference(method, rtol, p)
+    finally:
+        if cache is not None:
+            cache.clear_running(method, rtol)
+    return p
 
 
 def jacobian_spectrum(loop, x, t: float = 0.0) -> np.ndarray:
@@ -189,11 +263,13 @@ def spectrum_with_v0(scene, x, factor: float = 0.1, t: float = 0.0) -> tuple[np.
     return jacobian_spectrum(closed_loop(scene), x, t), jacobian_spectrum(closed_loop(changed), x, t)
 
 
-def measure(problem: PinForceProblem, fixed, steps, adaptive, rtols, repeats: int = 3) -> list[dict]:
+def measure(problem: PinForceProblem, fixed, steps, adaptive, rtols, repeats: int = 3,
+            cache: StudyCache | None = None) -> list[dict]:
     """Test 2 for every fixed-step method at every step ``h`` (s) and every adaptive method at every rtol
     (``atol = 1e-3 rtol``): rows of :func:`~cvtfem.integrate.study.work_precision` (error = ``E``, wall time =
-    median of ``repeats``, RHS calls, Jacobians, LU factorisations) with a ``setting`` label; a method run both
-    ways is labelled ``"NAME adaptive"`` in its adaptive runs."""
+    median of ``repeats``, RHS calls, Jacobians, LU factorisations) with a ``setting`` label and ``cpu``, the CPU
+    time per run (s, with the error's evaluation); a method run both ways is labelled ``"NAME adaptive"`` in its
+    adaptive runs.  ``cache``: rows found there are not run again, rows run are kept there."""
     from cvtfem.integrate.study import work_precision
 
     both = {label for label, _, _ in fixed} & {label for label, _, _ in adaptive}
@@ -202,9 +278,19 @@ def measure(problem: PinForceProblem, fixed, steps, adaptive, rtols, repeats: in
     runs += [(label + " adaptive" if label in both else label, method,
               {**opts, "rtol": r, "atol": 1e-3 * r, "t_eval": problem.t_eval})
              for label, method, opts in adaptive for r in rtols]
-    rows = work_precision(problem, runs, repeats=repeats, error=problem.error)
-    for row in rows:
-        row["setting"] = f"h={row['h']:g}" if "h" in row else f"rtol={row['rtol']:g}"
+    rows = []
+    for label, method, opts in runs:
+        setting = f"h={opts['h']:g}" if "h" in opts else f"rtol={opts['rtol']:g}"
+        key = f"{label} {method} {setting}"
+        if cache is not None and key in cache.rows:
+            rows.append(cache.rows[key])
+            continue
+        cpu = time.process_time()
+        (row,) = work_precision(problem, [(label, method, opts)], repeats=repeats, error=problem.error)
+        row.update(setting=setting, cpu=(time.process_time() - cpu) / repeats)
+        if cache is not None:
+            cache.keep_row(key, row)
+        rows.append(row)
     return rows
 
 
@@ -216,7 +302,8 @@ def speedups(rows: list[dict], baseline: dict | None, accept: float = ACCEPT_E) 
         ok = [r for r in rows if r["label"] == label and r["error"] <= accept]
         best = min(ok, key=lambda r: r["time"]) if ok else None
         out.append({"label": label, "setting": best["setting"] if best else None,
-                    **{k: best.get(k) if best else None for k in ("error", "time", "nfev", "njev", "nlu", "nsteps")},
+                    **{k: best.get(k) if best else None for k in ("error", "time", "cpu", "nfev", "njev", "nlu",
+                                                                  "nsteps")},
                     "speedup": baseline["time"] / best["time"] if best and baseline else None})
     return out
 

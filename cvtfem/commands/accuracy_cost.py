@@ -38,6 +38,11 @@ def add_subparser(s) -> None:
     e.add_argument("--reference", default="Radau:1e-8", help="METHOD:RTOL of the reference run")
     e.add_argument("--check", default="rodas5p:1e-8", help="METHOD:RTOL of the second, independent reference")
     e.add_argument("--repeats", type=int, default=3, help="wall time = median of this many runs")
+    e.add_argument("--cache", default="",
+                   help="directory keeping the reference outputs and the rows of test 2: a study run again (or split "
+                        "over processes sharing it) runs only what it does not hold")
+    e.add_argument("--from-cache", action="store_true",
+                   help="with --cache: the tables and figures from every run the cache holds (runs nothing new)")
     e.add_argument("--png", default="out/studies/accuracy_cost.png", help="E against wall time and RHS calls")
     e.add_argument("--spectrum-png", default="out/studies/accuracy_cost_spectrum.png",
                    help="Jacobian eigenvalues at the window's start, with v0 and v0/10")
@@ -183,8 +188,14 @@ def run(args: argparse.Namespace) -> int:
     steps, rtols = _floats(args.steps, "--steps"), _floats(args.rtols, "--rtols")
     _check(args, fixed, steps, adaptive, rtols, window)
     reference, check = _pair(args.reference, "--reference"), _pair(args.check, "--check")
+    if args.from_cache and not args.cache:
+        raise InputError("--from-cache", True, "must come with --cache DIR (the directory whose runs it tabulates)")
     scene = load_scene(args.scene)
-    problem, report = ac.pin_force_problem(scene, window, args.sample, reference, check, args.settle, args.placed)
+    cache = ac.StudyCache(args.cache, f"{args.scene} window {args.window} sample {args.sample:g} settle "
+                                      f"{args.settle:g} placed {args.placed} reference {args.reference}"
+                          ) if args.cache else None
+    problem, report = ac.pin_force_problem(scene, window, args.sample, reference, check, args.settle, args.placed,
+                                           cache)
     t0, span = problem.t_span[0], window[1] - problem.t_span[0]
     unit = "N/m" if report["output"] == ac.BAND_FORCE else "N"
     what = f"{ac.output_component(report)} {'sheave normal' if unit == 'N/m' else 'axial'} force, {unit}"
@@ -201,7 +212,9 @@ def run(args: argparse.Namespace) -> int:
         spectrum = spectrum_summary(lam, lam_v0)
         print(f"spectrum at t = {t0:g} s: min Re {lam.real.min():.3g} 1/s ({lam_v0.real.min():.3g} with v0/10), max "
               f"|Im| {np.abs(lam.imag).max():.3g} 1/s ({np.abs(lam_v0.imag).max():.3g}), max Re {lam.real.max():.3g}")
-    rows = ac.measure(problem, fixed, steps, adaptive, rtols, args.repeats)
+    rows = (sorted(cache.rows.values(), key=lambda r: (r["label"], -r.get("h", r.get("rtol", 0.0))))
+            if args.from_cache else
+            ac.measure(problem, fixed, steps, adaptive, rtols, args.repeats, cache))
     base = ac.baseline_time(rows, BASELINE_H, span)
     table = ac.speedups(rows, base)
     how = ("none: no rk4 runs" if base is None else
@@ -217,15 +230,17 @@ def run(args: argparse.Namespace) -> int:
     write_csv(rows, _out(args.csv))
     with open(_out(args.json), "w", encoding="utf-8") as fh:
         json.dump({"scene": args.scene, "machine": machine(), "reference": report, "baseline": base,
-                   "wall_per_simulated_s": wall_per_simulated_second(table, span), "speedups": table,
+                   "wall_per_simulated_s": wall_per_simulated_second(table, span),
+                   "cpu_per_simulated_s": wall_per_simulated_second(table, span, "cpu"), "speedups": table,
                    "spectrum": spectrum}, fh, indent=1)
     print(f"wrote {args.png}, " + ("" if args.skip_spectrum else f"{args.spectrum_png}, ") + f"{args.csv}, {args.json}")
     return 0
 
 
-def wall_per_simulated_second(table, span: float) -> dict:
-    """Wall time (s) per simulated second of each method's cheapest accepted run over ``span`` s."""
-    return {t["label"]: t["time"] / span for t in table if t["time"] is not None}
+def wall_per_simulated_second(table, span: float, key: str = "time") -> dict:
+    """Wall time (``key = "cpu"``: CPU time), s, per simulated second of each method's cheapest accepted run over
+    ``span`` s."""
+    return {t["label"]: t[key] / span for t in table if t.get(key) is not None}
 
 
 def spectrum_summary(lam, lam_v0) -> dict:
@@ -238,13 +253,14 @@ def spectrum_summary(lam, lam_v0) -> dict:
 
 def markdown_table(table) -> list[str]:
     """The speed-up table in the style of the source's Table 2.4, as Markdown lines."""
-    lines = ["| method | cheapest setting with E <= 0.05 | E | wall s | RHS calls | Jacobians | LUs | steps | speed-up |",
-             "|---|---|---|---|---|---|---|---|---|"]
+    lines = ["| method | cheapest setting with E <= 0.05 | E | wall s | CPU s | RHS calls | Jacobians | LUs | steps | "
+             "speed-up |", "|---|---|---|---|---|---|---|---|---|---|"]
     for t in table:
         if t["setting"] is None:
-            lines.append(f"| {t['label']} | none | | | | | | | |")
+            lines.append(f"| {t['label']} | none | | | | | | | | |")
             continue
         up = f"{t['speedup']:.1f}x" if t["speedup"] else "-"
-        lines.append(f"| {t['label']} | {t['setting']} | {t['error']:.2e} | {t['time']:.2f} | {t['nfev']} | "
+        cpu = f"{t['cpu']:.2f}" if t.get("cpu") is not None else "-"
+        lines.append(f"| {t['label']} | {t['setting']} | {t['error']:.2e} | {t['time']:.2f} | {cpu} | {t['nfev']} | "
                      f"{t['njev']} | {t['nlu']} | {t['nsteps']} | {up} |")
     return lines

@@ -1,5 +1,5 @@
-"""Figures of the accuracy-cost study (issue 16): Jacobian spectra on the signed-log plane, and the global
-error of the pin force against wall time and RHS calls."""
+"""Figures of the accuracy-cost study (issue 16): Jacobian spectra on the signed-log plane, the global error of
+the pin force against wall time and RHS calls, and the force traces behind that error."""
 from __future__ import annotations
 
 import textwrap
@@ -101,6 +101,34 @@ def plot_local_errors(rows, path: str | Path, title: str = "") -> Path:
     for ax in (a1, a2):
         ax.grid(alpha=0.3, which="both")
     fig.suptitle(title or "local error and effective order", fontsize=9)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return Path(path)
+
+
+def plot_force_traces(t, reference, runs: dict, path: str | Path, accept: float, title: str = "",
+                      unit: str = "N") -> Path:
+    """Test 2's output over the window: the reference ``P*(t)`` and each run's ``P(t)`` (``label -> series``, top),
+    and their differences scaled as ``E``, ``(P - P*) / max |P*|`` (bottom, the acceptance ``+-accept`` dashed),
+    against ``t`` (s, drawn in ms)."""
+    t_ms = 1e3 * np.asarray(t)
+    scale = float(np.max(np.abs(reference)))
+    fig, (a1, a2) = plt.subplots(2, 1, figsize=(11, 7), sharex=True, gridspec_kw={"height_ratios": (3, 2)})
+    a1.plot(t_ms, reference, "k-", lw=1.4, label="reference")
+    for k, (label, p) in enumerate(runs.items()):
+        e = float(np.max(np.abs(p - reference)) / scale)
+        a1.plot(t_ms, p, "-", lw=0.8, color=f"C{k}", label=f"{label}: E = {e:.3g}")
+        a2.plot(t_ms, (p - reference) / scale, "-", lw=0.8, color=f"C{k}", label=label)
+    for s in (-accept, accept):
+        a2.axhline(s, color="k", ls="--", lw=0.8)
+    a1.set_ylabel(f"output, {unit}")
+    a2.set_ylabel("(P - P*) / max |P*|")
+    a2.set_xlabel("t, ms")
+    a1.legend(fontsize=8, loc="best")
+    for ax in (a1, a2):
+        ax.grid(alpha=0.3)
+    fig.suptitle(textwrap.fill(title or "output over the window", 130), fontsize=9)
     fig.tight_layout()
     fig.savefig(path, dpi=120)
     plt.close(fig)
