@@ -265,6 +265,10 @@ class ChainHalvesCVT(ChainACVT):
     #: steps 0.003, 0.001, without which the untied solve of variant (e) (H2) stopped at 2.7e-3 of F2.
     LIFTS: ClassVar[tuple[float, ...]] = (1e-9, 1e-7, 1e-5, 1e-4, 1e-3)
     STEPS: ClassVar[tuple[float, ...]] = (1.0, 0.5, 0.25, 0.1, 0.03, 0.01, 0.003, 0.001)
+    #: Lifted Newton iterations per stage: the untied stage crawls (about 0.5 % of ``|r|`` per iteration) where the
+    #: span halves' axial positions hold nothing; at ratio 0.45 (chapter 2) the uniform chain of variant (e) stopped at
+    #: 7.4e-4 of F2 after the default 150 and converges to 3.7e-5 after 461 (docs/accuracy-cost.md, session 9).
+    NEWTON_ITERATIONS: ClassVar[int] = 600
 
     @property
     def n_ends(self) -> int:
@@ -522,7 +526,8 @@ class ChainHalvesCVT(ChainACVT):
         lifted Newton stalled on them at 2.5e-2 of F2 (central differences average the two sides)."""
         scheme, self.family.scheme = self.family.scheme, "central"
         try:
-            return lifted_newton(residual, jacobian, y0, tol, damped=0, lifts=self.LIFTS, steps=self.STEPS)
+            return lifted_newton(residual, jacobian, y0, tol, damped=0, lifts=self.LIFTS, steps=self.STEPS,
+                                 iterations=self.NEWTON_ITERATIONS)
         finally:
             self.family.scheme = scheme
 
