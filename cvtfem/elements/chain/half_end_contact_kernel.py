@@ -15,7 +15,7 @@ from __future__ import annotations
 import numpy as np
 
 from cvtfem.elements.chain.half_end_contact import N_POS, _gather, _spread
-from cvtfem.elements.chain.sheave_contact_kernel import _inputs, _near
+from cvtfem.elements.chain.sheave_contact_kernel import _inputs, _near, scatter_jacobian
 from cvtfem.elements.chain.sheave_contact_refined_kernel import refined_local_kernel
 from cvtfem.elements.chain.symmetric import END_SLOPE_FACTOR
 from cvtfem.elements.contact.kernels import LAW_CODES
@@ -112,23 +112,7 @@ def jacobian(y, cols, coef, shaft, rows, rw, centres, r2, meridians, face_radius
         for t in range(m):
             for o in range(N_OUT):
                 Jl[t, o, j] = (Yp[t, o] - Ym[t, o]) / (2 * steps[j])
-    K, nf = cols.shape[2], rows.shape[1]
-    n = 0
-    for t in range(m):
-        i = pair[t]
-        for j in range(N_IN):
-            for b in range(K):
-                col, cw = cols[i, j, b], coef[i, j, b]
-                if col >= n_state or cw == 0.0:
-                    continue
-                dD[col] -= cw * Jl[t, nf, j]
-                for o in range(nf):
-                    for a in range(K):
-                        val = rw[i, o, a] * Jl[t, o, j] * cw
-                        if val != 0.0:
-                            r_out[n], c_out[n], v_out[n] = rows[i, o, a], col, val
-                            n += 1
-    return n
+    return scatter_jacobian(pair[:m], Jl, cols, coef, rows, rw, n_state, dD, r_out, c_out, v_out)
 
 
 __all__ = ["STEPS", "forces", "jacobian", "pack"]

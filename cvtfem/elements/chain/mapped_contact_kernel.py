@@ -26,6 +26,7 @@ from cvtfem.elements.chain.half_end_contact import _gather as _half_gather
 from cvtfem.elements.chain.half_end_contact import _spread as _half_spread
 from cvtfem.elements.chain.sheave_contact_kernel import _local as _point_local
 from cvtfem.elements.chain.sheave_contact_kernel import pack as _pack_point_kernel
+from cvtfem.elements.chain.sheave_contact_kernel import scatter_jacobian
 from cvtfem.elements.chain.sheave_contact_refined_kernel import refined_local_kernel
 from cvtfem.elements.chain.symmetric import END_SLOPE_FACTOR
 from cvtfem.elements.contact.kernels import LAW_CODES
@@ -362,22 +363,7 @@ def jacobian(y, cols, coef, shaft, sheave, rows, rw, centres, r2, frame, ends, k
         for t in range(m):
             for o in range(n_out):
                 Jl[t, o, j] = (Rp[t, o] - Rm[t, o]) / (2 * steps[j])
-    K, nf = cols.shape[2], rows.shape[1]
-    n = 0
-    for t in range(m):
-        i = pair[t]
-        for j in range(n_in):
-            for b in range(K):
-                col, cw = cols[i, j, b], coef[i, j, b]
-                if col >= n_state or cw == 0.0:
-                    continue
-                dD[col] -= cw * Jl[t, nf, j]
-                for o in range(nf):
-                    for a in range(K):
-                        val = rw[i, o, a] * Jl[t, o, j] * cw
-                        if val != 0.0:
-                            r_out[n], c_out[n], v_out[n] = rows[i, o, a], col, val
-                            n += 1
+    n = scatter_jacobian(pair[:m], Jl, cols, coef, rows, rw, n_state, dD, r_out, c_out, v_out)
     return n, bad
 
 

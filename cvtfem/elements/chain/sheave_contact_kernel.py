@@ -162,4 +162,28 @@ def jacobian(y, cols, coef, shaft, rows, rw, centres, r2, prof, c, par, law, ste
     return n
 
 
-__all__ = ["STEPS", "forces", "jacobian", "pack"]
+@njit(cache=True)
+def scatter_jacobian(pair, Jl, cols, coef, rows, rw, n_state, dD, r_out, c_out, v_out) -> int:
+    """Local contact Jacobians ``Jl`` (m, nf + 1, n_in) of the candidates ``pair`` (m,) mapped on both sides into the
+    entries ``r_out``, ``c_out``, ``v_out`` of ``dQ/dy`` (over ``y[:n_state]``; their count returned), the last output
+    row (the friction power) as ``-d(power)/dy`` added to ``dD``: ``R^T Jl P`` as ``ChainCVT._contact_entries``."""
+    K, nf = cols.shape[2], rows.shape[1]
+    n = 0
+    for t in range(pair.shape[0]):
+        i = pair[t]
+        for j in range(Jl.shape[2]):
+            for b in range(K):
+                col, cw = cols[i, j, b], coef[i, j, b]
+                if col >= n_state or cw == 0.0:
+                    continue
+                dD[col] -= cw * Jl[t, nf, j]
+                for o in range(nf):
+                    for a in range(K):
+                        val = rw[i, o, a] * Jl[t, o, j] * cw
+                        if val != 0.0:
+                            r_out[n], c_out[n], v_out[n] = rows[i, o, a], col, val
+                            n += 1
+    return n
+
+
+__all__ = ["STEPS", "forces", "jacobian", "pack", "scatter_jacobian"]
