@@ -70,7 +70,8 @@ def _shaft(name: str, doc: str) -> Table:
             "N m/rad", gt=0.0),
         Key("shaft_length", "float", "Length between the bearings (elastic shaft models).", "m", gt=0.0),
         Key("shaft_diameter", "float", "Shaft diameter (elastic shaft models).", "m", gt=0.0),
-        Key("shaft_elements", "int", "Beam elements of the elastic shaft model.", "-", ge=1),
+        Key("shaft_elements", "int", "Beam elements of the elastic shaft model (at most 500: 8 resolve the first "
+            "three bending modes).", "-", ge=1, le=500),
         Key("bearing_stiffness", "float", "Radial stiffness of each of the two bearings.", "N/m", gt=0.0),
         Key("bearing_damping", "float", "Radial damping of each bearing.", "N s/m", ge=0.0),
         Key("sheave_offset", "float", "Axial distance of each sheave's centre of mass from the chain mid-plane "
