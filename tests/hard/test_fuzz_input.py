@@ -13,7 +13,7 @@ from pathlib import Path
 
 import pytest
 import tomli_w
-from hypothesis import HealthCheck, given, settings
+from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
 
 from cvtfem.cli import main
@@ -100,6 +100,10 @@ TOKENS = st.sampled_from(["describe", "scenes", "show", "docs", "run", "modes", 
 @settings(max_examples=300, deadline=None)
 @given(argv=st.lists(TOKENS, max_size=5))
 def test_random_cli_arguments_fail_clearly(argv):
+    # `run reference_cvt` (without a failing token) is a valid run of variant (e) on elastic shafts: hours, not an
+    # input error (the draw ["run", "reference_cvt"] hung the default suite); runs are fuzzed with a bounded
+    # `--until` in test_fuzz_commands.
+    assume(not ("run" in argv and "reference_cvt" in argv))
     with tempfile.TemporaryDirectory() as tmp, contextlib.chdir(tmp):  # commands may write files
         code, err = _run_cli(argv)
     assert code in (0, 2), (argv, err)
