@@ -15,7 +15,7 @@ from __future__ import annotations
 import numpy as np
 
 from cvtfem.elements.chain.half_end_contact import N_POS, _gather, _spread
-from cvtfem.elements.chain.sheave_contact_kernel import _inputs, _near, scatter_jacobian
+from cvtfem.elements.chain.sheave_contact_kernel import _inputs, _near, scatter_forces, scatter_jacobian
 from cvtfem.elements.chain.sheave_contact_refined_kernel import refined_local_kernel
 from cvtfem.elements.chain.symmetric import END_SLOPE_FACTOR
 from cvtfem.elements.contact.kernels import LAW_CODES
@@ -79,15 +79,7 @@ def forces(y, cols, coef, shaft, rows, rw, centres, r2, meridians, face_radius, 
     m = _candidates(y, cols, coef, shaft, centres, r2, X, sh, pair)
     Y = np.empty((m, N_OUT))
     bad = _local(X[:m], sh[:m], centres, meridians, face_radius, slope_factor, c, par, law, Y)
-    K, nf = cols.shape[2], rows.shape[1]
-    power = 0.0
-    for j in range(m):
-        i = pair[j]
-        for o in range(nf):
-            for a in range(K):
-                Q[rows[i, o, a]] += rw[i, o, a] * Y[j, o]
-        power += Y[j, nf]
-    return power, (pair[bad] if bad >= 0 else -1)
+    return scatter_forces(pair[:m], Y, rows, rw, Q), (pair[bad] if bad >= 0 else -1)
 
 
 @njit(cache=True)

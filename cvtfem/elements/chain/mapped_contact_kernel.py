@@ -26,7 +26,7 @@ from cvtfem.elements.chain.half_end_contact import _gather as _half_gather
 from cvtfem.elements.chain.half_end_contact import _spread as _half_spread
 from cvtfem.elements.chain.sheave_contact_kernel import _local as _point_local
 from cvtfem.elements.chain.sheave_contact_kernel import pack as _pack_point_kernel
-from cvtfem.elements.chain.sheave_contact_kernel import scatter_jacobian
+from cvtfem.elements.chain.sheave_contact_kernel import scatter_forces, scatter_jacobian
 from cvtfem.elements.chain.sheave_contact_refined_kernel import refined_local_kernel
 from cvtfem.elements.chain.symmetric import END_SLOPE_FACTOR
 from cvtfem.elements.contact.kernels import LAW_CODES
@@ -319,15 +319,7 @@ def forces(y, cols, coef, shaft, sheave, rows, rw, centres, r2, frame, ends, kin
     R, dK = np.empty((m, n_out)), np.empty((m, N_PATTERN))
     bad = mapped_outputs(Zall[:m], sh[:m], sv, centres, frame, kind, meridians, face_radius, slope_factor, c,
                          par, law, prof, axial_relative, share, R, dK)
-    K, nf = cols.shape[2], rows.shape[1]
-    power = 0.0
-    for t in range(m):
-        i = pair[t]
-        for o in range(nf):
-            for a in range(K):
-                Q[rows[i, o, a]] += rw[i, o, a] * R[t, o]
-        power += R[t, nf]
-    return power, (pair[bad] if bad >= 0 else -1)
+    return scatter_forces(pair[:m], R, rows, rw, Q), (pair[bad] if bad >= 0 else -1)
 
 
 @njit(cache=True)

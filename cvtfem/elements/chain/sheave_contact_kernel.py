@@ -163,6 +163,21 @@ def jacobian(y, cols, coef, shaft, rows, rw, centres, r2, prof, c, par, law, ste
 
 
 @njit(cache=True)
+def scatter_forces(pair, R, rows, rw, Q) -> float:
+    """Add the local contact outputs ``R`` (m, nf + 1) of the candidates ``pair`` (m,) through their output rows into
+    ``Q`` (n2,); return the summed last output (the friction power, W)."""
+    K, nf = rows.shape[2], rows.shape[1]
+    power = 0.0
+    for t in range(pair.shape[0]):
+        i = pair[t]
+        for o in range(nf):
+            for a in range(K):
+                Q[rows[i, o, a]] += rw[i, o, a] * R[t, o]
+        power += R[t, nf]
+    return power
+
+
+@njit(cache=True)
 def scatter_jacobian(pair, Jl, cols, coef, rows, rw, n_state, dD, r_out, c_out, v_out) -> int:
     """Local contact Jacobians ``Jl`` (m, nf + 1, n_in) of the candidates ``pair`` (m,) mapped on both sides into the
     entries ``r_out``, ``c_out``, ``v_out`` of ``dQ/dy`` (over ``y[:n_state]``; their count returned), the last output
@@ -186,4 +201,4 @@ def scatter_jacobian(pair, Jl, cols, coef, rows, rw, n_state, dD, r_out, c_out, 
     return n
 
 
-__all__ = ["STEPS", "forces", "jacobian", "pack", "scatter_jacobian"]
+__all__ = ["STEPS", "forces", "jacobian", "pack", "scatter_forces", "scatter_jacobian"]
