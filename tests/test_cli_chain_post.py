@@ -12,6 +12,7 @@ from cvtfem.io.results import ResultsWriter, read_results
 from cvtfem.machines.cvt import chain_loop
 from cvtfem.outputs import OutputSpec
 from cvtfem.post import chain_revolution as cr
+from cvtfem.post import spectrogram as sg
 from cvtfem.post.history import history
 from cvtfem.scene.loader import load_scene
 
@@ -61,6 +62,30 @@ def test_a_followed_link_sees_the_field_the_whole_chain_shows_at_an_instant(marc
         expected = np.interp(s % 1.0, at.s_raw, at.y_raw[:, 0], period=1.0)
         np.testing.assert_allclose(y, expected, rtol=1e-9, atol=1e-9 * abs(expected).max())
     assert (tmp_path / "follow.png").stat().st_size > 10_000
+
+
+def test_chain_frequencies_of_a_chain_gliding_along_its_placement(tmp_path):
+    """chain-S2 pins gliding along the polygon of their placement (ratio 0.45), a tenth of a pitch per 10 us row:
+    f_link = 10 kHz and f_chain = f_link / n, read from the pins' travel alone (no speed or contact radius is
+    stored); to the polygon's corner cutting, which shortens the path per pitch by at most (p / r)^2 / 8."""
+    scene = load_scene("chain-S2")
+    model = chain_loop(scene)
+    n = model.family.n
+    pl = place_on_path(model.family.geom.L, 0.45, model.contact.centres[0, 0])
+    u0 = np.vstack([pl.u, pl.u[:1]])
+    arc = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(u0, axis=0), axis=1))])
+    pitch = arc[-1] / n
+    spec = [s for s in model.output_specs if s.name == "chain.coordinates"]
+    path = tmp_path / "glide.h5"
+    with ResultsWriter(path, scene.to_toml(), "run", spec) as w:
+        for j in range(25):
+            at = (arc[:-1] + 0.1 * j * pitch) % arc[-1]
+            u = np.column_stack([np.interp(at, arc, u0[:, k]) for k in (0, 1)])
+            w.append(1e-5 * j, {"chain.coordinates": model._placed(replace(pl, u=u), np.zeros(n))})
+    freqs = sg.chain_frequencies(read_results(path), n, arc[-1], 0.1746)
+    r_min = np.min([np.linalg.norm(pl.u - c, axis=1).min() for c in model.contact.centres])
+    np.testing.assert_allclose(freqs.f_link, 1e4, rtol=(pitch / r_min) ** 2 / 8)
+    np.testing.assert_allclose(freqs.f_chain * n, freqs.f_link, rtol=1e-15)
 
 
 @pytest.mark.parametrize("args, option, allowed", [

@@ -43,9 +43,9 @@ def _read(path):
 def test_runcampbell_tracks_continuously_and_draws_the_run_lines(stored, campbell_csv):
     """From stored state to stored state (10 us apart) each tracked mode below 2.5 kHz keeps a MAC above 0.9 with
     its predecessor and moves by less than half the gap to the nearest other curve (continuous curves); the first
-    row's modes are J11's at the first stored state; the lines in the CSV are k f_chain with
-    f_chain = omega_1 r_1 / l_chain from the stored speeds and contact radii, and k/3 f_link with
-    f_link = n_pins f_chain."""
+    row's modes are J11's at the first stored state; the lines in the CSV are k f_chain with f_chain the pins'
+    mean speed over the loop's length (here from the stored velocities; the command differentiates the stored
+    positions: 1e-3), and k/3 f_link with f_link = n_pins f_chain."""
     png, out = campbell_csv
     assert png.stat().st_size > 10_000
     header, rows = _read(out)
@@ -65,13 +65,17 @@ def test_runcampbell_tracks_continuously_and_draws_the_run_lines(stored, campbel
     s = model.structure
     first = block_modes(structure_block(model, t[0], x[0]), s.dof_kind, s.M.diagonal())
     np.testing.assert_allclose(np.sort(hz[0]), np.sort(first.wd[:10] / (2 * np.pi)), rtol=1e-5)
-    n_pins, length, _ = chain_of(results)
-    r = results.series["contact.radius"].reshape(len(t), -1, 2)[:, :, 0]
-    f_chain = results.series["driving.speed"][:, 0] * r.sum(axis=1) / (r > 0).sum(axis=1) / length
+    n_pins, _, _ = chain_of(results)
+    f_chain = []                                       # the pins' mean speed over the loop, from the stored states
+    for row in x:
+        q, v = model.split(row)[:2]
+        u, w = model.pin_positions(q[:model.family.size]), model.pin_positions(v[:model.family.size])
+        f_chain.append(np.linalg.norm(w, axis=1).mean() / np.linalg.norm(np.roll(u, -1, axis=0) - u, axis=1).sum())
+    f_chain = np.array(f_chain)
     got = np.array([[float(row[col[f"{k}_f_chain_Hz"]]) for k in (1, 2, 3)] for row in rows])
-    np.testing.assert_allclose(got, np.outer(f_chain, [1, 2, 3]), rtol=1e-5)
-    np.testing.assert_allclose([float(row[col["f_link_Hz"]]) for row in rows], n_pins * f_chain, rtol=1e-5)
-    np.testing.assert_allclose([float(row[col["1/3_f_link_Hz"]]) for row in rows], n_pins * f_chain / 3, rtol=1e-5)
+    np.testing.assert_allclose(got, np.outer(f_chain, [1, 2, 3]), rtol=1e-3)
+    np.testing.assert_allclose([float(row[col["f_link_Hz"]]) for row in rows], n_pins * f_chain, rtol=1e-3)
+    np.testing.assert_allclose([float(row[col["1/3_f_link_Hz"]]) for row in rows], n_pins * f_chain / 3, rtol=1e-3)
 
 
 def test_jacobian_spectrum_of_a_stored_state(stored, tmp_path):

@@ -24,8 +24,8 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--chain-orders", default="1,2,3", metavar="K,...",
                    help="draw the lines k f_chain for these k (default 1,2,3; '' for none)")
     p.add_argument("--f-chain", type=float, default=None, metavar="HZ",
-                   help="chain revolution frequency, Hz, instead of omega_1 r_1 / l_chain (e.g. the measured "
-                        "pin-entry line / n_pins)")
+                   help="chain revolution frequency, Hz, instead of the one read from the run (a discrete "
+                        "chain's pins' travel; band models: omega_1 r_1 / l_chain)")
     p.add_argument("--campbell", metavar="CSV", help="draw the tracked modes of a `cvtfem runcampbell --csv` file "
                                                      "of the same run over the spectrogram")
     p.add_argument("--no-lines", action="store_true", help="draw no excitation lines (a run without a chain)")
