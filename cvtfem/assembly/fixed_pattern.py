@@ -4,7 +4,8 @@ A model builds its pattern and the positions of its constant parts once; per cal
 :func:`add_mixed_rows` (a block-diagonal map ``B`` times a matrix whose rows in each block share one column list,
 as ``M^-1 dQ/dq`` of a chain family), :func:`add_mixed_runs` (the same where each row lands on consecutive
 positions), :func:`add_mixed_entries` (``B`` times COO entries, located by binary search) and
-:func:`csr_matvec_into` (``B x`` into a slice); :func:`compact` drops the entries left zero.  Their numpy twin is
+:func:`csr_matvec_into` (``B x`` into a slice); :func:`compact` drops the entries left zero; :func:`pair_offsets`
+places a table of local maps (contacts) in the pattern once.  Their numpy twin is
 scipy's sparse algebra (``tests/assembly/test_fixed_pattern.py``).
 """
 from __future__ import annotations
@@ -155,5 +156,23 @@ def shared_rows(pattern: sp.csr_matrix, row_offset: int, b: sp.csc_matrix) -> bo
     return True
 
 
-__all__ = ["add_mixed_entries", "add_mixed_rows", "add_mixed_runs", "compact", "csr_matvec_into", "positions",
-           "runs", "shared_rows"]
+def pair_offsets(pattern: sp.csr_matrix, row_offset: int, b: sp.csc_matrix, cols, rows) -> np.ndarray:
+    """Offsets (int64, ``(P, nf, K, n_in, K)``) of the local entries ``(rows[i, o, a], cols[i, j, b])`` of a table of
+    ``P`` local maps within the first pattern row that column ``rows[i, o, a]`` of the CSC map ``b`` spreads to
+    (``row_offset + b.indices[b.indptr[r]]``; the rows it spreads to must share one column list,
+    :func:`shared_rows`); -1 where that row has no such column, 0 where ``b`` spreads the row nowhere.  The
+    position table of :func:`cvtfem.elements.chain.sheave_contact_kernel.scatter_jacobian_into`, built once."""
+    rows, cols = np.asarray(rows, np.int64), np.asarray(cols, np.int64)
+    P, nf, K = rows.shape
+    n_in = cols.shape[1]
+    spread = np.diff(b.indptr)[rows] > 0                                    # (P, nf, K)
+    r0 = row_offset + b.indices[np.minimum(b.indptr[rows], len(b.indices) - 1)]
+    rr = np.broadcast_to(r0[:, :, :, None, None], (P, nf, K, n_in, K))
+    cc = np.broadcast_to(cols[:, None, None, :, :], (P, nf, K, n_in, K))
+    pos = positions(pattern, rr.ravel(), cc.ravel()).reshape(rr.shape)
+    off = np.where(pos >= 0, pos - pattern.indptr[rr], -1)
+    return np.ascontiguousarray(np.where(spread[:, :, :, None, None], off, 0), np.int64)
+
+
+__all__ = ["add_mixed_entries", "add_mixed_rows", "add_mixed_runs", "compact", "csr_matvec_into", "pair_offsets",
+           "positions", "runs", "shared_rows"]

@@ -24,6 +24,7 @@ import scipy.sparse as sp
 from cvtfem.assembly import fixed_pattern as FP
 from cvtfem.elements.base import Block
 from cvtfem.elements.chain import halves_kernel as HK
+from cvtfem.elements.chain import sheave_contact_kernel as SK
 from cvtfem.elements.chain.halves import ChainA5
 from cvtfem.elements.chain.halves_placement import half_centres, rolling_link_directions, rolling_spacing
 from cvtfem.elements.chain.placement import Placement, place_on_path
@@ -347,8 +348,9 @@ class ChainHalvesCVT(ChainACVT):
     def _jac_plan(self) -> dict | None:
         """Positions in the data of the sorted :attr:`jac_sparsity` of every constant part of :meth:`jac` (built once):
         the ``x' = v`` rows, the chain family's entries after ``M^-1`` (the rows a mass block couples share the family
-        pattern's column list), the loops' rows and the work rows; None where the family's pattern does not allow
-        that (ChainCVT's general assembly then)."""
+        pattern's column list), the loops' rows, the work rows and, per contact pair of the table, the offsets of its
+        local entries after ``M^-1`` (:func:`~cvtfem.assembly.fixed_pattern.pair_offsets`: no search per call); None
+        where the family's pattern does not allow that (ChainCVT's general assembly then)."""
         if not self._one_pass:
             return None
         P = sp.csr_matrix(self.jac_sparsity, dtype=bool, copy=True)
@@ -377,7 +379,10 @@ class ChainHalvesCVT(ChainACVT):
         runs = [FP.runs(t, fp.indptr) for t in (fam_q, fam_v)]
         shared = FP.shared_rows(P, n2, Mc)
         fam = [(FP.add_mixed_rows, t) if r is None else (FP.add_mixed_runs, r) for t, r in zip((fam_q, fam_v), runs)]
-        return dict(P=P, fam=fam, ctrl=ctrl, top=top, in_cols=in_cols,
+        table = self._pair_table
+        contact = (FP.pair_offsets(P, n2, Mc, table[0], table[3]) if shared and self._compiled_contact is not None
+                   and type(self)._contact_jacobian is ChainCVT._contact_jacobian else None)
+        return dict(P=P, fam=fam, ctrl=ctrl, top=top, in_cols=in_cols, contact=contact,
                     work=(first, work_rows, P.indices[first:].astype(np.int64)),
                     mixing=(Mc.indptr.astype(np.int64), Mc.indices.astype(np.int64), Mc.data.astype(float), shared))
 
@@ -401,7 +406,17 @@ class ChainHalvesCVT(ChainACVT):
         data[plan["top"]] = 1.0
         for (add, where), J in zip(plan["fam"], (Jq, Jv)):
             add(data, where, J, fam.jac_sparsity.indptr, *mi)
-        (r, c, d), dD_contact = self._contact_jacobian(q, v)
+        if plan["contact"] is None:
+            (r, c, d), dD_contact = self._contact_jacobian(q, v)
+        else:                                     # straight into the pattern through the positions built once
+            r, c, d = np.zeros(0, np.int64), np.zeros(0, np.int64), np.zeros(0)
+            dD_contact = np.zeros(2 * n2)
+            table, K = self._pair_table, self._contact_kernel
+            pair, Jl = K.local_jacobians(np.concatenate([q, v, self._constants]), *table, *self._compiled_contact,
+                                         K.STEPS)
+            if SK.scatter_jacobian_into(pair, Jl, table[0], table[1], table[3], table[4], 2 * n2, dD_contact,
+                                        plan["contact"], data, P.indptr, n2, *plan["mixing"][:3]):
+                return super().jac(t, x)
         r = np.concatenate([r, np.repeat(iz, len(in_cols)), np.full(len(in_cols), iphi[1])])
         c = np.concatenate([c, np.tile(in_cols, 2), in_cols])
         d = np.concatenate([d, -self.sheaves_per_z * G[:2].ravel(), G[2]])

@@ -105,3 +105,41 @@ def test_compact_equals_eliminate_zeros_and_leaves_the_pattern():
     B.eliminate_zeros()
     assert np.array_equal(data, B.data) and np.array_equal(ci, B.indices) and np.array_equal(cp, B.indptr)
     assert np.array_equal(A.indices, indices) and np.array_equal(A.indptr, indptr)
+
+
+def test_pair_offsets_and_scatter_into_the_pattern_equal_the_coo_path():
+    """A table of local maps (contacts: output rows ``R``, input columns ``P``, duplicates and zero weights) scattered
+    ``B R^T Jl P`` straight into the pattern through :func:`pair_offsets` equals its COO entries
+    (:func:`sheave_contact_kernel.scatter_jacobian`) through :func:`add_mixed_entries`, and the power rows alike; an
+    entry outside the pattern is counted, not written."""
+    from cvtfem.elements.chain.sheave_contact_kernel import scatter_jacobian, scatter_jacobian_into
+    rng = np.random.default_rng(11)
+    n, off, P_, nf, K, n_in = 30, 4, 7, 3, 2, 5
+    B = sp.csc_matrix(_block_map(rng, n))
+    mix = (B.indptr.astype(np.int64), B.indices.astype(np.int64), B.data)
+    cols = rng.integers(0, 2 * n, (P_, n_in, K))
+    coef = rng.normal(size=(P_, n_in, K))
+    coef[0, 1, 1] = 0.0
+    rows = rng.integers(0, n, (P_, nf, K))
+    rw = rng.normal(size=(P_, nf, K))
+    pair = np.array([5, 1, 3, 1], np.int64)                       # pair 1 twice: its entries add up
+    Jl = rng.normal(size=(len(pair), nf + 1, n_in))
+    full = np.zeros((n + off, 2 * n))
+    full[off:] = 1.0
+    Pat = sp.csr_matrix(full)
+    Pat.sort_indices()
+    size = len(pair) * nf * K * n_in * K
+    r, c, d, dD_coo = np.empty(size, np.int64), np.empty(size, np.int64), np.empty(size), np.zeros(2 * n)
+    k = scatter_jacobian(pair, Jl, cols, coef, rows, rw, 2 * n, dD_coo, r, c, d)
+    want = np.zeros(Pat.nnz)
+    assert FP.add_mixed_entries(want, Pat.indptr, Pat.indices, off, r[:k], c[:k], d[:k], *mix, True) == 0
+    offsets = FP.pair_offsets(Pat, off, B, cols, rows)
+    got, dD = np.zeros(Pat.nnz), np.zeros(2 * n)
+    assert scatter_jacobian_into(pair, Jl, cols, coef, rows, rw, 2 * n, dD, offsets, got, Pat.indptr, off, *mix) == 0
+    assert np.abs(got - want).max() <= 1e-14 * np.abs(want).max() and np.abs(want).max() > 0
+    assert np.array_equal(dD, dD_coo)
+    sparse = sp.csr_matrix(np.eye(n + off, 2 * n))                # most entries outside
+    offsets = FP.pair_offsets(sparse, off, B, cols, rows)
+    assert (offsets < 0).any()
+    assert scatter_jacobian_into(pair, Jl, cols, coef, rows, rw, 2 * n, np.zeros(2 * n), offsets,
+                                 np.zeros(sparse.nnz), sparse.indptr, off, *mix) > 0

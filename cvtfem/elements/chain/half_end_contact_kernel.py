@@ -83,12 +83,10 @@ def forces(y, cols, coef, shaft, rows, rw, centres, r2, meridians, face_radius, 
 
 
 @njit(cache=True)
-def jacobian(y, cols, coef, shaft, rows, rw, centres, r2, meridians, face_radius, slope_factor, c, par, law, steps,
-             n_state, r_out, c_out, v_out, dD):
-    """Entries of ``dQ/dy`` of :func:`forces` (over ``y[:n_state]``) into ``r_out``, ``c_out``, ``v_out`` (their count
-    returned) and ``-d(friction power)/dy`` added to ``dD``: per candidate the local Jacobian (10, 17) by central
-    differences with ``steps`` (``HalfEndContact.local_jacobian``: one perturbed input column for all candidates at
-    once), mapped on both sides ``R^T (dY/dX) P``."""
+def local_jacobians(y, cols, coef, shaft, rows, rw, centres, r2, meridians, face_radius, slope_factor, c, par, law,
+                    steps):
+    """``(pair (m,), Jl (m, 10, 17))``: the candidates and their local Jacobians by central differences with ``steps``
+    (``HalfEndContact.local_jacobian``: one perturbed input column for all candidates at once)."""
     P = cols.shape[0]
     X, sh, pair = np.empty((P, N_IN)), np.empty(P, np.int64), np.empty(P, np.int64)
     m = _candidates(y, cols, coef, shaft, centres, r2, X, sh, pair)
@@ -104,7 +102,17 @@ def jacobian(y, cols, coef, shaft, rows, rw, centres, r2, meridians, face_radius
         for t in range(m):
             for o in range(N_OUT):
                 Jl[t, o, j] = (Yp[t, o] - Ym[t, o]) / (2 * steps[j])
-    return scatter_jacobian(pair[:m], Jl, cols, coef, rows, rw, n_state, dD, r_out, c_out, v_out)
+    return pair[:m], Jl
 
 
-__all__ = ["STEPS", "forces", "jacobian", "pack"]
+@njit(cache=True)
+def jacobian(y, cols, coef, shaft, rows, rw, centres, r2, meridians, face_radius, slope_factor, c, par, law, steps,
+             n_state, r_out, c_out, v_out, dD):
+    """Entries of ``dQ/dy`` of :func:`forces` (over ``y[:n_state]``) into ``r_out``, ``c_out``, ``v_out`` (their count
+    returned) and ``-d(friction power)/dy`` added to ``dD``: the local Jacobians of :func:`local_jacobians` (10, 17)
+    mapped on both sides ``R^T (dY/dX) P``."""
+    pair, Jl = local_jacobians(y, cols, coef, shaft, rows, rw, centres, r2, meridians, face_radius, slope_factor, c,
+                               par, law, steps)
+    return scatter_jacobian(pair, Jl, cols, coef, rows, rw, n_state, dD, r_out, c_out, v_out)
+
+__all__ = ["STEPS", "forces", "jacobian", "local_jacobians", "pack"]

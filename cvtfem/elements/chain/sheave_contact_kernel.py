@@ -124,16 +124,12 @@ def forces(y, cols, coef, shaft, rows, rw, centres, r2, prof, c, par, law, Q, st
 
 
 @njit(cache=True)
-def jacobian(y, cols, coef, shaft, rows, rw, centres, r2, prof, c, par, law, steps, n_state, r_out, c_out, v_out,
-             dD):
-    """Entries of ``dQ/dy`` of :func:`forces` (over ``y[:n_state]``, the constants dropped) into ``r_out``,
-    ``c_out``, ``v_out`` (their count returned) and ``-d(friction power)/dy`` added to ``dD``: per candidate the
-    local Jacobian ``dY/dX`` (6, 9) by central differences with ``steps`` (9,) mapped on both sides,
-    ``R^T (dY/dX) P`` (``ChainCVT._contact_entries``)."""
+def local_jacobians(y, cols, coef, shaft, rows, rw, centres, r2, prof, c, par, law, steps):
+    """``(pair (m,), Jl (m, 6, 9))``: the candidates and their local Jacobians ``dY/dX`` by central differences with
+    ``steps`` (9,)."""
     X, Xs, Yp, Ym = np.zeros(N_IN), np.zeros(N_IN), np.zeros(N_OUT), np.zeros(N_OUT)
-    Jl = np.zeros((N_OUT, N_IN))
-    K = cols.shape[2]
-    n = 0
+    pair, Jl = np.empty(cols.shape[0], np.int64), np.empty((cols.shape[0], N_OUT, N_IN))
+    m = 0
     for i in range(cols.shape[0]):
         k = shaft[i]
         if not _near(y, cols, coef, i, centres[k], r2):
@@ -146,20 +142,20 @@ def jacobian(y, cols, coef, shaft, rows, rw, centres, r2, prof, c, par, law, ste
             Xs[j] = X[j] - steps[j]
             _local(Xs, k, centres, prof, c, par, law, Ym)
             for o in range(N_OUT):
-                Jl[o, j] = (Yp[o] - Ym[o]) / (2 * steps[j])
-        for j in range(N_IN):
-            for b in range(K):
-                col, cw = cols[i, j, b], coef[i, j, b]
-                if col >= n_state or cw == 0.0:
-                    continue
-                dD[col] -= cw * Jl[N_OUT - 1, j]
-                for o in range(N_OUT - 1):
-                    for a in range(K):
-                        val = rw[i, o, a] * Jl[o, j] * cw
-                        if val != 0.0:
-                            r_out[n], c_out[n], v_out[n] = rows[i, o, a], col, val
-                            n += 1
-    return n
+                Jl[m, o, j] = (Yp[o] - Ym[o]) / (2 * steps[j])
+        pair[m] = i
+        m += 1
+    return pair[:m], Jl[:m]
+
+
+@njit(cache=True)
+def jacobian(y, cols, coef, shaft, rows, rw, centres, r2, prof, c, par, law, steps, n_state, r_out, c_out, v_out,
+             dD):
+    """Entries of ``dQ/dy`` of :func:`forces` (over ``y[:n_state]``, the constants dropped) into ``r_out``,
+    ``c_out``, ``v_out`` (their count returned) and ``-d(friction power)/dy`` added to ``dD``: the local Jacobians of
+    :func:`local_jacobians` mapped on both sides, ``R^T (dY/dX) P`` (``ChainCVT._contact_entries``)."""
+    pair, Jl = local_jacobians(y, cols, coef, shaft, rows, rw, centres, r2, prof, c, par, law, steps)
+    return scatter_jacobian(pair, Jl, cols, coef, rows, rw, n_state, dD, r_out, c_out, v_out)
 
 
 @njit(cache=True)
@@ -201,4 +197,40 @@ def scatter_jacobian(pair, Jl, cols, coef, rows, rw, n_state, dD, r_out, c_out, 
     return n
 
 
-__all__ = ["STEPS", "forces", "jacobian", "pack", "scatter_forces", "scatter_jacobian"]
+@njit(cache=True)
+def scatter_jacobian_into(pair, Jl, cols, coef, rows, rw, n_state, dD, offsets, data, indptr, row_offset, b_indptr,
+                          b_indices, b_data) -> int:
+    """:func:`scatter_jacobian` through a map ``B`` straight into the data of a sorted CSR pattern: ``data += B R^T
+    Jl P`` (the CSC map ``B (b_indptr, b_indices, b_data)`` spreads output row ``r`` to the pattern's rows
+    ``row_offset + b_indices[k]``, which share one column list), with ``offsets (P, nf, K, n_in, K)`` the position of
+    each local entry within its first spread row (:func:`cvtfem.assembly.fixed_pattern.pair_offsets`, built once; -1
+    outside the pattern): no search per call.  ``dD`` as :func:`scatter_jacobian`'s.  Returns the number of nonzero
+    entries that found no place (0: all in)."""
+    K, nf = cols.shape[2], rows.shape[1]
+    missed = 0
+    for t in range(pair.shape[0]):
+        i = pair[t]
+        for j in range(Jl.shape[2]):
+            for b in range(K):
+                col, cw = cols[i, j, b], coef[i, j, b]
+                if col >= n_state or cw == 0.0:
+                    continue
+                dD[col] -= cw * Jl[t, nf, j]
+                for o in range(nf):
+                    for a in range(K):
+                        val = rw[i, o, a] * Jl[t, o, j] * cw
+                        r = rows[i, o, a]
+                        k0, k1 = b_indptr[r], b_indptr[r + 1]
+                        if val == 0.0 or k0 == k1:
+                            continue
+                        p = offsets[i, o, a, j, b]
+                        if p < 0:
+                            missed += 1
+                            continue
+                        for k in range(k0, k1):
+                            data[indptr[row_offset + b_indices[k]] + p] += b_data[k] * val
+    return missed
+
+
+__all__ = ["STEPS", "forces", "jacobian", "local_jacobians", "pack", "scatter_forces", "scatter_jacobian",
+           "scatter_jacobian_into"]

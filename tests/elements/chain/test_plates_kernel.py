@@ -36,3 +36,32 @@ def test_kernel_equals_the_numpy_twin(model):
     assert np.all(np.abs(Q - Q_np) <= 1e-13 * fscale[:, None])
     assert np.all(np.abs(T - st.tension) <= 1e-13 * 2 / H_PLATE * S)
     assert np.all(np.abs(M - st.moment) <= 1e-13 * S[:, None])
+
+
+def test_taut_shortcut_agrees_with_the_full_state_selection():
+    """``_taut`` (the taut state proven from a bound of the other nine margins, which ``_plate_law`` takes before the
+    full ten-state selection ``_state``) never claims state 1 where ``_state`` finds another, also at the boundary of
+    state 1 (strains scaled onto it, where the margins tie to round-off); and it decides most taut plates of a
+    stretched chain (else it would save nothing)."""
+    c, c1, c2, h = law()
+    rng = np.random.default_rng(23)
+    n = 20000
+    psi = rng.normal(size=(n, 2)) * 10.0 ** rng.uniform(-7, -2, (n, 1))
+    Delta = rng.normal(size=n) * 10.0 ** rng.uniform(-9, -5, n)
+    A, m = np.zeros((3, 3)), np.zeros(10)
+    # onto the boundary of state 1: the stretch at which M0 = max(|M01|, |M02|) (margin 0 ties margin 1..4)
+    M01, M02 = c1 * psi[:, 0] + c2 * psi[:, 1], c2 * psi[:, 0] + c1 * psi[:, 1]
+    edge = 2.0 / (h * c) * np.maximum(np.abs(M01), np.abs(M02)) * (1 + rng.choice([-1, 1], n) * 1e-15)
+    taut_total, decided = 0, 0
+    for case in range(2 * n):
+        p1, p2 = psi[case % n]
+        D = Delta[case] if case < n else edge[case - n]
+        st = ker._state(p1, p2, D, c, c1, c2, h, A, m)[0]
+        quick = ker._taut(p1, p2, D, c, c1, c2, h)
+        assert not quick or st == 1, (p1, p2, D, st)
+        taut_total += st == 1
+        decided += quick
+    assert taut_total > 1000 and decided > 0.5 * taut_total
+    stretched = np.abs(Delta) + 1e-6                               # a chain under tension: strains small against it
+    quick = [ker._taut(p1 * 1e-3, p2 * 1e-3, D, c, c1, c2, h) for (p1, p2), D in zip(psi[:2000], stretched)]
+    assert np.mean(quick) > 0.99
