@@ -1,14 +1,19 @@
 """Stationary runs with the loops on: the ratio loop's integral started at zero (the source) or seeded.
 
 Run:  .venv/bin/python studies/chain/seeded_loop.py RESULTS.h5 [RESULTS.h5 ...] [--labels a,b] [--every 0.005]
-      [--png out/studies/chain/seeded_loop_a.png]
+      [--tail 0.2] [--png out/studies/chain/seeded_loop_a.png]
 The results files come from ``cvtfem run`` (e.g. ``cvtfem run studies/chain/variant-a-seeded.toml --until 0.05``
 and the same scene with ``ratio_loop_start = "zero"``).  Per file: the ratio's and input speed's deviation from
 the targets (2.4, 3500 rpm) at every ``--every`` s and their largest value over the run's second half, the driving
 clamping force F1 and the ratio loop's integral F11 (from F1, the estimate's F1a and the stored ratio estimate), the
 drift of the ratio over the second half (1/s, linear fit), the run's energy balance (residual of input work +
 clamping work = output work + dissipated work + change of stored energy, of the input work) and whether any series
-holds a NaN.  ``--png`` draws ratio, input speed and F1 over time, one line per file.
+holds a NaN.  The acceptance of issue 14 over the run's last ``--tail`` share (default 20 %): the largest deviation of
+the ratio (2 %) and of the input speed (1 %) and their trends (linear fits, %/s), the driven speed's deviation (the
+input speed is not held by a loop: w1 = ratio x w2), the efficiency over the tail from the work integrals (steady and
+kinetic-energy corrected; plausibility band 95-99.5 %), the tight and slack span tensions against the torque over the
+driving contact radius, and the pin axial forces on the sheaves.  ``--png`` draws ratio, input speed, driven speed
+(with the acceptance bands) and F1/F2 over time, one line per file.
 """
 from __future__ import annotations
 
@@ -22,6 +27,7 @@ import numpy as np
 from cvtfem.control.clamping import Clamping
 from cvtfem.io.results import read_results
 from cvtfem.machines.cvt import band_params
+from cvtfem.post.history import windowed_efficiency
 from cvtfem.scene.loader import scene_from_dict
 
 RPM = 30 / math.pi
@@ -45,12 +51,43 @@ def series(path):
     E = np.asarray(s["energy"]).reshape(-1)
     residual = (W[-1, 0] + W[-1, 3] - W[-1, 1] - W[-1, 2] - (E[-1] - E[0])) / W[-1, 0]
     nan = any(np.isnan(np.asarray(v, float)).any() for v in s.values() if np.asarray(v).dtype.kind == "f")
-    return dict(t=t, ratio=ratio, rpm=w1 * RPM, F1=F1, F11=F11, residual=float(residual), nan=nan,
-                target=(rg.ratio, rg.input_speed * RPM),
-                F2=float(np.asarray(s["driven.clamping_force"]).reshape(-1)[0]))
+    w2 = np.asarray(s["driven.speed"]).reshape(-1)
+    d = dict(t=t, ratio=ratio, rpm=w1 * RPM, rpm2=w2 * RPM, F1=F1, F11=F11, residual=float(residual), nan=nan,
+             target=(rg.ratio, rg.input_speed * RPM), torque=rg.torque, W=W, E=E,
+             F2=float(np.asarray(s["driven.clamping_force"]).reshape(-1)[0]))
+    for key, name in (("spans", "chain.span_tension"), ("pin_axial", "chain.pin_axial_force"),
+                      ("radius", "contact.radius")):
+        if name in s:
+            d[key] = np.asarray(s[name])
+    return d
 
 
-def report(label, d, every):
+def tail_figures(d, share):
+    """Acceptance figures over the run's last ``share`` of its time: deviations (largest, mean, linear trend in %/s)
+    of ratio, input and driven speed from their targets; efficiency over the tail (steady, kinetic-energy corrected);
+    mean span tensions against ``M1 / r1`` (r1 the mean driving contact radius); pin axial forces on the sheaves
+    (median and largest magnitude of the pins carrying more than 100 N)."""
+    t, (i_d, n_d) = d["t"], d["target"]
+    tail = t >= t[-1] * (1 - share)
+    out = {"t0": float(t[tail][0]), "t1": float(t[-1])}
+    for key, y, ref in (("ratio", d["ratio"], i_d), ("input", d["rpm"], n_d), ("driven", d["rpm2"], n_d / i_d)):
+        dev = 100 * (y[tail] / ref - 1)
+        out[key] = (float(np.abs(dev).max()), float(dev.mean()), float(np.polyfit(t[tail], dev, 1)[0]))
+    span = float(t[-1] - out["t0"])
+    out["efficiency"] = (float(windowed_efficiency(t, d["W"], span)[-1]),
+                         float(windowed_efficiency(t, d["W"], span, d["E"])[-1]))
+    if "spans" in d and "radius" in d:
+        r = d["radius"][tail].reshape(tail.sum(), -1, 2)[..., 0]
+        r1 = float(r[r > 0].mean())
+        tight, slack = d["spans"][tail].mean(axis=0)
+        out["spans"] = (float(tight), float(slack), r1, d["torque"] / r1)
+    if "pin_axial" in d:
+        f = np.abs(d["pin_axial"][tail])
+        out["pin_axial"] = (float(np.median(f[f > 100])), float(f.max()))
+    return out
+
+
+def report(label, d, every, share):
     """Print the table of one run."""
     t, (i_d, n_d) = d["t"], d["target"]
     dev_i, dev_n = d["ratio"] / i_d - 1, d["rpm"] / n_d - 1
@@ -67,27 +104,43 @@ def report(label, d, every):
     print(f"  second half: largest |ratio dev| {100 * np.abs(dev_i[half]).max():.2f} %, |speed dev| "
           f"{100 * np.abs(dev_n[half]).max():.2f} %; ratio drift {rate:+.3f} 1/s (towards the target if its sign is "
           f"opposite to the mean deviation {100 * dev_i[half].mean():+.2f} %)")
+    f = tail_figures(d, share)
+    print(f"  last {share:.0%} ({1e3 * f['t0']:.1f}-{1e3 * f['t1']:.1f} ms): largest |dev|, mean dev, trend")
+    for key, name, tol in (("ratio", "ratio", 2.0), ("input", "input speed", 1.0), ("driven", "driven speed", None)):
+        big, mean, trend = f[key]
+        verdict = "" if tol is None else f"  {'within' if big <= tol else 'OUTSIDE'} {tol:g} %"
+        print(f"    {name:13s} {big:5.2f} %  {mean:+5.2f} %  {trend:+7.2f} %/s{verdict}")
+    print(f"    efficiency over the tail {100 * f['efficiency'][0]:.2f} % (kinetic-energy corrected "
+          f"{100 * f['efficiency'][1]:.2f} %; plausibility band 95-99.5 %)")
+    if "spans" in f:
+        tight, slack, r1, ref = f["spans"]
+        print(f"    spans: tight {tight:.0f} N, slack {slack:.0f} N, difference {tight - slack:.0f} N against "
+              f"M1 / r1 = {ref:.0f} N (r1 {1e3 * r1:.2f} mm)")
+    if "pin_axial" in f:
+        print(f"    pin axial force on the sheaves: median {f['pin_axial'][0]:.0f} N, largest {f['pin_axial'][1]:.0f} N")
 
 
 def plot(runs, path):
-    """Ratio, input speed and F1 over time, one line per run."""
+    """Ratio, input and driven speed (acceptance bands) and F1/F2 over time, one line per run."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, ax = plt.subplots(3, 1, figsize=(8, 9), sharex=True)
+    fig, ax = plt.subplots(4, 1, figsize=(8, 11), sharex=True)
     for k, (label, d) in enumerate(runs.items()):
         i_d, n_d = d["target"]
         ax[0].plot(1e3 * d["t"], d["ratio"], c=f"C{k}", lw=0.8, label=label)
         ax[1].plot(1e3 * d["t"], d["rpm"], c=f"C{k}", lw=0.8, label=label)
-        ax[2].plot(1e3 * d["t"], 1e-3 * d["F1"], c=f"C{k}", lw=0.8, label=label)
-    for a, y, tol in ((ax[0], i_d, 0.02), (ax[1], n_d, 0.01)):
+        ax[2].plot(1e3 * d["t"], d["rpm2"], c=f"C{k}", lw=0.8, label=label)
+        ax[3].plot(1e3 * d["t"], d["F1"] / d["F2"], c=f"C{k}", lw=0.8, label=label)
+    for a, y, tol in ((ax[0], i_d, 0.02), (ax[1], n_d, 0.01), (ax[2], n_d / i_d, 0.01)):
         a.axhline(y, c="k", lw=0.6)
         a.axhspan(y * (1 - tol), y * (1 + tol), color="0.9", zorder=0, label=f"acceptance +-{tol:.0%}")
     ax[0].set_ylabel("speed ratio w1 / w2")
     ax[1].set_ylabel("input speed, rpm")
-    ax[2].set_ylabel("driving clamping force F1, kN")
-    ax[2].set_xlabel("t, ms")
+    ax[2].set_ylabel("driven speed, rpm")
+    ax[3].set_ylabel("clamping force ratio F1 / F2")
+    ax[3].set_xlabel("t, ms")
     for a in ax:
         a.legend(fontsize=8)
     fig.tight_layout()
@@ -100,12 +153,13 @@ def main() -> None:
     ap.add_argument("results", nargs="+")
     ap.add_argument("--labels", default="", help="comma-separated, one per file (default: file names)")
     ap.add_argument("--every", type=float, default=0.005, help="table step, s")
+    ap.add_argument("--tail", type=float, default=0.2, help="share of the run the acceptance is judged on")
     ap.add_argument("--png", default="")
     a = ap.parse_args()
     labels = a.labels.split(",") if a.labels else [os.path.basename(p) for p in a.results]
     runs = {lab: series(p) for lab, p in zip(labels, a.results)}
     for lab, d in runs.items():
-        report(lab, d, a.every)
+        report(lab, d, a.every, a.tail)
     if a.png:
         plot(runs, a.png)
         print(f"wrote {a.png}")
