@@ -56,7 +56,7 @@ def series(path):
              target=(rg.ratio, rg.input_speed * RPM), torque=rg.torque, W=W, E=E,
              F2=float(np.asarray(s["driven.clamping_force"]).reshape(-1)[0]))
     for key, name in (("spans", "chain.span_tension"), ("pin_axial", "chain.pin_axial_force"),
-                      ("radius", "contact.radius")):
+                      ("radius", "contact.radius"), ("normal", "contact.normal_force")):
         if name in s:
             d[key] = np.asarray(s[name])
     return d
@@ -65,8 +65,8 @@ def series(path):
 def tail_figures(d, share):
     """Acceptance figures over the run's last ``share`` of its time: deviations (largest, mean, linear trend in %/s)
     of ratio, input and driven speed from their targets; efficiency over the tail (steady, kinetic-energy corrected);
-    mean span tensions against ``M1 / r1`` (r1 the mean driving contact radius); pin axial forces on the sheaves
-    (median and largest magnitude of the pins carrying more than 100 N)."""
+    mean span tensions against ``M1 / r1`` (r1 the mean driving contact radius); pin axial forces on each pulley
+    (median and largest magnitude over the pins touching its sheaves, samples of the tail)."""
     t, (i_d, n_d) = d["t"], d["target"]
     tail = t >= t[-1] * (1 - share)
     out = {"t0": float(t[tail][0]), "t1": float(t[-1])}
@@ -81,9 +81,14 @@ def tail_figures(d, share):
         r1 = float(r[r > 0].mean())
         tight, slack = d["spans"][tail].mean(axis=0)
         out["spans"] = (float(tight), float(slack), r1, d["torque"] / r1)
-    if "pin_axial" in d:
+    if "pin_axial" in d and "normal" in d:
         f = np.abs(d["pin_axial"][tail])
-        out["pin_axial"] = (float(np.median(f[f > 100])), float(f.max()))
+        n_pins = f.shape[1]
+        on = d["normal"][tail].reshape(len(f), n_pins, -1, 2).max(axis=2) > 0    # (rows, pins, shaft): touching
+        F = (d["F1"][tail].mean(), d["F2"])
+        out["pin_axial"] = [(float(np.median(f[on[..., k]])), float(f[on[..., k]].max()),
+                             float(on[..., k].sum(axis=1).mean()), float((f * on[..., k]).sum(axis=1).mean()), F[k])
+                            for k in (0, 1)]
     return out
 
 
@@ -117,7 +122,9 @@ def report(label, d, every, share):
         print(f"    spans: tight {tight:.0f} N, slack {slack:.0f} N, difference {tight - slack:.0f} N against "
               f"M1 / r1 = {ref:.0f} N (r1 {1e3 * r1:.2f} mm)")
     if "pin_axial" in f:
-        print(f"    pin axial force on the sheaves: median {f['pin_axial'][0]:.0f} N, largest {f['pin_axial'][1]:.0f} N")
+        for name, (med, big, count, total, clamp) in zip(("driving", "driven"), f["pin_axial"]):
+            print(f"    pin axial force on the {name} sheaves: median {med:.0f} N, largest {big:.0f} N; "
+                  f"{count:.1f} pins touching, their sum {total:.0f} N against the clamping force {clamp:.0f} N")
 
 
 def plot(runs, path):
