@@ -8,7 +8,8 @@ the targets (2.4, 3500 rpm) at every ``--every`` s and their largest value over 
 clamping force F1 and the ratio loop's integral F11 (from F1, the estimate's F1a and the stored ratio estimate), the
 drift of the ratio over the second half (1/s, linear fit), the run's energy balance (residual of input work +
 clamping work = output work + dissipated work + change of stored energy, of the input work) and whether any series
-holds a NaN.  The acceptance of issue 14 over the run's last ``--tail`` share (default 20 %): the largest deviation of
+holds a NaN; with ``--fit-from T0`` the loop integral's exponential approach from T0 on (its time constant and end
+value: the chain's own clamping ratio at zero ratio error).  The acceptance of issue 14 over the run's last ``--tail`` share (default 20 %): the largest deviation of
 the ratio (2 %) and of the input speed (1 %) and their trends (linear fits, %/s), the driven speed's deviation (the
 input speed is not held by a loop: w1 = ratio x w2), the efficiency over the tail from the work integrals (steady and
 kinetic-energy corrected; plausibility band 95-99.5 %), the tight and slack span tensions against the torque over the
@@ -53,13 +54,30 @@ def series(path):
     nan = any(np.isnan(np.asarray(v, float)).any() for v in s.values() if np.asarray(v).dtype.kind == "f")
     w2 = np.asarray(s["driven.speed"]).reshape(-1)
     d = dict(t=t, ratio=ratio, rpm=w1 * RPM, rpm2=w2 * RPM, F1=F1, F11=F11, residual=float(residual), nan=nan,
-             target=(rg.ratio, rg.input_speed * RPM), torque=rg.torque, W=W, E=E,
+             target=(rg.ratio, rg.input_speed * RPM), torque=rg.torque, W=W, E=E, F1a=F1a, gains=(c.c_f0, c.c_f1),
              F2=float(np.asarray(s["driven.clamping_force"]).reshape(-1)[0]))
     for key, name in (("spans", "chain.span_tension"), ("pin_axial", "chain.pin_axial_force"),
                       ("radius", "contact.radius"), ("normal", "contact.normal_force")):
         if name in s:
             d[key] = np.asarray(s[name])
     return d
+
+
+def integral_fit(d, t0):
+    """Fit ``F11 = F11* + A exp(-(t - t0) / T)`` to the loop's integral from ``t0`` on (scipy ``curve_fit``): the
+    settling time T (s; the creep-limited loop predicts ``c_f0 / c_f1``), the integral's end value F11* (N) and the
+    chain's own clamping ratio ``(F1a + F11*) / F2`` at zero ratio error, and the rms misfit (N)."""
+    from scipy.optimize import curve_fit
+
+    sel = d["t"] >= t0
+    t, F11 = d["t"][sel], d["F11"][sel]
+
+    def model(tt, Fs, A, T):
+        return Fs + A * np.exp(-(tt - t0) / T)
+
+    (Fs, A, T), _ = curve_fit(model, t, F11, p0=(F11[-1], F11[0] - F11[-1], 0.1))
+    return dict(T=float(T), F11_end=float(Fs), ratio=float((d["F1a"] + Fs) / d["F2"]),
+                rms=float(np.sqrt(np.mean((model(t, Fs, A, T) - F11) ** 2))))
 
 
 def tail_figures(d, share):
@@ -92,7 +110,7 @@ def tail_figures(d, share):
     return out
 
 
-def report(label, d, every, share):
+def report(label, d, every, share, fit_from):
     """Print the table of one run."""
     t, (i_d, n_d) = d["t"], d["target"]
     dev_i, dev_n = d["ratio"] / i_d - 1, d["rpm"] / n_d - 1
@@ -121,6 +139,12 @@ def report(label, d, every, share):
         tight, slack, r1, ref = f["spans"]
         print(f"    spans: tight {tight:.0f} N, slack {slack:.0f} N, difference {tight - slack:.0f} N against "
               f"M1 / r1 = {ref:.0f} N (r1 {1e3 * r1:.2f} mm)")
+    if fit_from is not None and d["t"][-1] > fit_from + 0.05:
+        g = integral_fit(d, fit_from)
+        c_f0, c_f1 = d["gains"]
+        print(f"  integral from {1e3 * fit_from:.0f} ms: F11 -> {g['F11_end']:.0f} N with T = {g['T']:.3f} s "
+              f"(c_f0 / c_f1 = {c_f0 / c_f1:.3f} s; rms misfit {g['rms']:.1f} N): the chain's clamping ratio at "
+              f"zero ratio error F1/F2 = {g['ratio']:.4f}")
     if "pin_axial" in f:
         for name, (med, big, count, total, clamp) in zip(("driving", "driven"), f["pin_axial"]):
             print(f"    pin axial force on the {name} sheaves: median {med:.0f} N, largest {big:.0f} N; "
@@ -161,12 +185,14 @@ def main() -> None:
     ap.add_argument("--labels", default="", help="comma-separated, one per file (default: file names)")
     ap.add_argument("--every", type=float, default=0.005, help="table step, s")
     ap.add_argument("--tail", type=float, default=0.2, help="share of the run the acceptance is judged on")
+    ap.add_argument("--fit-from", type=float, default=None,
+                    help="fit the loop integral's exponential approach from this time on, s")
     ap.add_argument("--png", default="")
     a = ap.parse_args()
     labels = a.labels.split(",") if a.labels else [os.path.basename(p) for p in a.results]
     runs = {lab: series(p) for lab, p in zip(labels, a.results)}
     for lab, d in runs.items():
-        report(lab, d, a.every, a.tail)
+        report(lab, d, a.every, a.tail, a.fit_from)
     if a.png:
         plot(runs, a.png)
         print(f"wrote {a.png}")
