@@ -91,6 +91,11 @@ def tail_figures(d, share):
     for key, y, ref in (("ratio", d["ratio"], i_d), ("input", d["rpm"], n_d), ("driven", d["rpm2"], n_d / i_d)):
         dev = 100 * (y[tail] / ref - 1)
         out[key] = (float(np.abs(dev).max()), float(dev.mean()), float(np.polyfit(t[tail], dev, 1)[0]))
+    out["inside_from"] = {}
+    for key, y, ref, tol in (("ratio", d["ratio"], i_d, 0.02), ("input", d["rpm"], n_d, 0.01)):
+        out_of_band = np.flatnonzero(np.abs(y / ref - 1) > tol)
+        out["inside_from"][key] = float(t[out_of_band[-1] + 1]) if out_of_band.size and out_of_band[-1] + 1 < len(t) \
+            else (float(t[0]) if not out_of_band.size else np.inf)
     span = float(t[-1] - out["t0"])
     out["efficiency"] = (float(windowed_efficiency(t, d["W"], span)[-1]),
                          float(windowed_efficiency(t, d["W"], span, d["E"])[-1]))
@@ -131,7 +136,8 @@ def report(label, d, every, share, fit_from):
     print(f"  last {share:.0%} ({1e3 * f['t0']:.1f}-{1e3 * f['t1']:.1f} ms): largest |dev|, mean dev, trend")
     for key, name, tol in (("ratio", "ratio", 2.0), ("input", "input speed", 1.0), ("driven", "driven speed", None)):
         big, mean, trend = f[key]
-        verdict = "" if tol is None else f"  {'within' if big <= tol else 'OUTSIDE'} {tol:g} %"
+        verdict = "" if tol is None else (f"  {'within' if big <= tol else 'OUTSIDE'} {tol:g} % (within it from "
+                                          f"{1e3 * f['inside_from'][key]:.1f} ms on)")
         print(f"    {name:13s} {big:5.2f} %  {mean:+5.2f} %  {trend:+7.2f} %/s{verdict}")
     print(f"    efficiency over the tail {100 * f['efficiency'][0]:.2f} % (kinetic-energy corrected "
           f"{100 * f['efficiency'][1]:.2f} %; plausibility band 95-99.5 %)")
@@ -164,9 +170,10 @@ def plot(runs, path):
         ax[1].plot(1e3 * d["t"], d["rpm"], c=f"C{k}", lw=0.8, label=label)
         ax[2].plot(1e3 * d["t"], d["rpm2"], c=f"C{k}", lw=0.8, label=label)
         ax[3].plot(1e3 * d["t"], d["F1"] / d["F2"], c=f"C{k}", lw=0.8, label=label)
-    for a, y, tol in ((ax[0], i_d, 0.02), (ax[1], n_d, 0.01), (ax[2], n_d / i_d, 0.01)):
+    for a, y, tol, what in ((ax[0], i_d, 0.02, "acceptance"), (ax[1], n_d, 0.01, "acceptance"),
+                            (ax[2], n_d / i_d, 0.01, "no criterion")):
         a.axhline(y, c="k", lw=0.6)
-        a.axhspan(y * (1 - tol), y * (1 + tol), color="0.9", zorder=0, label=f"acceptance +-{tol:.0%}")
+        a.axhspan(y * (1 - tol), y * (1 + tol), color="0.9", zorder=0, label=f"+-{tol:.0%} ({what})")
     ax[0].set_ylabel("speed ratio w1 / w2")
     ax[1].set_ylabel("input speed, rpm")
     ax[2].set_ylabel("driven speed, rpm")
