@@ -60,6 +60,9 @@ def series(path):
                       ("radius", "contact.radius"), ("normal", "contact.normal_force")):
         if name in s:
             d[key] = np.asarray(s[name])
+    if "chain.pin_half_axial_force" in s:   # A5: each pin half's, half-major (half -, half +); to pin-major
+        f = np.asarray(s["chain.pin_half_axial_force"])
+        d["pin_axial"] = f.reshape(len(f), 2, -1).transpose(0, 2, 1).reshape(len(f), -1)
     return d
 
 
@@ -84,7 +87,8 @@ def tail_figures(d, share):
     """Acceptance figures over the run's last ``share`` of its time: deviations (largest, mean, linear trend in %/s)
     of ratio, input and driven speed from their targets; efficiency over the tail (steady, kinetic-energy corrected);
     mean span tensions against ``M1 / r1`` (r1 the mean driving contact radius); pin axial forces on each pulley
-    (median and largest magnitude over the pins touching its sheaves, samples of the tail)."""
+    (median and largest magnitude over the pins, or pin halves, touching its sheaves, samples of the tail; the
+    contact forces are element-major with the shaft last)."""
     t, (i_d, n_d) = d["t"], d["target"]
     tail = t >= t[-1] * (1 - share)
     out = {"t0": float(t[tail][0]), "t1": float(t[-1])}
@@ -106,7 +110,7 @@ def tail_figures(d, share):
         out["spans"] = (float(tight), float(slack), r1, d["torque"] / r1)
     if "pin_axial" in d and "normal" in d:
         f = np.abs(d["pin_axial"][tail])
-        n_pins = f.shape[1]
+        n_pins = f.shape[1]                                                     # pins, or pin halves
         on = d["normal"][tail].reshape(len(f), n_pins, -1, 2).max(axis=2) > 0    # (rows, pins, shaft): touching
         F = (d["F1"][tail].mean(), d["F2"])
         out["pin_axial"] = [(float(np.median(f[on[..., k]])), float(f[on[..., k]].max()),
@@ -154,7 +158,8 @@ def report(label, d, every, share, fit_from):
     if "pin_axial" in f:
         for name, (med, big, count, total, clamp) in zip(("driving", "driven"), f["pin_axial"]):
             print(f"    pin axial force on the {name} sheaves: median {med:.0f} N, largest {big:.0f} N; "
-                  f"{count:.1f} pins touching, their sum {total:.0f} N against the clamping force {clamp:.0f} N")
+                  f"{count:.1f} pins (or halves) touching, their sum {total:.0f} N against the clamping force "
+                  f"{clamp:.0f} N")
 
 
 def plot(runs, path):
