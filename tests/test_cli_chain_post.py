@@ -13,7 +13,7 @@ from cvtfem.machines.cvt import chain_loop
 from cvtfem.outputs import OutputSpec
 from cvtfem.post import chain_revolution as cr
 from cvtfem.post import spectrogram as sg
-from cvtfem.post.history import history
+from cvtfem.post.history import energy_residual, history, nonfinite_series
 from cvtfem.scene.loader import load_scene
 
 
@@ -127,12 +127,26 @@ def test_history_efficiencies_of_constant_powers(tmp_path):
     assert np.isnan(cols["efficiency"][0])                       # no input work yet
 
 
+def test_energy_residual_and_nonfinite_series(tmp_path):
+    """The made-up run closes its balance (input = output + dissipated + dE) to round-off; 1 J of input work
+    booked nowhere shows as 1 J over the input work, and a NaN is named by its series."""
+    results = read_results(constant_power_run(tmp_path / "run.h5"))
+    r = energy_residual(results)
+    assert np.isnan(r[0]) and np.abs(r[1:]).max() < 1e-14
+    results.series["work"][:, 0] += 1.0
+    np.testing.assert_allclose(energy_residual(results), 1.0 / results.series["work"][:, 0], rtol=1e-12)
+    assert nonfinite_series(results) == []
+    results.series["ratio"][7] = np.nan
+    assert nonfinite_series(results) == ["ratio"]
+
+
 def test_history_cli_writes_png_and_csv(tmp_path, capsys):
     path = constant_power_run(tmp_path / "run.h5")
     assert main(["history", str(path), "--window", "0.2", "--png", str(tmp_path / "h.png"),
                  "--csv", str(tmp_path / "h.csv")]) == 0
     out = capsys.readouterr().out
     assert "efficiency over the last 0.2 s: 0.9500 (kinetic-energy corrected 0.9700)" in out
+    assert "energy balance over the run: residual " in out and "non-finite values: none" in out
     table = np.genfromtxt(tmp_path / "h.csv", delimiter=",", names=True)
     assert table["ratio"][-1] == 2.4 and table["n1_rpm"][0] == pytest.approx(300 * 30 / np.pi)
     assert main(["history", str(path), "--window", "0"]) == 2

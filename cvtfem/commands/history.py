@@ -1,5 +1,6 @@
 """``cvtfem history RESULTS [--window S] [--png OUT] [--csv OUT]``: regime history of a CVT run (speeds, ratio,
-efficiency steady and kinetic-energy corrected, slip, clamping forces)."""
+efficiency steady and kinetic-energy corrected, slip, clamping forces), the run's energy balance and any non-finite
+series."""
 from __future__ import annotations
 
 import argparse
@@ -19,7 +20,7 @@ def run(args: argparse.Namespace) -> int:
     import numpy as np
 
     from cvtfem.io.results import read_results
-    from cvtfem.post.history import history, plot_history, write_history_csv
+    from cvtfem.post.history import energy_residual, history, nonfinite_series, plot_history, write_history_csv
 
     results = read_results(args.results)
     t = results.time
@@ -34,6 +35,10 @@ def run(args: argparse.Namespace) -> int:
         print(f"slip speed at the end: driving {last['slip_driving']:.4g} m/s, driven {last['slip_driven']:.4g} m/s")
     if not np.isfinite(last["efficiency"]):
         print("no input work in the last window: efficiency undefined (NaN)")
+    print(f"energy balance over the run: residual {energy_residual(results)[-1]:.2e} of the input work "
+          f"(input + clamping work = output + dissipated work + change of stored energy)")
+    bad = nonfinite_series(results)
+    print("non-finite values: " + (", ".join(bad) if bad else "none"))
     if args.csv:
         print(f"wrote {write_history_csv(cols, args.csv)}")
     if args.png:

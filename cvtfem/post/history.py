@@ -70,6 +70,21 @@ def history(results, window: float) -> dict[str, np.ndarray]:
     return cols
 
 
+def energy_residual(results) -> np.ndarray:
+    """Residual of the run's energy balance at each row, relative to the input work so far: ``(W_in + W_clamp -
+    W_out - W_diss - (E - E(0))) / W_in`` from the cumulative works ``(input, output, dissipated, clamping)`` (J)
+    and the stored energy ``E`` (J); NaN before any input work."""
+    W, E = np.asarray(results.series["work"]), np.asarray(results.series["energy"]).reshape(-1)
+    r = W[:, 0] + W[:, 3] - W[:, 1] - W[:, 2] - (E - E[0])
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.where(W[:, 0] > 0, r / np.where(W[:, 0] > 0, W[:, 0], 1.0), np.nan)
+
+
+def nonfinite_series(results) -> list[str]:
+    """Names of the stored series that hold a NaN or an infinity."""
+    return [k for k, v in results.series.items() if np.asarray(v).dtype.kind == "f" and not np.isfinite(v).all()]
+
+
 def write_history_csv(cols: dict[str, np.ndarray], path: str | Path) -> Path:
     out = Path(path)
     out.parent.mkdir(parents=True, exist_ok=True)
