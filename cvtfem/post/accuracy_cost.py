@@ -69,7 +69,7 @@ def plot_accuracy_cost(rows, path: str | Path, accept: float, title: str = "") -
             if not pts:
                 continue
             ys = [max(abs(r[value]), 1e-16) for r in pts]
-            line, = ax.loglog([r[key] for r in pts], ys, "o-", ms=4, label=label, color=f"C{k % 10}",
+            line, = ax.loglog([r[key] for r in pts], ys, marker="o", ms=4, label=label, color=f"C{k % 10}",
                               ls=("-", "--", ":")[k // 10 % 3])
             for r, y in zip(pts, ys):
                 ax.annotate(r["setting"], (r[key], y), fontsize=6, color=line.get_color(),

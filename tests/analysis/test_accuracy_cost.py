@@ -148,6 +148,25 @@ def test_speedups_by_cpu_and_by_rhs_equivalents():
     assert t["speedup_cpu"] is None and t["speedup_rhs"] is None
 
 
+def test_the_energy_acceptance_rejects_a_chattering_run_and_labels_stay_apart():
+    """A run with E <= 0.05 whose energy balance is off by more than ACCEPT_ENERGY (chatter in stick) is not
+    accepted, one without the column is judged by E alone; the cheapest accepted run is found by CPU time; adaptive
+    rows of a method that also ran at fixed steps are labelled apart (rows gathered from a cache)."""
+    rows = [{"label": "rock4", "setting": "rtol=0.01", "error": 0.033, "time": 1.0, "cpu": 37.0, "nfev": 71_116,
+             "energy_residual": -0.016},
+            {"label": "rock4", "setting": "rtol=0.001", "error": 4.4e-3, "time": 3.0, "cpu": 39.0, "nfev": 74_662,
+             "energy_residual": -3.6e-5},
+            {"label": "dumka3", "setting": "h=2e-06", "error": 1.5e-4, "time": 9.0, "cpu": 29.0, "nfev": 53_676},
+            {"label": "dumka3", "setting": "rtol=0.03", "error": 1e-4, "time": 2.0, "cpu": 35.0, "nfev": 67_493,
+             "energy_residual": 1.9e-6}]
+    assert not ac.accepted(rows[0]) and ac.accepted(rows[0], accept_energy=None) and ac.accepted(rows[2])
+    table = {t["label"]: t for t in ac.speedups(ac.distinct_labels(rows), {"time": 500.0, "cpu": 150.0,
+                                                                          "nfev": 400_005})}
+    assert table["rock4"]["setting"] == "rtol=0.001"
+    assert table["dumka3"]["setting"] == "h=2e-06" and table["dumka3"]["speedup_cpu"] == pytest.approx(150 / 29)
+    assert table["dumka3 adaptive"]["setting"] == "rtol=0.03"
+
+
 def test_the_energy_balance_of_a_run_closes_and_names_the_dissipated_work(study):
     """A run accurate to E < 1e-4 (RK4 at 1e-6 s on chain-S2) closes the balance of its work integrals and stored
     energy to well below 1e-4 of the input work and dissipates work; the row of test 2 carries both."""
