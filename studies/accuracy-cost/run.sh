@@ -110,6 +110,7 @@ if [[ $part == all || $part == w-short ]]; then
            --png "$out/variant-e-w-short.png" --csv "$out/variant-e-w-short.csv" --json "$out/variant-e-w-short.json" "$@"; }
   ws --fixed rk4 --steps 5e-8,5e-7 --adaptive ""
   ws --fixed dumka3 --steps 1e-6,2e-6 --adaptive rock4 --rtols 1e-2,1e-3
+  ws --fixed "" --adaptive dumka3 --rtols 1e-1,3e-2,1e-2
   ws --fixed sw24,sw24:jac_every=10,sw24:jac_every=20 --steps 2e-6 --adaptive ""
   ws --fixed sw24:jac_every=20,sw24:jac_every=100 --steps 5e-7,1e-6 --adaptive ""
   ws --fixed ros34pw2,ros34pw2:jac_every=5 --steps 1e-6,2e-6 --adaptive ""
@@ -127,8 +128,11 @@ if [[ $part == all || $part == w-4ms ]]; then
   w4 --fixed sw24:jac_every=20 --steps 5e-7,1e-6 --adaptive ""
   w4 --fixed rk4 --steps 5e-7,1e-6 --adaptive ""
   w4 --fixed "" --adaptive rock4 --rtols 1e-3,1e-2
+  w4 --fixed "" --adaptive dumka3 --rtols 1e-1,3e-2,1e-2
   w4 --from-cache | tee "$out/variant-e-w-4ms.log"
   uptime | tee -a "$out/variant-e-w-4ms.log"
+  nice .venv/bin/python studies/accuracy-cost/force_trace.py "$out/variant-e-w-4ms.json" "$cache" \
+    rk4:5e-7,sw24:jac_every=20:5e-7,dumka3:2e-6 "$out/variant-e-w-4ms-trace.png" | tee -a "$out/variant-e-w-4ms.log"
 fi
 if [[ $part == all || $part == variant-e || $part == variant-e-spectra ]]; then   # which friction is stiffest
   for v in e zh; do
