@@ -24,6 +24,7 @@ _SPECS: dict[str, object] = {
     "sw24": "cvtfem.integrate.wmethods:SW24",
     "w1": "cvtfem.integrate.wmethods:W1",
     "w1-extrapolation": "cvtfem.integrate.wmethods:W1Extrapolation",
+    "ros34pw2": "cvtfem.integrate.rosw:ROS34PW2",
     "rodas4": "cvtfem.integrate.rosenbrock:Rodas4",
     "rodas5p": "cvtfem.integrate.rosenbrock:Rodas5P",
     "radau5": "cvtfem.integrate.radau:Radau5",

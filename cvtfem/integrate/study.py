@@ -107,7 +107,8 @@ def work_precision(problem, runs, repeats: int = 3, error=None):
             times.append(time.perf_counter() - t0)
         st = res.stats
         rows.append({"label": label, "method": method, "error": error(res) if res.success else np.inf,
-                     "nfev": st["nfev"], "nfev_jac": st["nfev_jac"], "njev": st["njev"], "nlu": st["nlu"], "nsteps": st["nsteps"],
+                     "nfev": st["nfev"], "nfev_jac": st["nfev_jac"], "njev": st["njev"], "nlu": st["nlu"], "nsolve": st["nsolve"],
+                     "nsteps": st["nsteps"],
                      "time": statistics.median(times), "status": res.status,
                      **{k: v for k, v in options.items() if isinstance(v, (int, float, str))}})
     return rows

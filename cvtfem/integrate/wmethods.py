@@ -30,6 +30,11 @@ from cvtfem.integrate.linsolve import LU, reduced_matrix
 
 __all__ = ["SW24", "W1", "W1Extrapolation"]
 
+#: Relative difference of two step sizes below which they share one LU of ``I - h d A``: the rounding of
+#: ``t_end - t`` at a fixed step's end.  Using the other step's matrix is the W-method with ``A`` scaled by
+#: ``1 +- H_ROUNDOFF``: a W-method keeps its order for any ``A``.
+H_ROUNDOFF = 1e-9
+
 
 class _WBase(Stepper):
     """Shared parts: ``d``, the matrix ``A`` and cached LUs of ``I - h d A`` per step size."""
@@ -63,8 +68,11 @@ class _WBase(Stepper):
         self._age += 1
 
     def lu(self, h: float) -> LU:
-        """LU of ``W = I - h d A`` (reduced), cached while ``A`` is unchanged."""
+        """LU of ``W = I - h d A`` (reduced), cached while ``A`` is unchanged; a step within round-off (relative
+        ``H_ROUNDOFF``) of a cached one reuses its LU (the last step of a fixed-step run, ``t_end - t``)."""
         lu = self._lus.get(h)
+        if lu is None:
+            lu = next((v for k, v in self._lus.items() if abs(k - h) <= H_ROUNDOFF * h), None)
         if lu is None:
             n2, g = self.system.n2, h * self.d
             if len(self._lus) > 8:

@@ -52,21 +52,35 @@ def plot_spectra(spectra: dict, path: str | Path, title: str = "") -> Path:
 
 
 def plot_accuracy_cost(rows, path: str | Path, accept: float, title: str = "") -> Path:
-    """Global error E of each run against wall time (left) and RHS calls (right), one line per method, each
-    point labelled with its step or tolerance; the acceptance ``E = accept`` dashed."""
-    fig, axes = plt.subplots(1, 2, figsize=(12, 5), sharey=True)
+    """Global error E of each run against wall time (left) and RHS calls (middle), one line per method, each
+    point labelled with its step or tolerance; the acceptance ``E = accept`` dashed.  Where the rows carry the
+    energy balance (``energy_residual``), a third panel: its modulus (relative to the input work) against RHS calls,
+    so a run accepted by E that chatters in stick (dissipating too much) stands out."""
+    energy = [r for r in rows if r.get("energy_residual") is not None and np.isfinite(r["energy_residual"])]
+    fig, axes = plt.subplots(1, 3 if energy else 2, figsize=(18 if energy else 12, 5))
     finite = [r for r in rows if np.isfinite(r["error"]) and r["error"] > 0]
-    for (ax, key, xlabel) in ((axes[0], "time", "wall time, s (median)"), (axes[1], "nfev", "RHS calls")):
-        for label in dict.fromkeys(r["label"] for r in finite):
-            pts = [r for r in finite if r["label"] == label]        # in the order of the settings
-            line, = ax.loglog([r[key] for r in pts], [r["error"] for r in pts], "o-", ms=4, label=label)
-            for r in pts:
-                ax.annotate(r["setting"], (r[key], r["error"]), fontsize=6, color=line.get_color(),
+    panels = [(axes[0], finite, "time", "error", "wall time, s (median)"),
+              (axes[1], finite, "nfev", "error", "RHS calls")]
+    if energy:
+        panels.append((axes[2], energy, "nfev", "energy_residual", "RHS calls"))
+    for (ax, use, key, value, xlabel) in panels:
+        for k, label in enumerate(dict.fromkeys(r["label"] for r in finite + energy)):
+            pts = [r for r in use if r["label"] == label]        # in the order of the settings
+            if not pts:
+                continue
+            ys = [max(abs(r[value]), 1e-16) for r in pts]
+            line, = ax.loglog([r[key] for r in pts], ys, marker="o", ms=4, label=label, color=f"C{k % 10}",
+                              ls=("-", "--", ":")[k // 10 % 3])
+            for r, y in zip(pts, ys):
+                ax.annotate(r["setting"], (r[key], y), fontsize=6, color=line.get_color(),
                             xytext=(3, 3), textcoords="offset points")
-        ax.axhline(accept, color="k", ls="--", lw=0.8)
         ax.set_xlabel(xlabel)
         ax.grid(alpha=0.3, which="both")
-    axes[0].set_ylabel("E = max|P - P*| / max|P*| over the window")
+    for ax in axes[:2]:
+        ax.axhline(accept, color="k", ls="--", lw=0.8)
+        ax.set_ylabel("E = max|P - P*| / max|P*| over the window")
+    if energy:
+        axes[2].set_ylabel("|energy balance residual| / input work, over the run")
     axes[1].legend(fontsize=7, loc="lower left")
     failed = sorted({f"{r['label']} {r['setting']}" for r in rows if not np.isfinite(r["error"])})
     note = f"\nfailed or unstable: {', '.join(failed)}" if failed else ""

@@ -3,7 +3,7 @@
 # numerics-and-periodic section 9) into studies/accuracy-cost/results/.  Run from the repository root:
 #     bash studies/accuracy-cost/run.sh            # all (about 2 h of one core)
 #     bash studies/accuracy-cost/run.sh chain-S2   # the chain-S2 part only (also chain-A1, band, local, variant-e,
-#                                                  # variant-e-4ms)
+#                                                  # variant-e-4ms, w-short, w-4ms)
 # Each test-2 run prints its speed-up table (Table 2.4 style); the logs go next to the results.
 set -euo pipefail
 cd "$(dirname "$0")/../.."
@@ -96,6 +96,43 @@ if [[ $part == all || $part == variant-e-4ms ]]; then
   uptime | tee -a "$out/variant-e-4ms.log"
   nice .venv/bin/python studies/accuracy-cost/force_trace.py "$out/variant-e-4ms.json" "$cache" rk4:1e-6,rk4:2e-6 \
     "$out/variant-e-4ms-trace.png" | tee -a "$out/variant-e-4ms.log"
+fi
+# Session 10: W-methods with a reused Jacobian (sw24 with jac_every, ros34pw2) against DUMKA3, rock4 and RK4 on variant
+# (e), FROM THE QUASI-STATIC START (converged at ratio 0.45 since session 9's iteration budget; the cache keeps the start
+# state, so each further process skips the minute of the solve).  First a window of [0.2, 0.4] ms (references DOP853
+# and dopri78 at rtol 1e-7), then the source's [1, 5] ms (rtol 1e-6).  Each invocation prints its rows' table (energy
+# residual and speed-ups by wall, CPU and RHS-equivalents); the --from-cache call tabulates everything.  The parts
+# under one cache may run in parallel shells (start the reference-computing ones first).
+if [[ $part == all || $part == w-short ]]; then
+  cache=out/studies/w-short-cache
+  ws() { nice "$cvtfem" study accuracy-cost "$(e_scene e linear-saturated)" --skip-spectrum --window 2e-4:4e-4 \
+           --sample 1e-6 --repeats 1 --reference DOP853:1e-7 --check dopri78:1e-7 --cache "$cache" \
+           --png "$out/variant-e-w-short.png" --csv "$out/variant-e-w-short.csv" --json "$out/variant-e-w-short.json" "$@"; }
+  ws --fixed rk4 --steps 5e-8,5e-7 --adaptive ""
+  ws --fixed dumka3 --steps 1e-6,2e-6 --adaptive rock4 --rtols 1e-2,1e-3
+  ws --fixed "" --adaptive dumka3 --rtols 1e-1,3e-2,1e-2
+  ws --fixed sw24,sw24:jac_every=10,sw24:jac_every=20 --steps 2e-6 --adaptive ""
+  ws --fixed sw24:jac_every=20,sw24:jac_every=100 --steps 5e-7,1e-6 --adaptive ""
+  ws --fixed ros34pw2,ros34pw2:jac_every=5 --steps 1e-6,2e-6 --adaptive ""
+  ws --fixed rodas4 --steps 2e-6,4e-6 --adaptive ""
+  ws --from-cache | tee "$out/variant-e-w-short.log"
+  uptime | tee -a "$out/variant-e-w-short.log"
+fi
+if [[ $part == all || $part == w-4ms ]]; then
+  cache=out/studies/w-4ms-cache
+  w4() { nice "$cvtfem" study accuracy-cost "$(e_scene e linear-saturated)" --skip-spectrum --window 1e-3:5e-3 \
+           --sample 1e-6 --repeats 1 --reference DOP853:1e-6 --check dopri78:1e-6 --cache "$cache" \
+           --png "$out/variant-e-w-4ms.png" --csv "$out/variant-e-w-4ms.csv" --json "$out/variant-e-w-4ms.json" "$@"; }
+  w4 --fixed rk4 --steps 5e-8 --adaptive ""             # the baseline (and, in a second shell, the next line)
+  w4 --fixed dumka3 --steps 2e-6,1e-6 --adaptive ""
+  w4 --fixed sw24:jac_every=20 --steps 5e-7,1e-6 --adaptive ""
+  w4 --fixed rk4 --steps 5e-7,1e-6 --adaptive ""
+  w4 --fixed "" --adaptive rock4 --rtols 1e-3,1e-2
+  w4 --fixed "" --adaptive dumka3 --rtols 1e-1,3e-2,1e-2
+  w4 --from-cache | tee "$out/variant-e-w-4ms.log"
+  uptime | tee -a "$out/variant-e-w-4ms.log"
+  nice .venv/bin/python studies/accuracy-cost/force_trace.py "$out/variant-e-w-4ms.json" "$cache" \
+    rk4:5e-7,sw24:jac_every=20:5e-7,dumka3:2e-6 "$out/variant-e-w-4ms-trace.png" | tee -a "$out/variant-e-w-4ms.log"
 fi
 if [[ $part == all || $part == variant-e || $part == variant-e-spectra ]]; then   # which friction is stiffest
   for v in e zh; do

@@ -132,6 +132,52 @@ def test_speedups_pick_the_cheapest_accepted_run():
     assert table["x"]["setting"] is None and table["x"]["speedup"] is None
 
 
+def test_speedups_by_cpu_and_by_rhs_equivalents():
+    """RHS-equivalents weight Jacobians, LUs and solves by their measured cost in RHS calls (scipy's uncounted
+    solves, -1, count 0); the speed-ups by CPU and by RHS-equivalents are the baseline's over the run's."""
+    costs = {"jac_rhs": 50.0, "lu_rhs": 20.0, "solve_rhs": 0.5}
+    w = {"label": "sw24", "setting": "h=2e-06", "error": 0.01, "time": 2.0, "cpu": 1.0, "nfev": 1000, "njev": 10,
+         "nlu": 11, "nsolve": 1000, "nsteps": 500, "energy_residual": -1e-3, "dissipated": 0.3}
+    assert ac.rhs_equivalents(w, costs) == 1000 + 10 * 50 + 11 * 20 + 1000 * 0.5
+    assert ac.rhs_equivalents({"nfev": 7, "njev": 0, "nlu": 0, "nsolve": -1}, costs) == 7
+    base = {"time": 40.0, "cpu": 20.0, "nfev": 44_000}
+    (t,) = ac.speedups([w], base, costs=costs)
+    assert t["speedup"] == 20.0 and t["speedup_cpu"] == 20.0 and t["speedup_rhs"] == pytest.approx(44_000 / 2220)
+    assert t["energy_residual"] == -1e-3 and t["dissipated"] == 0.3
+    (t,) = ac.speedups([w], {"time": 40.0, "nfev": 44_000})          # an estimated baseline has no CPU time
+    assert t["speedup_cpu"] is None and t["speedup_rhs"] is None
+
+
+def test_the_energy_acceptance_rejects_a_chattering_run_and_labels_stay_apart():
+    """A run with E <= 0.05 whose energy balance is off by more than ACCEPT_ENERGY (chatter in stick) is not
+    accepted, one without the column is judged by E alone; the cheapest accepted run is found by CPU time; adaptive
+    rows of a method that also ran at fixed steps are labelled apart (rows gathered from a cache)."""
+    rows = [{"label": "rock4", "setting": "rtol=0.01", "error": 0.033, "time": 1.0, "cpu": 37.0, "nfev": 71_116,
+             "energy_residual": -0.016},
+            {"label": "rock4", "setting": "rtol=0.001", "error": 4.4e-3, "time": 3.0, "cpu": 39.0, "nfev": 74_662,
+             "energy_residual": -3.6e-5},
+            {"label": "dumka3", "setting": "h=2e-06", "error": 1.5e-4, "time": 9.0, "cpu": 29.0, "nfev": 53_676},
+            {"label": "dumka3", "setting": "rtol=0.03", "error": 1e-4, "time": 2.0, "cpu": 35.0, "nfev": 67_493,
+             "energy_residual": 1.9e-6}]
+    assert not ac.accepted(rows[0]) and ac.accepted(rows[0], accept_energy=None) and ac.accepted(rows[2])
+    table = {t["label"]: t for t in ac.speedups(ac.distinct_labels(rows), {"time": 500.0, "cpu": 150.0,
+                                                                          "nfev": 400_005})}
+    assert table["rock4"]["setting"] == "rtol=0.001"
+    assert table["dumka3"]["setting"] == "h=2e-06" and table["dumka3"]["speedup_cpu"] == pytest.approx(150 / 29)
+    assert table["dumka3 adaptive"]["setting"] == "rtol=0.03"
+
+
+def test_the_energy_balance_of_a_run_closes_and_names_the_dissipated_work(study):
+    """A run accurate to E < 1e-4 (RK4 at 1e-6 s on chain-S2) closes the balance of its work integrals and stored
+    energy to well below 1e-4 of the input work and dissipates work; the row of test 2 carries both."""
+    _, problem, _ = study
+    (row,) = ac.measure(problem, [parse_method("rk4")], [1e-6], [], [], repeats=1)
+    assert row["error"] < 1e-4
+    assert abs(row["energy_residual"]) < 1e-5 and row["dissipated"] > 0
+    failed = solve(**problem.solve_kwargs(), method="rk4", h=1e-6, t_eval=problem.t_eval, max_steps=3)
+    assert not failed.success and problem.energy_balance(failed) == {}
+
+
 @pytest.mark.parametrize("args,needle", [
     (("--local", "--hs", "1e-5:1e-8:5"), "`--hs`"),
     (("--local", "--methods", "Radau"), "`--methods`"),
@@ -253,6 +299,12 @@ def test_the_study_cache_keeps_runs_and_refuses_another_study(study, tmp_path):
     assert again[0]["time"] == first[0]["time"] and again[0]["error"] == first[0]["error"] < ac.ACCEPT_E
     assert first[0]["cpu"] > 0 and first[0]["setting"] == "h=1e-06"
     assert cache.reference("Radau", 1e-6) is None and not cache.running("Radau", 1e-6)
+    assert cache.start() is None
+    cache.keep_start(problem.y0, "quasi-static")
+    x0, kind = ac.StudyCache.existing(tmp_path).start()
+    assert np.array_equal(x0, problem.y0) and kind == "quasi-static"
+    with pytest.raises(InputError, match="cache"):
+        ac.StudyCache.existing(tmp_path / "none")
     p = np.arange(6.0).reshape(3, 2)
     cache.keep_reference("Radau", 1e-6, p)
     assert np.array_equal(cache.reference("Radau", 1e-6), p)

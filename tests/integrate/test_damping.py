@@ -25,6 +25,7 @@ def R(method, z, **options):
     ("w1-extrapolation", {}, 0.0),
     ("rodas4", {}, 0.0),
     ("rodas5p", {}, 0.0),
+    ("ros34pw2", {}, 0.0),                   # stiffly accurate, L-stable with A = J
     ("radau5", {}, 0.0),
     ("implicit-euler", {}, 0.0),
     ("trapezoidal", {}, -1.0),
@@ -41,7 +42,7 @@ def test_sw24_stability_function_closed_form(d):
         assert R("sw24", z, d=d) == pytest.approx(closed, rel=1e-12)
 
 
-@pytest.mark.parametrize("method", ["rodas4", "rodas5p", "radau5"])
+@pytest.mark.parametrize("method", ["rodas4", "rodas5p", "radau5", "ros34pw2"])
 def test_rodas_is_a_stable_on_the_imaginary_axis(method):
     """A-stability (Hairer-Wanner IV.7; Steinebach 2023): a rotation ``y' = [[0, w], [-w, 0]] y`` (eigenvalues
     ``+-iw``) is not amplified by one step, ``|R(iw)| <= 1``, and damped strongly for large ``w``."""

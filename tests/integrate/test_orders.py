@@ -31,6 +31,7 @@ CASES = [  # method, options, nominal order, step sizes
     ("w1-extrapolation", {"d": 1.0, "stages": 3}, 3, [0.05, 0.025]),
     ("sw24", {"d": 0.25}, 2, [0.05, 0.025]),
     ("sw24", {"d": 1.0}, 2, [0.05, 0.025]),
+    ("ros34pw2", {}, 3, [0.1, 0.05]),
     ("trapezoidal", {}, 2, [0.05, 0.025]),
     ("trapezoidal", {"newton": "exact"}, 2, [0.05, 0.025]),
     ("implicit-euler", {}, 1, [0.02, 0.01]),
