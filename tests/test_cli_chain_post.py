@@ -64,11 +64,13 @@ def test_a_followed_link_sees_the_field_the_whole_chain_shows_at_an_instant(marc
     assert (tmp_path / "follow.png").stat().st_size > 10_000
 
 
-def test_chain_frequencies_of_a_chain_gliding_along_its_placement(tmp_path):
-    """chain-S2 pins gliding along the polygon of their placement (ratio 0.45), a tenth of a pitch per 10 us row:
+@pytest.mark.parametrize("preset", ["chain-S2", "chain-A5"])
+def test_chain_frequencies_of_a_chain_gliding_along_its_placement(tmp_path, preset):
+    """Pins gliding along the polygon of their placement (ratio 0.45), a tenth of a pitch per 10 us row:
     f_link = 10 kHz and f_chain = f_link / n, read from the pins' travel alone (no speed or contact radius is
-    stored); to the polygon's corner cutting, which shortens the path per pitch by at most (p / r)^2 / 8."""
-    scene = load_scene("chain-S2")
+    stored); to the polygon's corner cutting, which shortens the path per pitch by at most (p / r)^2 / 8.  A5's
+    pin is the mean of its two halves, placed rolling on each other."""
+    scene = load_scene(preset)
     model = chain_loop(scene)
     n = model.family.n
     pl = place_on_path(model.family.geom.L, 0.45, model.contact.centres[0, 0])
