@@ -103,7 +103,8 @@ CONTROL = Table("control", "Speed and ratio stabilisation systems (spec section 
     Key("start_force_ratio", "float", "Clamping-force ratio F1/F2 at which the chain runs at the target ratio (open "
         "loop, studies/chain/clamping_ratio_variant.py); used by ratio_loop_start = 'force-ratio' (0: unset).", "-",
         0.0, ge=0.0, le=10.0),
-), checks=(lambda t, p: _check_ordered(t, p, "i_min", "i_max"), lambda t, p: _check_loop_start(t, p)))
+), checks=(lambda t, p: _check_ordered(t, p, "i_min", "i_max"), lambda t, p: _check_loop_start(t, p),
+            lambda t, p: _check_speed_loop_time(t, p)))
 
 REGIME = Table("regime", "Operating regime of a run.", (
     Key("kind", "str", "Regime type.", "", "stationary",
@@ -183,6 +184,14 @@ def _check_geometry(t: Mapping[str, Any], path: str) -> None:
             raise InputError(f"{path}.torus_radius", t["torus_radius"],
                              f"must exceed |r + torus_offset| over r_min..r_max = {reach:g} m for toroidal sheaves "
                              "(the generating arc must reach every contact radius)")
+
+
+def _check_speed_loop_time(t: Mapping[str, Any], path: str) -> None:
+    """The driven-speed loop's transient time is at least 2-3 filter constants (spec 1.6.4): a loop faster than
+    its own speed measurement has gains ``~ 1/tau^2`` that no run resolves (a fuzzed 4.5e-30 s made BDF crawl)."""
+    if t["tau"] < 2 * t["tau_omega"]:
+        raise InputError(f"{path}.tau", t["tau"], f"must be at least 2 `tau_omega` = {2 * t['tau_omega']:g} s (spec "
+                         "1.6.4: the loop's transient time is 2-3 filter constants or more)")
 
 
 def _check_chain(t: Mapping[str, Any], path: str) -> None:
