@@ -28,7 +28,7 @@ import numpy as np
 from cvtfem.control.clamping import Clamping
 from cvtfem.io.results import read_results
 from cvtfem.machines.cvt import band_params
-from cvtfem.post.history import windowed_efficiency
+from cvtfem.post.history import energy_residual, windowed_efficiency
 from cvtfem.scene.loader import scene_from_dict
 
 RPM = 30 / math.pi
@@ -50,7 +50,7 @@ def series(path):
     F11 = F1 - F1a - c.c_f0 * (np.asarray(s["control.ratio_estimate"]).reshape(-1) - rg.ratio)
     W = np.asarray(s["work"])          # cumulative works (input, output, dissipated, clamping), J
     E = np.asarray(s["energy"]).reshape(-1)
-    residual = (W[-1, 0] + W[-1, 3] - W[-1, 1] - W[-1, 2] - (E[-1] - E[0])) / W[-1, 0]
+    residual = energy_residual(r)[-1]     # the run's balance, as `cvtfem history` prints it
     nan = any(np.isnan(np.asarray(v, float)).any() for v in s.values() if np.asarray(v).dtype.kind == "f")
     w2 = np.asarray(s["driven.speed"]).reshape(-1)
     d = dict(t=t, ratio=ratio, rpm=w1 * RPM, rpm2=w2 * RPM, F1=F1, F11=F11, residual=float(residual), nan=nan,
