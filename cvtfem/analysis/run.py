@@ -77,7 +77,7 @@ def run_scene(scene, until: float | None = None, results: str | Path | None = No
 
 def resume_run(results: str | Path, show_progress: bool = True,
                on_checkpoint: Callable[[float, int], None] | None = None, scene=None,
-               changed: bool = False) -> RunSummary:
+               changed: bool = False, until: float | None = None) -> RunSummary:
     """Continue a killed run from the newest checkpoint of its results file, appending to that file.
 
     The scene (TOML stored in the file), end time and solver come from the file; rows after the
@@ -85,20 +85,27 @@ def resume_run(results: str | Path, show_progress: bool = True,
     fixed or adaptive: the step size is restored) and those that export their memory (trapezoidal/theta,
     scipy Radau and BDF; sparse Jacobians stored compressed) give bitwise the series of an uninterrupted
     run; others (W-methods, stabilized methods, LSODA) restart their memory, so their results agree within
-    the solver tolerance.  A finished run or a file without checkpoint is refused
-    with :class:`InputError`.
+    the solver tolerance.  A file without checkpoint is refused with :class:`InputError`, and so is a
+    finished run unless ``until`` is given.
+
+    ``until`` (s) continues the run, killed or finished, to that end time instead of the stored one: it
+    must lie after the checkpoint.  The series then equal those of one run to ``until`` (bitwise for the
+    methods above); the summary's efficiency window starts at the checkpoint when the last
+    :data:`~cvtfem.analysis.summary.EFFICIENCY_WINDOW` before ``until`` began before it.  Everything is
+    checked before the file is touched.
 
     ``scene`` (a :class:`~cvtfem.scene.loader.Scene`, optional) must equal the stored one but for its
     ``title`` and ``description``: a difference is an :class:`InputError` naming the first differing key,
     unless ``changed``: then the run continues with ``scene``'s values from the checkpoint (which must have
     its state layout), and the file stores ``scene`` and the changes (``/stats`` ``scene_changed``).
     """
-    from cvtfem.io.results import ResultsWriter, read_scene_toml
+    from cvtfem.io.results import ResultsWriter, read_checkpoint, read_scene_toml
     from cvtfem.scene.loader import _parse, scene_from_dict
 
+    text = read_scene_toml(results, "--resume")
     diff = []
     if scene is not None:
-        stored = scene_from_dict(_parse(read_scene_toml(results, "--resume"), str(results)), source=str(results))
+        stored = scene_from_dict(_parse(text, str(results)), source=str(results))
         diff = scene_differences(stored, scene)
         if diff and not changed:
             raise InputError("SCENE", scene.source, f"must equal the scene stored in {results} to resume it: "
@@ -107,12 +114,25 @@ def resume_run(results: str | Path, show_progress: bool = True,
         if diff and _Run.prepared(scene).layout() != _Run.prepared(stored).layout():
             raise InputError("SCENE", scene.source, f"must give the state layout of the run in {results} to "
                              "continue it: its model, solver method or events change what a checkpoint holds")
-    writer, seq, values = ResultsWriter.resume(results, scene_toml=scene.to_toml() if diff else None)
+    run = None
+    if until is not None:    # checked, and the run built, before the file is rewritten
+        latest = read_checkpoint(results)
+        t_ck = float(latest["t"][0]) if latest is not None else 0.0
+        if not (math.isfinite(until) and until > t_ck):
+            raise InputError("--until", until, f"must be a finite end time after the newest checkpoint of {results} "
+                             f"(t = {t_ck:.6g} s), which the run continues from")
+        text = scene.to_toml() if diff else text
+        run = _Run.prepared(scene_from_dict(_parse(text, str(results)), source=f"{results} (resumed)"), until)
+    writer, seq, values = ResultsWriter.resume(results, scene_toml=scene.to_toml() if diff else None,
+                                               extend=until is not None)
     try:
         stored = scene_from_dict(_parse(writer.scene_toml, str(results)), source=f"{results} (resumed)")
         if diff:
             writer.set_stats({"scene_changed": "; ".join(diff)})
-        run = _Run.prepared(stored, float(values["t_end"][0]))
+        if run is None:
+            run = _Run.prepared(stored, float(values["t_end"][0]))
+        elif until != float(values["t_end"][0]):   # a new end: its window starts at the checkpoint at the earliest
+            run.j_window = max(run.j_window, int(values["k"][0]))
         if dict(writer.checkpoint_layout) != {**dict(run.layout().fields), "rows": 1}:
             raise InputError("--resume", str(results), "must hold a checkpoint of this cvtfem version's run driver "
                              f"(state layout {writer.checkpoint_layout} differs)")

@@ -1,7 +1,8 @@
 """``cvtfem run SCENE [--until T] [--summary-json OUT] [--results FILE]``: a time run of a CVT scene.
 
 ``cvtfem run --resume RESULTS.h5`` continues a killed run from the newest checkpoint in its
-results file (scene, end time and solver from the file), appending to the same file.
+results file (scene, end time and solver from the file), appending to the same file; with ``--until T``
+it continues a killed or finished run to the end time T.
 ``cvtfem run SCENE --resume RESULTS.h5`` checks that SCENE is the stored scene (exit 2 naming the first
 differing key otherwise); with ``--resume-changed`` it continues the run with SCENE's values.
 """
@@ -11,17 +12,18 @@ import argparse
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
-    p = sub.add_parser("run", help="time run of a CVT scene (band models), results to HDF5")
+    p = sub.add_parser("run", help="time run of a CVT scene (band and chain models), results to HDF5")
     p.add_argument("scene", metavar="SCENE", nargs="?", default=None,
                    help="scene file (.toml) or preset name (e.g. band-4dof); omitted with --resume")
-    p.add_argument("--until", type=float, default=None, metavar="T", help="simulated end time, s (default solver.t_end)")
+    p.add_argument("--until", type=float, default=None, metavar="T", help="simulated end time, s (default solver.t_end); with --resume: continue the run, killed or "
+                        "finished, to T")
     p.add_argument("--results", default=None, metavar="FILE",
                    help="HDF5 results file (default: out/runs/<scene>.h5; 'none' for no file)")
     p.add_argument("--overwrite", action="store_true", help="replace an existing results file")
     p.add_argument("--summary-json", default=None, metavar="OUT", help="write the run summary as JSON")
     p.add_argument("--resume", default=None, metavar="RESULTS.h5",
                    help="continue a killed run from the newest checkpoint of its results file (scene from the "
-                        "file; a SCENE given too must equal it)")
+                        "file; a SCENE given too must equal it); with --until T also a finished run, to T")
     p.add_argument("--resume-changed", action="store_true",
                    help="with SCENE and --resume: continue the run with SCENE's values where they differ from the "
                         "stored scene's (same state layout)")
@@ -46,13 +48,13 @@ def run(args: argparse.Namespace) -> int:
         raise InputError("--resume-changed", True, "needs SCENE and --resume RESULTS.h5 (it continues that run "
                          "with SCENE's values)")
     if args.resume is not None:
-        for name, value in (("--until", args.until), ("--results", args.results),
-                            ("--overwrite", args.overwrite or None)):
+        for name, value in (("--results", args.results), ("--overwrite", args.overwrite or None)):
             if value is not None:
-                raise InputError(name, value, "cannot be combined with --resume (end time and results file "
-                                 "are those of the resumed run)", "run `cvtfem run --resume RESULTS.h5`")
+                raise InputError(name, value, "cannot be combined with --resume (the run appends to its own "
+                                 "results file)", "run `cvtfem run --resume RESULTS.h5 [--until T]`")
         scene = None if args.scene is None else load_scene(args.scene)
-        summary = resume_run(args.resume, on_checkpoint=on_checkpoint, scene=scene, changed=args.resume_changed)
+        summary = resume_run(args.resume, on_checkpoint=on_checkpoint, scene=scene, changed=args.resume_changed,
+                             until=args.until)
     else:
         if args.scene is None:
             raise InputError("SCENE", None, "is required (a scene file or preset name), unless --resume RESULTS.h5")

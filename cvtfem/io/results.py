@@ -179,38 +179,39 @@ class ResultsWriter:
 
     @classmethod
     def resume(cls, path: str | Path, flush_interval: float = 2.0, where: str = "--resume",
-               scene_toml: str | None = None) -> tuple[ResultsWriter, int, dict[str, np.ndarray]]:
+               scene_toml: str | None = None, extend: bool = False) -> tuple[ResultsWriter, int, dict[str, np.ndarray]]:
         """Reopen a killed run's file for appending from its newest checkpoint.
 
         Returns the writer (rows up to the checkpoint, later rows dropped: the run recomputes
         them), the checkpoint number and its payload (``rows`` included).  Refused with
-        :class:`InputError` for a finished run, a file without checkpoint or not a run.
-        ``scene_toml`` replaces the stored scene (a resume with changed values).
+        :class:`InputError` for a finished run (unless ``extend``: a run continued to a later end
+        time), a file without checkpoint or not a run.  ``scene_toml`` replaces the stored scene (a
+        resume with changed values).
         """
         path = Path(path)
         if not path.is_file():
             raise InputError(where, str(path), "must be an existing results file (.h5) of a killed run")
         lock = RunLock(path, where)
         try:
-            return cls._resume(path, flush_interval, where, lock, scene_toml)
+            return cls._resume(path, flush_interval, where, lock, scene_toml, extend)
         except BaseException:
             lock.release()
             raise
 
     @classmethod
     def _resume(cls, path: Path, flush_interval: float, where: str, lock: RunLock,
-                scene_toml: str | None) -> tuple[ResultsWriter, int, dict[str, np.ndarray]]:
+                scene_toml: str | None, extend: bool) -> tuple[ResultsWriter, int, dict[str, np.ndarray]]:
         with _reading(path, where) as f:
             attrs, group = _checked(f, path, where)
             if attrs.get("kind") != "run":
                 raise InputError(where, str(path), f"must be the results file of `cvtfem run` (kind is "
                                  f"{attrs.get('kind')!r})")
-            if attrs.get("status") == "finished":
+            if attrs.get("status") == "finished" and not extend:
                 t = group["time"]
                 last = f"{t[-1]:.6g} s" if t.shape[0] else "its end"
                 raise InputError(where, str(path), f"must be an unfinished run: this one finished (t = {last})",
-                                 "nothing to resume; results are never overwritten, start a new run with "
-                                 "another --results file")
+                                 "to continue it to a later end time add `--until T`; results are never "
+                                 "overwritten otherwise")
             latest = ckpt.read_latest(f)
             if latest is None:
                 raise InputError(where, str(path), "must hold a checkpoint: this run wrote none",
@@ -490,6 +491,15 @@ def read_scene_toml(path: str | Path, where: str = "RESULTS") -> str:
     path = Path(path)
     with _reading(path, where) as f:
         return _scene_text(f, path, where)
+
+
+def read_checkpoint(path: str | Path, where: str = "--resume") -> dict[str, np.ndarray] | None:
+    """The payload of the newest intact checkpoint of a results file (``t``, ``t_end``, ...), None without one;
+    the file is only read."""
+    path = Path(path)
+    with _reading(path, where) as f:
+        latest = ckpt.read_latest(f)
+        return None if latest is None else latest[1]
 
 
 def read_results(path: str | Path) -> Results:

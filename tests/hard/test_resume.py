@@ -123,8 +123,9 @@ def test_killed_run_resumes_bitwise(tmp_path, cli):
     assert _series_equal(ref, res), where
     assert res.stats["solver_steps"] == ref.stats["solver_steps"]
     path = res.path
-    again = cli("run", "--resume", str(path))  # a finished run is not resumed (and never overwritten)
-    assert again.returncode == 2 and "unfinished run" in again.stderr and "Traceback" not in again.stderr
+    again = cli("run", "--resume", str(path))  # a finished run is not resumed without --until (nor overwritten)
+    assert again.returncode == 2 and "unfinished run" in again.stderr and "--until" in again.stderr
+    assert "Traceback" not in again.stderr
     assert _series_equal(ref, read_results(path))
 
 
@@ -287,9 +288,46 @@ def test_resume_refuses_file_without_checkpoint(tmp_path, cli):
     assert read_results(path).time.size == 1  # untouched
 
 
+def test_finished_run_extended_equals_one_longer_run(tmp_path, cli):
+    """`cvtfem run --resume FILE --until T` continues a finished run: its series equal those of one run to T
+    bitwise (rk4 restarts from the newest checkpoint, the rows after it are recomputed), and the summary's
+    efficiency is the work ratio over the samples since that checkpoint (the last 50 ms began before it)."""
+    scene_file = tmp_path / "scene.toml"
+    scene_file.write_text(SCENE, encoding="utf-8")
+    ref_path, path = tmp_path / "ref.h5", tmp_path / "ext.h5"
+    run_scene(load_scene(scene_file), until=UNTIL, results=ref_path, show_progress=False)
+    first = cli("run", str(scene_file), "--until", str(0.6 * UNTIL), "--results", str(path))
+    assert first.returncode == 0, first.stderr
+    short = read_results(path)
+    assert short.attrs["status"] == "finished" and short.time[-1] == pytest.approx(0.6 * UNTIL)
+    summary = resume_run(path, show_progress=False, until=UNTIL)
+    ref, res = read_results(ref_path), read_results(path)
+    assert res.attrs["status"] == "finished" and res.attrs["resumed"] == 1
+    assert _series_equal(ref, res), _difference(ref, res)
+    t_ck = res.stats["resumed_from_t"]
+    assert 0.5 * UNTIL < t_ck < 0.6 * UNTIL                      # the newest checkpoint of the short run
+    j = int(np.searchsorted(res.time, t_ck, side="right"))       # the first sample the resumed run wrote
+    W = res.series["work"]
+    assert summary.efficiency == pytest.approx((W[-1, 1] - W[j, 1]) / (W[-1, 0] - W[j, 0]), rel=1e-12)
+
+
+def test_extension_before_the_checkpoint_is_refused_untouched(tmp_path, cli):
+    scene_file = tmp_path / "scene.toml"
+    scene_file.write_text(SCENE, encoding="utf-8")
+    path = tmp_path / "run.h5"
+    run_scene(load_scene(scene_file), until=0.02, results=path, show_progress=False)
+    before = read_results(path)
+    res = cli("run", "--resume", str(path), "--until", "0.01")
+    assert res.returncode == 2 and "`--until`" in res.stderr and "after the newest checkpoint" in res.stderr
+    assert "Traceback" not in res.stderr
+    after = read_results(path)
+    assert after.attrs["status"] == "finished" and "resumed" not in after.attrs
+    assert _series_equal(before, after)
+
+
 def test_resume_argument_errors(tmp_path, cli):
-    res = cli("run", "--resume", str(tmp_path / "x.h5"), "--until", "1")
-    assert res.returncode == 2 and "`--until` cannot be combined with --resume" in res.stderr
+    res = cli("run", "--resume", str(tmp_path / "x.h5"), "--results", "y.h5")
+    assert res.returncode == 2 and "`--results` cannot be combined with --resume" in res.stderr
     res = cli("run", "--resume", str(tmp_path / "missing.h5"))
     assert res.returncode == 2 and "must be an existing results file" in res.stderr
     res = cli("run")
