@@ -32,9 +32,10 @@ ZENO_GAP = 1e-9     # events closer than this fraction of the span ...
 ZENO_GAP_H = 1e-6   # ... or of the step count towards Zeno accumulation
 ZENO_COUNT = 3      # that many in a row stop the run
 GROWTH_LIMIT = 1e8  # default growth guard (see :mod:`cvtfem.integrate.guards`)
-#: Exceptions of a right-hand side at a state it cannot evaluate (a blown-up state reaching a linear solve):
-#: a failed attempt with the reason, not a traceback.
-MODEL_FAILURES = (np.linalg.LinAlgError, FloatingPointError, ZeroDivisionError, OverflowError)
+#: Exceptions of a right-hand side at a state it cannot evaluate (a blown-up state reaching a linear solve, or a
+#: model's own NumericalError, e.g. a pin end on a shaft axis): a failed attempt with the reason, not a
+#: traceback; an adaptive method retries with a smaller step, a fixed-step one stops there.
+MODEL_FAILURES = (np.linalg.LinAlgError, FloatingPointError, ZeroDivisionError, OverflowError, NumericalError)
 
 
 @dataclass

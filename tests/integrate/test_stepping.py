@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 
+from cvtfem.errors import NumericalError
 from cvtfem.integrate.stepping import Stepping, make_engine
 from cvtfem.integrate.system import as_system
 from cvtfem.io import checkpoint as ckpt
@@ -58,3 +59,37 @@ def test_sparse_checkpoint_slot_is_small_and_restores_bitwise(tmp_path, method):
         assert run.t == again.t and np.array_equal(run.x, again.x)
     for c in ("nfev", "njev", "nlu"):
         assert run.counts[c] == again.counts[c], c
+
+
+class _Unphysical:
+    """``y' = -k (y - 0.9)`` from 0 whose right-hand side refuses a state above 1 with the model's NumericalError
+    (as the H2 contact refuses a pin end on a shaft axis): an explicit stage of a too-long step lands there."""
+
+    k = 50.0
+
+    def __call__(self, t, y):
+        if y[0] > 1.0:
+            raise NumericalError("a state the model cannot evaluate", component="test model")
+        return -self.k * (y - 0.9)
+
+
+def test_a_models_numerical_error_rejects_the_step_of_an_adaptive_run():
+    """The playground's adaptive steppers retry with a smaller step (scipy's solvers stop with the reason)."""
+    fun = _Unphysical()
+    system = as_system(fun, np.zeros(1))
+    run = Stepping(make_engine("dopri45", system, 0.0, np.zeros(1), 1.0, 1e-8, 1e-10, first_step=0.1), 0.0,
+                   np.zeros(1), 1.0)
+    with pytest.raises(NumericalError):
+        fun(0.0, np.array([0.0 + 0.1 * fun.k * 0.9]))        # the first trial's stage lies beyond the limit
+    while run.status == "running":
+        assert run.step(), run.failure
+    assert run.x[0] == pytest.approx(0.9 - 0.9 * np.exp(-fun.k), abs=1e-8)
+
+
+def test_a_models_numerical_error_stops_a_fixed_step_run_with_its_reason():
+    from cvtfem.integrate import solve
+
+    res = solve(_Unphysical(), (0.0, 1.0), [0.0], method="rk4", h=0.1)   # stage y = 4.5 at the first step
+    assert not res.success and "cannot evaluate" in res.message and "h = 0.1" in res.message
+    with pytest.raises(NumericalError, match="cannot evaluate"):
+        solve(_Unphysical(), (0.0, 1.0), [0.0], method="rk4", h=0.1, raise_on_failure=True)
