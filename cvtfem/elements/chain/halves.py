@@ -696,8 +696,8 @@ class ChainA5:
         to ``max(|x|, l)``) differences of that link alone, kept as its cross-check; each pin's coordinate block
         (bending, contacts, friction) central differences of the pin alone (step ``1e-7 max(|x|, l)``), its velocity
         block exact in one pass (dampers and the friction laws' slopes, :func:`halves_kernel._pin_velocity_block`);
-        the axial friction's tension dependence by the chain rule.  Forward differences are one-sided at the kinks of the plate law and
-        the contacts: Newton from the exact straight chain diverged with them.
+        the axial friction's tension dependence by the chain rule.  Forward differences are one-sided at the kinks
+        of the plate law and the contacts: Newton from the exact straight chain diverged with them.
         numpy backend: :meth:`coloured_jacobian`.
         """
         if scheme not in ("analytic", "forward", "central"):

@@ -838,7 +838,7 @@ def _pin_velocity_block(x, xd, p, T_next, T_prev, b_joint, cs, arc, idx, sig_, c
             for d in range(2):                                    # directions t, n of the half and their weights
                 u0, u1 = (th[h2, 0], th[h2, 1]) if d == 0 else (nh[h2, 0], nh[h2, 1])
                 A = A_tau if d == 0 else A_n
-                for sg in (1.0, -1.0):                            # [[4, 2], [2, 4]] = 3 (1, 1)(1, 1)^T + (1, -1)(1, -1)^T
+                for sg in (1.0, -1.0):                            # [[4, 2], [2, 4]] = 3 (1,1)(1,1)^T + (1,-1)(1,-1)^T
                     for k in range(2):
                         a = 1.0 if k == 0 else sg
                         w[o + 2 * k] += a * u0
