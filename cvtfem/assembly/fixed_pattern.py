@@ -74,14 +74,23 @@ def add_mixed_rows(data, target, src, src_indptr, b_indptr, b_indices, b_data):
 
 @njit(cache=True)
 def add_mixed_runs(data, start, src, src_indptr, b_indptr, b_indices, b_data):
-    """:func:`add_mixed_rows` where each row's entries land on consecutive positions of ``data``, from ``start[r]``
-    (a contiguous update the compiler vectorises)."""
-    for r in range(src_indptr.shape[0] - 1):
+    """:func:`add_mixed_rows` where each row's entries land on consecutive positions of ``data``, from ``start[r]``:
+    each row summed in a scratch row first, then added (contiguous updates the compiler vectorises; accumulating in
+    ``data`` itself took 1.07 ms against 0.78 for the A5 chain's two matrices)."""
+    n = src_indptr.shape[0] - 1
+    width = 0
+    for r in range(n):
+        width = max(width, src_indptr[r + 1] - src_indptr[r])
+    row = np.empty(width)
+    for r in range(n):
         t, length = start[r], src_indptr[r + 1] - src_indptr[r]
+        row[:length] = 0.0
         for k in range(b_indptr[r], b_indptr[r + 1]):
             b, s0 = b_data[k], src_indptr[b_indices[k]]
             for j in range(length):
-                data[t + j] += b * src[s0 + j]
+                row[j] += b * src[s0 + j]
+        for j in range(length):
+            data[t + j] += row[j]
 
 
 def runs(target: np.ndarray, indptr: np.ndarray) -> np.ndarray | None:

@@ -693,11 +693,11 @@ class ChainA5:
         its coordinate block by ``scheme``: "analytic" (default; exact within the plates' states: the strain
         Hessians, the state law's Jacobian and the curvature of the moving plate stations,
         :func:`halves_kernel._link_jacobian`), or "central" (step ``1e-7``) or "forward" (step ``sqrt(eps)``, relative
-        to ``max(|x|, l)``) differences of that link alone, kept as its cross-check; each pin's blocks (bending,
-        contacts, friction) central differences of the pin alone (steps ``1e-7 max(|x|, l)`` and ``1e-2 v_0``: the
-        friction laws bend on the scale ``v_0`` of the slip, whatever the chain's speed); the axial friction's
-        tension dependence by the chain rule.  Forward differences are one-sided at the kinks of the plate law and
-        the contacts: Newton from the exact straight chain diverged with them.
+        to ``max(|x|, l)``) differences of that link alone, kept as its cross-check; each pin's coordinate block
+        (bending, contacts, friction) central differences of the pin alone (step ``1e-7 max(|x|, l)``), its velocity
+        block exact in one pass (dampers and the friction laws' slopes, :func:`halves_kernel._pin_velocity_block`);
+        the axial friction's tension dependence by the chain rule.  Forward differences are one-sided at the kinks
+        of the plate law and the contacts: Newton from the exact straight chain diverged with them.
         numpy backend: :meth:`coloured_jacobian`.
         """
         if scheme not in ("analytic", "forward", "central"):
@@ -728,7 +728,7 @@ class ChainA5:
             self._positions = HK.positions(self._kernel_args, self.dof_index, pat)
         Jq, Jv = np.zeros(pat.nnz + 1), np.zeros(pat.nnz + 1)
         dDq, dDv = np.zeros(self.n2), np.zeros(self.n2)
-        steps = np.array([np.sqrt(np.finfo(float).eps) if scheme == "forward" else 1e-7, 1e-7, 1e-2])
+        steps = np.array([np.sqrt(np.finfo(float).eps) if scheme == "forward" else 1e-7, 1e-7])
         link = {"forward": HK.FORWARD, "central": HK.CENTRAL, "analytic": HK.ANALYTIC}[scheme]
         HK.jacobian(np.asarray(q, float), np.asarray(v, float), *self._kernel_args, *self._positions, steps, link,
                     Jq, Jv, dDq, dDv)

@@ -733,6 +733,142 @@ def _pin(x, xd, p, T_next, T_prev, b_joint, cs, arc, idx, sig_, cw, par, law, el
 
 
 @njit(cache=True)
+def _rank1(Jl, dPl, w, nz, c, dP):
+    """Add ``c w w^T`` to the local block ``Jl`` (29, 29) and ``dP w`` to ``dPl`` (29,) over the nonzero entries of
+    ``w``, then clear ``w``: one velocity term ``F(s) w`` with ``s = w . v``, slope ``c = F'(s)`` and power
+    derivative ``dP = (F s)'``."""
+    m = 0
+    for i in range(29):
+        if w[i] != 0.0:
+            nz[m] = i
+            m += 1
+    for a in range(m):
+        wa = w[nz[a]]
+        dPl[nz[a]] += dP * wa
+        for b in range(m):
+            Jl[nz[a], nz[b]] += c * wa * w[nz[b]]
+    for a in range(m):
+        w[nz[a]] = 0.0
+
+
+@njit(cache=True)
+def _damper(Jl, dPl, w, nz, xd, c):
+    """A damper ``-c s w`` on ``s = w . v`` (power ``-c s^2``)."""
+    s = 0.0
+    for i in range(29):
+        s += w[i] * xd[i]
+    _rank1(Jl, dPl, w, nz, -c, -2 * c * s)
+
+
+@njit(cache=True)
+def _slope(v, f0, v0, law, eps):
+    """``df/dv`` (s/m) of the friction law ``f(v) = psi(v) v`` at ``v >= 0`` (:func:`.friction.friction_slope`;
+    at the kink of ``linear-saturated`` the right-hand slope)."""
+    x = v / v0
+    if law == 4:
+        t = np.tanh(x)
+        s = 1.0 - t * t
+    elif law == 2:
+        y = 0.5 * np.pi * x
+        s = 1.0 / (1.0 + y * y)
+    elif law == 3:
+        s = 1.5 * (1.0 - x * x) if x < 1.0 else 0.0
+    elif law == 1:
+        s = 1.0 if x < 1 - eps else (0.0 if x > 1 + eps else 1.0 - (x - (1 - eps)) / (2 * eps))
+    else:
+        s = 1.0 if x < 1.0 else 0.0
+    return (f0 / v0) * s
+
+
+@njit(cache=True)
+def _slider(Jl, dPl, w, nz, xd, N, f0, v0, law):
+    """Friction ``F = -N psi(|s|) s`` along ``w`` on ``s = w . v``: slope ``-N f'(|s|)``, power derivative
+    ``F' s + F``."""
+    s = 0.0
+    for i in range(29):
+        s += w[i] * xd[i]
+    F = -N * _gain(abs(s), f0, v0, law, SMOOTH_EPS) * s
+    c = -N * _slope(abs(s), f0, v0, law, SMOOTH_EPS)
+    _rank1(Jl, dPl, w, nz, c, c * s + F)
+
+
+@njit(cache=True)
+def _station_map(w, A, B, H, n0, n1, cA, cB, ath):
+    """``w = n . (dU_B - dU_A) + cA dth_A + cB dth_B`` at a station with shape values ``H``: the rate map of a
+    contact direction ``n`` whose force :func:`_pair` spreads (``ath (2, 29)``: the links' spin-rate maps)."""
+    for i in range(4):
+        w[10 * B + 2 * i] += H[i] * n0
+        w[10 * B + 2 * i + 1] += H[i] * n1
+        w[10 * A + 2 * i] -= H[i] * n0
+        w[10 * A + 2 * i + 1] -= H[i] * n1
+    for k in range(21, 29):
+        w[k] += cA * ath[A, k] + cB * ath[B, k]
+
+
+@njit(cache=True)
+def _pin_velocity_block(x, xd, p, T_next, T_prev, b_joint, cs, arc, idx, sig_, cw, par, law, wk, vw, Jl, dPl):
+    """``dQ/dv`` of pin ``p``'s element (:func:`_pin`) added into ``Jl (29, 29)`` and the gradient of its power over
+    ``v`` into ``dPl (29,)``, in one pass.  Every velocity term of the pin is ``F_k(s_k) w_k`` with a rate
+    ``s_k = w_k . v`` whose map ``w_k`` depends on ``x`` only (the forces are the transposed rate maps): its block
+    is ``F_k' w_k w_k^T`` (dampers ``F_k = -c_k s_k``, friction laws by their slopes :func:`_slope`), its power
+    gradient ``(F_k' s_k + F_k) w_k``.  Half bending damping splits into four such dampers."""
+    tau, rho, thd, th, nh, Qth, H, Hp, Hpp, Ux, Vx, kA, kB, nab, Hs, CG, pw = wk
+    w, nz, ath = vw
+    l, b_half, A_tau, A_n, beta = par[0], par[2], par[3], par[4], par[5]
+    b_roll, f0, v0 = par[9], par[13], par[14]
+    for h2 in range(2):                                           # half axial damping
+        w[10 * h2 + 9] = 1.0
+        _damper(Jl, dPl, w, nz, xd, 4 * b_half)
+    if f0 != 0.0:                                                 # axial friction (1.221)
+        Tn, Tp = max(T_next, 0.0), max(T_prev, 0.0)
+        w[18], w[8] = 1.0, -1.0
+        _slider(Jl, dPl, w, nz, xd, 0.5 * (Tn + Tp), f0, v0, law)
+        for h2 in range(2):
+            w[10 * h2 + 8], w[20] = 1.0, -1.0
+            _slider(Jl, dPl, w, nz, xd, Tn if h2 == 0 else Tp, f0, v0, law)
+    _pin_geometry(x, p, cs, arc, idx, sig_, cw, par, tau, rho, th, nh, H, Hp, Hpp, Ux, Hs, CG)
+    for j in range(2):                                            # spin-rate maps of the links
+        o = 21 + 4 * j
+        ath[j, :] = 0.0
+        ath[j, o], ath[j, o + 1] = tau[j, 1] / rho[j], -tau[j, 0] / rho[j]
+        ath[j, o + 2], ath[j, o + 3] = -tau[j, 1] / rho[j], tau[j, 0] / rho[j]
+    if beta != 0.0:                                               # half bending damping, beta N^T G N
+        for h2 in range(2):
+            o = 10 * h2 + 4
+            for d in range(2):                                    # directions t, n of the half and their weights
+                u0, u1 = (th[h2, 0], th[h2, 1]) if d == 0 else (nh[h2, 0], nh[h2, 1])
+                A = A_tau if d == 0 else A_n
+                for sg in (1.0, -1.0):                            # [[4, 2], [2, 4]] = 3 (1,1)(1,1)^T + (1,-1)(1,-1)^T
+                    for k in range(2):
+                        a = 1.0 if k == 0 else sg
+                        w[o + 2 * k] += a * u0
+                        w[o + 2 * k + 1] += a * u1
+                        cth = a * (u0 * x[o + 2 * k + 1] - u1 * x[o + 2 * k])
+                        for c in range(21, 29):
+                            w[c] += cth * ath[h2, c]
+                    _damper(Jl, dPl, w, nz, xd, beta * (3.0 if sg > 0 else 1.0) * A / l)
+    for s in range(2):
+        Hst = Hs[s]
+        for ic in range(3):
+            A, B, sig = idx[ic, 0], idx[ic, 1], sig_[ic]
+            RA, RB = arc[ic, 2], arc[ic, 5]
+            wgt = l / 2 * cw[ic, p]
+            n0, n1, g, N = CG[s, ic, 1], CG[s, ic, 2], CG[s, ic, 3], CG[s, ic, 4]
+            kA0, kA1, kB0, kB1 = CG[s, ic, 5], CG[s, ic, 6], CG[s, ic, 7], CG[s, ic, 8]
+            t0, t1 = -n1, n0
+            if b_roll != 0.0 and ic == 0 and g < 0:               # roll damping on the gap rate
+                _station_map(w, A, B, Hst, n0, n1, -(n0 * kA0 + n1 * kA1), n0 * kB0 + n1 * kB1, ath)
+                _damper(Jl, dPl, w, nz, xd, wgt * b_roll)
+            if f0 != 0.0 and N != 0.0:                            # rolling friction on the slip
+                _station_map(w, A, B, Hst, t0, t1, -(t0 * kA0 + t1 * kA1 + RA), t0 * kB0 + t1 * kB1 - sig * RB, ath)
+                _slider(Jl, dPl, w, nz, xd, N, f0, v0, law)
+    if b_joint[p] != 0.0:                                         # joint damping (1.80)
+        for c in range(21, 29):
+            w[c] = ath[0, c] - ath[1, c]
+        _damper(Jl, dPl, w, nz, xd, b_joint[p])
+
+
+@njit(cache=True)
 def _axial_friction_slopes(xd, p, T_next, T_prev, f0, v0, law, out):
     """``d Q / d T`` of pin ``p``'s axial friction (rows ``w_0-``, ``w_0+``, ``q_p``) for ``T_next`` (``out[0]``)
     and ``T_prev`` (``out[1]``); zero where a tension is not positive."""
@@ -813,16 +949,16 @@ def jacobian(q, v, gl, gp, L, c_twist, b_joint, cs, plate_w, plate_d, plate_c, p
 
     Element by element: a link's velocity block is exact (its forces are linear in the velocities), its
     coordinate block exact within the plates' states (``link_scheme`` :data:`ANALYTIC`, :func:`_link_jacobian`) or
-    :data:`FORWARD` or :data:`CENTRAL` differences of the link alone; a pin's blocks
-    central differences of the pin alone (a coordinate and its copies at once); the axial friction's
-    dependence on the link tensions by the chain rule with the tensions' differences.  ``steps = (link, pin
-    coordinate, pin velocity)`` relative steps, applied to ``max(|x|, l)`` (smaller steps drown in the round-off
-    of the contact forces) and to ``v_0`` (the friction laws bend on that scale of the slip, whatever the speed:
-    a step relative to ``|v|`` spans the law's knee at chain speed).
+    :data:`FORWARD` or :data:`CENTRAL` differences of the link alone; a pin's coordinate block central
+    differences of the pin alone (a coordinate and its copies at once), its velocity block exact in one pass
+    (:func:`_pin_velocity_block`); the axial friction's dependence on the link tensions by the chain rule with
+    the tensions' differences.  ``steps = (link, pin coordinate)`` relative steps, applied to ``max(|x|, l)``
+    (smaller steps drown in the round-off of the contact forces).
 
     The gradient of the dissipated power ``D`` of :func:`forces_power` over ``q`` and ``v`` is added into ``dDq``,
-    ``dDv`` (21 n,) from the same element passes: the elements' power differences (a link's ``dD/dv`` exact,
-    ``-2 Q_d``: its damping forces are linear in the velocities) and the axial friction's tension dependence.
+    ``dDv`` (21 n,) from the same element passes: the elements' power differences over ``q``, exact over ``v`` (a
+    link's ``-2 Q_d``: its damping forces are linear in the velocities; a pin's from its velocity block) and the
+    axial friction's tension dependence.
     """
     n = L.shape[0]
     l, f0, v0 = par[0], par[13], par[14]
@@ -887,38 +1023,40 @@ def jacobian(q, v, gl, gp, L, c_twist, b_joint, cs, plate_w, plate_d, plate_c, p
     pk = _pin_work()
     ppw = pk[-1]
     slopes = np.zeros((2, 3))
+    Jl, dPl, vw = np.zeros((29, 29)), np.zeros(29), (np.zeros(29), np.zeros(29, np.int64), np.zeros((2, 29)))
     for p in range(n):
         pv = (p - 1) % n
         for j in range(29):
             y[j], yd[j] = q[gp[p, j]], v[gp[p, j]]
-        for j in range(58):                                       # 29 coordinates, then 29 velocities
-            z = y if j < 29 else yd
-            jj = j % 29
+        for jj in range(29):                                      # coordinates
             if first[p, jj] != jj:                                # a copy: moved with its first
                 continue
-            if j == 29:                                           # geometry at the unperturbed coordinates
-                _pin(y, yd, p, T[p], T[pv], b_joint, cs, arc, idx, sig, cw, par, law, False, True, False, g_p, pk)
             lateral = jj < 8 or 9 < jj < 18 or jj > 20                # w, q_p reach the axial terms only
-            z0 = z[jj]
-            h = _step(z0, steps[1], floor) if j < 29 else (z0 + steps[2] * v0) - z0
+            z0 = y[jj]
+            h = _step(z0, steps[1], floor)
             dP = 0.0
             for sgn in range(2):
                 for k in range(jj, 29):
                     if first[p, k] == jj:
-                        z[k] = z0 + h if sgn == 0 else z0 - h
+                        y[k] = z0 + h if sgn == 0 else z0 - h
                 g = g_p if sgn == 0 else g_m
                 g[:] = 0.0
                 ppw[0] = 0.0
-                _pin(y, yd, p, T[p], T[pv], b_joint, cs, arc, idx, sig, cw, par, law, j < 29, lateral, j >= 29, g,
-                     pk)
+                _pin(y, yd, p, T[p], T[pv], b_joint, cs, arc, idx, sig, cw, par, law, True, lateral, False, g, pk)
                 dP += ppw[0] if sgn == 0 else -ppw[0]
             for k in range(jj, 29):
                 if first[p, k] == jj:
-                    z[k] = z0
-            Jx = Jq if j < 29 else Jv
-            (dDq if j < 29 else dDv)[gp[p, jj]] -= dP / (2 * h)
+                    y[k] = z0
+            dDq[gp[p, jj]] -= dP / (2 * h)
             for r in range(29):
-                Jx[pos_p[p, r, jj]] += (g_p[r] - g_m[r]) / (2 * h)
+                Jq[pos_p[p, r, jj]] += (g_p[r] - g_m[r]) / (2 * h)
+        Jl[:, :] = 0.0                                            # velocities: one pass (copies add up)
+        dPl[:] = 0.0
+        _pin_velocity_block(y, yd, p, T[p], T[pv], b_joint, cs, arc, idx, sig, cw, par, law, pk, vw, Jl, dPl)
+        for c in range(29):
+            dDv[gp[p, c]] -= dPl[c]
+            for r in range(29):
+                Jv[pos_p[p, r, c]] += Jl[r, c]
         if f0 != 0.0:
             _axial_friction_slopes(yd, p, T[p], T[pv], f0, v0, law, slopes)
             for j in range(2):

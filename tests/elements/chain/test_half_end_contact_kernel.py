@@ -64,9 +64,15 @@ def test_compiled_contact_forces_equal_the_numpy_path(model, states):
 
 def test_compiled_contact_jacobian_equals_the_numpy_path(model, states):
     """``dQ/dy`` entries of the contacts and the friction power's gradient: the same central differences of the
-    local contact (steps of HalfEndContact.local_jacobian), so equal but for the round-off the steps magnify."""
+    local contact (steps of HalfEndContact.local_jacobian), so equal but for the round-off the steps magnify.  The
+    compiled path differentiates the candidates in contact only (those with ``delta > 0``), the numpy path all."""
     n2 = model.n2
+    K, table = model._contact_kernel, model._pair_table
     for q, v in states[:2]:
+        pair, _ = K.local_jacobians(np.concatenate([q, v, model._constants]), *table, *model._compiled_contact,
+                                    K.STEPS)
+        _, _, _, (_, det) = model._contacts(q, v, details=True)
+        assert len(pair) == (det["delta"] > 0).sum() < len(det["delta"])
         (rc, cc, dc), gc = model._contact_jacobian(q, v)
         (rr, cr, dr), gr = model._contact_jacobian(q, v, reference=True)
         A = sp.csr_matrix((dc, (rc, cc)), shape=(n2, 2 * n2))
