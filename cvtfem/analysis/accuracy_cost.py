@@ -69,6 +69,11 @@ class PinForceProblem(Problem):
     p_ref: np.ndarray = field(default_factory=lambda: np.zeros(0))
     output: str = PIN_FORCE
 
+    def solve_kwargs(self) -> dict:
+        """:class:`Problem`'s, with the loop's stiff split (A5's halves' friction) where it has one."""
+        split = getattr(self.loop, "stiff_split", None)
+        return {**super().solve_kwargs(), **({"split": split} if split is not None else {})}
+
     def pin_forces(self, y, t=None) -> np.ndarray:
         """The output (samples, components) at the states ``y`` (n, samples) and times ``t`` (default
         ``t_eval``): a chain's pin axial forces (N) from the chain family's output alone (the contacts and loops

@@ -29,6 +29,7 @@ from cvtfem.elements.chain.halves import ChainA5
 from cvtfem.elements.chain.halves_placement import half_centres, rolling_link_directions, rolling_spacing
 from cvtfem.elements.chain.placement import Placement, place_on_path
 from cvtfem.errors import InputError, NumericalError
+from cvtfem.integrate.system import StiffSplit
 from cvtfem.machines.chain_a_cvt import PLATE_HEIGHT, PLATE_THICKNESS, POISSON, ChainACVT
 from cvtfem.machines.chain_cvt import ChainCVT
 from cvtfem.machines.static_balance import lifted_newton
@@ -325,13 +326,17 @@ class ChainHalvesCVT(ChainACVT):
         equal to ``evaluate(t, x)[0]`` to round-off (``tests/machines/test_chain_halves_one_pass.py``)."""
         if not self._one_pass:
             return super().rhs(t, x)
+        return self._rhs_with(t, x, self.family.chain._kernel_args)
+
+    def _rhs_with(self, t: float, x, chain_args: tuple):
+        """The one-pass :meth:`rhs` with the chain's compiled pass on the kernel constants ``chain_args``."""
         n2, nz = self.n2, self.control.size
         nc, iphi, iz, _ = self._idx
         v = x[n2:2 * n2]
         w = v[iphi]
         F, M, dz, _ = self._controls(t, w, x[2 * n2:2 * n2 + nz])
         Q = np.zeros(n2)
-        D = HK.add_forces_power(Q, x, v, *self.family.chain._kernel_args)
+        D = HK.add_forces_power(Q, x, v, *chain_args)
         Pf = self._contact_forces(x[:n2], v, Q)[0]
         Q[iphi] += M
         Q[iz] -= self.sheaves_per_z * F
@@ -343,6 +348,40 @@ class ChainHalvesCVT(ChainACVT):
         out[2 * n2:2 * n2 + nz] = dz
         out[2 * n2 + nz:] = (M[0] * w[0], -M[1] * w[1], D - Pf, -self.sheaves_per_z * float(F @ v[iz]))
         return out
+
+    # ----- the halves' internal friction split off (stiff, solved implicitly) ------------------------------------
+    @cached_property
+    def stiff_split(self) -> StiffSplit | None:
+        """``x' = f_E(x) + f_I(x)`` with ``f_I`` the halves' internal friction (axial (1.221) and rolling; velocity rows
+        and the dissipated-work row only): :meth:`rhs_explicit` and :meth:`friction_solve`; None off the one-pass path
+        (numpy chain backend, elastic shafts)."""
+        if not self._one_pass or self.family.chain.f0 == 0.0:
+            return None
+        return StiffSplit(self.rhs_explicit, self.friction_solve)
+
+    @cached_property
+    def _frictionless_args(self) -> tuple:
+        return self.family.chain.without_friction()._kernel_args
+
+    def rhs_explicit(self, t: float, x):
+        """:meth:`rhs` without the halves' internal friction (their ``f_0 = 0``): ``f_E`` of :attr:`stiff_split`."""
+        return self._rhs_with(t, x, self._frictionless_args)
+
+    def friction_solve(self, t: float, x, h: float) -> tuple[np.ndarray, int]:
+        """Backward Euler over ``h`` (s) of ``x' = f_I(x)`` (positions frozen): the chain's velocities from
+        :meth:`ChainA5.friction_step` and its dissipated work added to the work integral ``D - P_fr``, so the run's
+        energy balance closes exactly.  Returns the new state and the Newton iterations (each one sparse LU)."""
+        chain, nc, n2 = self.family.chain, self.family.size, self.n2
+        key = x[:nc].tobytes()
+        if self._slips[0] != key:
+            self._slips = (key, *chain.friction_slips(x[:nc]))
+        v, W, its = chain.friction_step(self._slips[1], self._slips[2], x[n2:n2 + nc], h)
+        out = np.array(x, float)
+        out[n2:n2 + nc] = v
+        out[2 * n2 + self.control.size + 2] += W
+        return out, its
+
+    _slips: tuple = (None, None, None)
 
     @cached_property
     def _jac_plan(self) -> dict | None:

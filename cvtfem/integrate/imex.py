@@ -1,0 +1,60 @@
+"""Strang splitting of a stiff part the model solves itself: ``I(h/2) o E(h) o I(h/2)`` (the halves' friction of A5).
+
+The system carries a :class:`~cvtfem.integrate.system.StiffSplit` ``x' = f_E + f_I``.  A step is a backward-Euler
+half step of ``f_I`` (the model's own nonlinear solve; for A5 the halves' internal friction with the positions
+frozen, :meth:`~cvtfem.machines.chain_halves_cvt.ChainHalvesCVT.friction_solve`), one step of an explicit method on
+``f_E`` alone, and another half step of ``f_I``.  Order 1 in general (backward Euler's half steps; Strang's order 2
+needs a second-order ``I``), unconditionally stable for a dissipative ``f_I``; the explicit method's stage count
+follows the spectral radius of ``f_E`` alone.  Fixed steps only (no error estimate).  The friction solves count as
+``nnewton`` (iterations) and ``nlu`` (one sparse LU each), timed in ``t_lu``.
+"""
+from __future__ import annotations
+
+from cvtfem.errors import InputError
+from cvtfem.integrate.base import Attempt, Stepper
+from cvtfem.integrate.system import OdeSystem
+
+__all__ = ["StrangFriction"]
+
+#: The explicit methods a split step may use.
+EXPLICIT = ("dumka3", "rk4", "rock4", "dopri45")
+
+
+class StrangFriction(Stepper):
+    """``I(h/2) o E(h) o I(h/2)``: ``explicit`` (a registered explicit method, default DUMKA3, with its options
+    ``stages``, ``spectral_radius``, ``rho_every``) on ``f_E``, the system's own backward Euler on ``f_I``."""
+
+    name, order = "strang-friction", 1
+    OPTIONS = frozenset({"explicit", "stages", "spectral_radius", "rho_every"})
+
+    def __init__(self, system: OdeSystem, stats=None, explicit: str = "dumka3", **options) -> None:
+        super().__init__(system, stats)
+        from cvtfem.integrate.methods import METHODS
+
+        if system.split is None:
+            raise InputError("method", self.name, "needs a system with a stiff split (StiffSplit): the A5 chain on rigid "
+                                                  "shafts with internal friction (variants (e), (zh)) has one")
+        if explicit not in EXPLICIT:
+            raise InputError("explicit", explicit, f"must be one of {EXPLICIT}")
+        cls = METHODS[explicit]
+        unknown = set(options) - cls.OPTIONS
+        if unknown:
+            raise InputError("options", sorted(unknown), f"must be options of {explicit}: {sorted(cls.OPTIONS)}")
+        inner = OdeSystem(fun=system.split.explicit, n=system.n, n2=system.n2)
+        self.inner = cls(inner, self.stats, **options)
+        self.inner.need_error = False
+
+    def _implicit(self, t, x, h):
+        st = self.stats
+        with st.timer("t_lu"):
+            x1, its = self.system.split.solve(t, x, h)
+        st.add("nnewton", its)
+        st.add("nlu", its)
+        return x1
+
+    def attempt(self, t, x, h):
+        y = self._implicit(t, x, 0.5 * h)
+        y = self.inner.attempt(t, y, h).x1
+        self.stages = self.inner.stages
+        self.inner.accept(Attempt(t, y, h, y))
+        return Attempt(t, x, h, self._implicit(t + h, y, 0.5 * h))
