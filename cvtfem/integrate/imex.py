@@ -18,6 +18,10 @@ __all__ = ["StrangFriction"]
 
 #: The explicit methods a split step may use.
 EXPLICIT = ("dumka3", "rk4", "rock4", "dopri45")
+#: ``strang``: ``I(h/2) o E(h) o I(h/2)``; ``frozen``: the stiff part's forces from one backward-Euler step of
+#: ``f_I`` after the explicit impulse ``h f_E(x)`` (velocity rows), held constant over the explicit method's step
+#: (their work booked at the power they deliver along it: the split's ``hold``).
+SCHEMES = ("strang", "frozen")
 
 
 class StrangFriction(Stepper):
@@ -25,9 +29,10 @@ class StrangFriction(Stepper):
     ``stages``, ``spectral_radius``, ``rho_every``) on ``f_E``, the system's own backward Euler on ``f_I``."""
 
     name, order = "strang-friction", 1
-    OPTIONS = frozenset({"explicit", "stages", "spectral_radius", "rho_every"})
+    OPTIONS = frozenset({"explicit", "scheme", "stages", "spectral_radius", "rho_every"})
 
-    def __init__(self, system: OdeSystem, stats=None, explicit: str = "dumka3", **options) -> None:
+    def __init__(self, system: OdeSystem, stats=None, explicit: str = "dumka3", scheme: str = "strang",
+                 **options) -> None:
         super().__init__(system, stats)
         from cvtfem.integrate.methods import METHODS
 
@@ -40,7 +45,14 @@ class StrangFriction(Stepper):
         unknown = set(options) - cls.OPTIONS
         if unknown:
             raise InputError("options", sorted(unknown), f"must be options of {explicit}: {sorted(cls.OPTIONS)}")
-        inner = OdeSystem(fun=system.split.explicit, n=system.n, n2=system.n2)
+        if scheme not in SCHEMES:
+            raise InputError("scheme", scheme, f"must be one of {SCHEMES}")
+        self.scheme, self._frozen = scheme, None
+        if scheme == "frozen" and system.split.hold is None:
+            raise InputError("scheme", scheme, "needs the split's `hold` (the work rate of the held forces)")
+        split = system.split
+        fun = split.explicit if scheme == "strang" else (lambda t, x: split.explicit(t, x) + split.hold(x, self._frozen))
+        inner = OdeSystem(fun=fun, n=system.n, n2=system.n2)
         self.inner = cls(inner, self.stats, **options)
         self.inner.need_error = False
 
@@ -53,8 +65,19 @@ class StrangFriction(Stepper):
         return x1
 
     def attempt(self, t, x, h):
-        y = self._implicit(t, x, 0.5 * h)
-        y = self.inner.attempt(t, y, h).x1
+        if self.scheme == "frozen":
+            fe = self.system.split.explicit(t, x)
+            self.stats.add("nfev")
+            pred = x.copy()
+            n2 = self.system.n2
+            pred[n2:] += h * fe[n2:]                  # positions frozen: the explicit impulse of the step
+            d = (self._implicit(t, pred, h) - pred) / h
+            self._frozen = d
+            y = self.inner.attempt(t, x, h).x1
+        else:
+            y = self._implicit(t, x, 0.5 * h)
+            y = self.inner.attempt(t, y, h).x1
+            y = self._implicit(t + h, y, 0.5 * h)
         self.stages = self.inner.stages
         self.inner.accept(Attempt(t, y, h, y))
-        return Attempt(t, x, h, self._implicit(t + h, y, 0.5 * h))
+        return Attempt(t, x, h, y)

@@ -22,11 +22,14 @@ class StiffSplit:
     """``x' = f_E(t, x) + f_I(t, x)`` with a stiff part ``f_I`` the model solves itself.
 
     ``explicit(t, x)`` is ``f_E``; ``solve(t, x, h)`` returns ``(x_new, iterations)``: backward Euler of
-    ``x' = f_I(t, x)`` over ``h`` from ``x`` (``x_new = x + h f_I(t, x_new)``, each iteration one sparse LU).
+    ``x' = f_I(t, x)`` over ``h`` from ``x`` (``x_new = x + h f_I(t, x_new)``, each iteration one sparse LU);
+    ``hold(x, d)`` (optional) the rate at ``x`` of the stiff part's forces held constant: ``d``'s velocity rows (the
+    forces' accelerations) and the work rows at the power those forces deliver at ``x``.
     """
 
     explicit: Callable[[float, np.ndarray], np.ndarray]
     solve: Callable[[float, np.ndarray, float], tuple]
+    hold: Callable[[np.ndarray, np.ndarray], np.ndarray] | None = None
 
 
 @dataclass(frozen=True)

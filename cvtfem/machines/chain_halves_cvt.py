@@ -357,7 +357,7 @@ class ChainHalvesCVT(ChainACVT):
         (numpy chain backend, elastic shafts)."""
         if not self._one_pass or self.family.chain.f0 == 0.0:
             return None
-        return StiffSplit(self.rhs_explicit, self.friction_solve)
+        return StiffSplit(self.rhs_explicit, self.friction_solve, self.friction_hold)
 
     @cached_property
     def _frictionless_args(self) -> tuple:
@@ -382,6 +382,15 @@ class ChainHalvesCVT(ChainACVT):
         return out, its
 
     _slips: tuple = (None, None, None)
+
+    def friction_hold(self, x, d):
+        """The rate at ``x`` of the friction forces ``M d_v`` held constant (``d_v``: ``d``'s chain velocity rows,
+        m/s^2): those accelerations, and their dissipated power ``-(M d_v) . v`` on the work row ``D - P_fr``."""
+        nc, n2 = self.family.size, self.n2
+        out = np.zeros(self.size)
+        out[n2:n2 + nc] = d[n2:n2 + nc]
+        out[2 * n2 + self.control.size + 2] = -float((self.family.chain.mass_matrix @ d[n2:n2 + nc]) @ x[n2:n2 + nc])
+        return out
 
     @cached_property
     def _jac_plan(self) -> dict | None:

@@ -655,12 +655,13 @@ class ChainA5:
             return HK.link_tensions(np.asarray(q, float), a[0], *a[2:4], *a[6:11], a[15], a[16])
         return self.outputs(q)["chain.link_tension"]
 
-    def friction_slips(self, q: np.ndarray) -> tuple[sp.csr_matrix, np.ndarray]:
+    def friction_slips(self, q: np.ndarray, groups: bool = False) -> tuple:
         """``(B, c)``: with the positions ``q`` frozen every slip of the halves' internal friction is linear in the
         velocities, ``s = B v`` (m/s; rows: the half-half axial slip of each pin, the half-pack slips of half -, half +,
         then the rolling slip of each contact and Gauss station where it is closed), and the friction forces are
         ``F = -B^T (c psi(|s|) s)`` with the normal forces ``c`` (N) and the law's gain ``psi`` (:meth:`friction_forces`
-        exactly, to round-off)."""
+        exactly, to round-off).  With ``groups`` also each row's group: 0 axial half-half, 1 axial half-pack, then
+        ``2 + k`` for contact ``k`` of :data:`CONTACTS` (rolling, hole of the next link, of the previous one)."""
         n, di, l = self.n_pins, self.dof_index, self.l
         u = self.split(np.asarray(q, float))[0]
         p = np.arange(n)
@@ -709,23 +710,28 @@ class ChainA5:
         B = sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))), shape=(m, self.n2))
         c = np.concatenate(c)
         keep = np.flatnonzero(c > 0)
-        return B[keep], c[keep]
+        label = np.concatenate([np.zeros(n, int), np.ones(2 * n, int), np.repeat(2 + np.arange(len(CONTACTS)),
+                                                                                 len(GAUSS_XI) * n)])
+        return (B[keep], c[keep], label[keep]) if groups else (B[keep], c[keep])
 
     def friction_step(self, B: sp.csr_matrix, c: np.ndarray, v_star: np.ndarray, h: float,
-                      tol: float = 1e-8, max_lu: int = 100) -> tuple[np.ndarray, float, int]:
+                      tol: float = 1e-6, max_lu: int = 100) -> tuple[np.ndarray, float, int]:
         """Backward Euler of the halves' friction alone with the positions frozen: ``v`` with
         ``M (v - v_star) = h F(v)``, ``F = -B^T (c psi(|Bv|) Bv)`` (:meth:`friction_slips`).
 
         ``v`` minimises the convex ``(v - v_star)^T M (v - v_star) / 2 + h sum c Phi(|Bv|)`` (``Phi' = f``).  Each
-        iteration tries a Newton step (tangent slopes ``c f'``); where it does not lower that function (a slip that
+        iteration tries a Newton step (tangent slopes ``c f'``; its matrix ``M + h B^T D B`` inverted through the
+        slips' ``I + h D B M^-1 B^T``); where it does not lower that function (a slip that
         the tangent of a saturated law sends far off), the majorise-minimise step (secant slopes ``c psi``: the
         quadratic through the current slips lies above ``Phi`` for laws with falling ``psi``, so the function
-        falls) instead; until a full step changes the slips by less than ``tol v_0``.  Returns ``(v, W, LUs)`` with
+        falls) instead; until a step changes the slips by less than ``tol v_0``.  Returns ``(v, W, LUs)`` with
         the work the step dissipates ``W = -h F(v) . (v + v_star) / 2`` (J): the kinetic energy it removes."""
-        M, f0, v0, law = self.mass_matrix, self.f0, self.v0, self.law
+        M, Mi, f0, v0, law = self.mass_matrix, self.inverse_mass, self.f0, self.v0, self.law
         if law not in _POTENTIALS:
             raise InputError("friction_law", law, f"must be one of {sorted(_POTENTIALS)} for the implicit friction")
         Bt = B.T.tocsr()
+        G = (B @ Mi @ Bt).tocsr()                         # slip-space inverse mass (m x m)
+        I = sp.identity(B.shape[0], format="csr")
         v, s_star = np.array(v_star, float), B @ v_star
         s, lus = s_star, 0
 
@@ -734,8 +740,10 @@ class ChainA5:
             return 0.5 * dv_ @ (M @ dv_) + h * c @ _POTENTIALS[law](np.abs(s_), f0, v0)
 
         def step(slopes, g):
-            K = (M + h * (Bt.multiply(slopes[None, :]) @ B)).tocsc()
-            dv = -spla.splu(K).solve(g)
+            """``-(M + h B^T D B)^-1 g`` in the slips' space (Woodbury): ``M^-1`` is block diagonal, the slips few."""
+            y = Mi @ g
+            w = spla.splu((I + h * G.multiply(slopes[:, None])).tocsc()).solve(slopes * (B @ y))
+            dv = h * (Mi @ (Bt @ w)) - y
             return dv, B @ dv
 
         while lus < max_lu:
@@ -743,11 +751,12 @@ class ChainA5:
             g = M @ (v - v_star) + h * (Bt @ (c * gain * s))
             dv, ds = step(c * friction_slope(np.abs(s), f0, v0, law), g)
             lus += 1
-            if objective(v + dv, s + ds) > objective(v, s) + 1e-4 * (g @ dv):
+            done = np.max(np.abs(ds), initial=0.0) <= tol * v0
+            if not done and objective(v + dv, s + ds) > objective(v, s) + 1e-4 * (g @ dv):
                 dv, ds = step(c * gain, g)
                 lus += 1
             v, s = v + dv, s + ds
-            if np.max(np.abs(ds), initial=0.0) <= tol * v0:
+            if done or np.max(np.abs(ds), initial=0.0) <= tol * v0:
                 break
         else:
             raise NumericalError(f"the implicit friction step (h = {h:g} s) did not converge in {max_lu} LUs",
