@@ -20,8 +20,9 @@ __all__ = ["StrangFriction"]
 EXPLICIT = ("dumka3", "rk4", "rock4", "dopri45")
 #: ``strang``: ``I(h/2) o E(h) o I(h/2)``; ``frozen``: the stiff part's forces from one backward-Euler step of
 #: ``f_I`` after the explicit impulse ``h f_E(x)`` (velocity rows), held constant over the explicit method's step
-#: (their work booked at the power they deliver along it: the split's ``hold``).
-SCHEMES = ("strang", "frozen")
+#: (their work booked at the power they deliver along it: the split's ``hold``); ``frozen-mid``: the same from a
+#: backward-Euler half step after half the explicit impulse (the forces of the step's middle).
+SCHEMES = ("strang", "frozen", "frozen-mid")
 
 
 class StrangFriction(Stepper):
@@ -48,7 +49,7 @@ class StrangFriction(Stepper):
         if scheme not in SCHEMES:
             raise InputError("scheme", scheme, f"must be one of {SCHEMES}")
         self.scheme, self._frozen = scheme, None
-        if scheme == "frozen" and system.split.hold is None:
+        if scheme != "strang" and system.split.hold is None:
             raise InputError("scheme", scheme, "needs the split's `hold` (the work rate of the held forces)")
         split = system.split
         fun = split.explicit if scheme == "strang" else (lambda t, x: split.explicit(t, x) + split.hold(x, self._frozen))
@@ -65,13 +66,13 @@ class StrangFriction(Stepper):
         return x1
 
     def attempt(self, t, x, h):
-        if self.scheme == "frozen":
+        if self.scheme != "strang":
             fe = self.system.split.explicit(t, x)
             self.stats.add("nfev")
-            pred = x.copy()
-            n2 = self.system.n2
-            pred[n2:] += h * fe[n2:]                  # positions frozen: the explicit impulse of the step
-            d = (self._implicit(t, pred, h) - pred) / h
+            pred, n2 = x.copy(), self.system.n2
+            hi = h if self.scheme == "frozen" else 0.5 * h
+            pred[n2:] += hi * fe[n2:]                 # positions frozen: the explicit impulse of the step (or half)
+            d = (self._implicit(t, pred, hi) - pred) / hi
             self._frozen = d
             y = self.inner.attempt(t, x, h).x1
         else:

@@ -370,18 +370,23 @@ class ChainHalvesCVT(ChainACVT):
     def friction_solve(self, t: float, x, h: float) -> tuple[np.ndarray, int]:
         """Backward Euler over ``h`` (s) of ``x' = f_I(x)`` (positions frozen): the chain's velocities from
         :meth:`ChainA5.friction_step` and its dissipated work added to the work integral ``D - P_fr``, so the run's
-        energy balance closes exactly.  Returns the new state and the Newton iterations (each one sparse LU)."""
+        energy balance closes exactly.  Newton starts from the friction's acceleration of the previous solve (a guess
+        only: the solution is unique).  Returns the new state and the Newton iterations (each one sparse LU)."""
         chain, nc, n2 = self.family.chain, self.family.size, self.n2
         key = x[:nc].tobytes()
         if self._slips[0] != key:
             self._slips = (key, *chain.friction_slips(x[:nc]))
-        v, W, its = chain.friction_step(self._slips[1], self._slips[2], x[n2:n2 + nc], h)
+        v_star = x[n2:n2 + nc]
+        guess = None if self._friction_accel is None else v_star + h * self._friction_accel
+        v, W, its = chain.friction_step(self._slips[1], self._slips[2], v_star, h, guess)
+        self._friction_accel = (v - v_star) / h
         out = np.array(x, float)
         out[n2:n2 + nc] = v
         out[2 * n2 + self.control.size + 2] += W
         return out, its
 
     _slips: tuple = (None, None, None)
+    _friction_accel = None
 
     def friction_hold(self, x, d):
         """The rate at ``x`` of the friction forces ``M d_v`` held constant (``d_v``: ``d``'s chain velocity rows,

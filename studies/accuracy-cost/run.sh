@@ -141,7 +141,7 @@ if [[ $part == all || $part == variant-e || $part == variant-e-spectra ]]; then 
   done
 fi
 # Session 11: the halves' internal friction (axial (1.221) and rolling) split off and solved implicitly (strang-friction:
-# Strang splitting, or the friction forces of one backward-Euler step held over an explicit DUMKA3/RK4 step), on the
+# Strang splitting, or the friction forces of a backward-Euler step held over an explicit DUMKA3/RK4 step), on the
 # short window of w-short (same cache: its references and start).  The friction owners at 0.2 ms come from
 # a5_friction_owners.py.
 if [[ $part == all || $part == imex-short ]]; then
@@ -150,8 +150,9 @@ if [[ $part == all || $part == imex-short ]]; then
            --sample 1e-6 --repeats 1 --reference DOP853:1e-7 --check dopri78:1e-7 --cache "$cache" \
            --csv "$out/variant-e-imex-short.csv" --json "$out/variant-e-imex-short.json" "$@"; }
   nice .venv/bin/python studies/accuracy-cost/a5_friction_owners.py "$cache" 2e-4 | tee "$out/variant-e-friction-owners.log"
-  is --fixed strang-friction,strang-friction:scheme=frozen --steps 1e-6,2e-6 --adaptive ""
-  is --fixed strang-friction:scheme=frozen:explicit=rk4 --steps 4e-7 --adaptive ""
+  is --fixed strang-friction,strang-friction:scheme=frozen,strang-friction:scheme=frozen-mid --steps 1e-6,2e-6 \
+    --adaptive ""
+  is --fixed strang-friction:scheme=frozen-mid:explicit=rk4 --steps 4e-7 --adaptive ""
   is --fixed dumka3 --steps 1e-6,2e-6 --adaptive "" | tee "$out/variant-e-imex-short.log"
   uptime | tee -a "$out/variant-e-imex-short.log"
 fi

@@ -82,6 +82,16 @@ def test_frozen_error_and_energy(reference):
     assert_balance("frozen")
 
 
+def test_frozen_mid_converges(reference):
+    """The held forces of the step's middle (a backward-Euler half step after half the explicit impulse) converge:
+    the error falls by 3..6 per halving from 2.5e-4 s (order 1.5..2.5) and the balance closes."""
+    errs = [np.abs(solve(SYSTEM, (0.0, 0.5), X0, method="strang-friction", h=h, explicit="rk4",
+                         scheme="frozen-mid").y[:2, -1] - reference[:2]).max() for h in (2.5e-4, 1.25e-4, 6.25e-5)]
+    ratios = np.array(errs[:-1]) / errs[1:]
+    assert np.all(ratios > 3) and np.all(ratios < 6) and errs[-1] < 1.5e-4, errs
+    assert_balance("frozen-mid")
+
+
 def assert_balance(scheme):
     ts = np.linspace(0.0, 0.5, 5001)
     res = solve(SYSTEM, (0.0, 0.5), X0, method="strang-friction", h=1e-4, explicit="rk4", t_eval=ts, scheme=scheme)
@@ -106,3 +116,6 @@ def test_bad_input():
     for bad in ({"explicit": "radau5"}, {"scheme": "lie"}, {"explicit": "rk4", "stages": 9}):
         with pytest.raises(InputError):
             solve(SYSTEM, (0.0, 0.01), X0, method="strang-friction", h=1e-3, **bad)
+    no_hold = OdeSystem(fun=full, n=3, n2=1, split=StiffSplit(explicit, backward_euler))
+    with pytest.raises(InputError, match="hold"):
+        solve(no_hold, (0.0, 0.01), X0, method="strang-friction", h=1e-3, scheme="frozen")

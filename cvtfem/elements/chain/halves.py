@@ -714,7 +714,7 @@ class ChainA5:
                                                                                  len(GAUSS_XI) * n)])
         return (B[keep], c[keep], label[keep]) if groups else (B[keep], c[keep])
 
-    def friction_step(self, B: sp.csr_matrix, c: np.ndarray, v_star: np.ndarray, h: float,
+    def friction_step(self, B: sp.csr_matrix, c: np.ndarray, v_star: np.ndarray, h: float, v_start=None,
                       tol: float = 1e-6, max_lu: int = 100) -> tuple[np.ndarray, float, int]:
         """Backward Euler of the halves' friction alone with the positions frozen: ``v`` with
         ``M (v - v_star) = h F(v)``, ``F = -B^T (c psi(|Bv|) Bv)`` (:meth:`friction_slips`).
@@ -724,7 +724,8 @@ class ChainA5:
         slips' ``I + h D B M^-1 B^T``); where it does not lower that function (a slip that
         the tangent of a saturated law sends far off), the majorise-minimise step (secant slopes ``c psi``: the
         quadratic through the current slips lies above ``Phi`` for laws with falling ``psi``, so the function
-        falls) instead; until a step changes the slips by less than ``tol v_0``.  Returns ``(v, W, LUs)`` with
+        falls) instead, from ``v_start`` (default ``v_star``; the solution does not depend on it), until a step
+        changes the slips by less than ``tol v_0``.  Returns ``(v, W, LUs)`` with
         the work the step dissipates ``W = -h F(v) . (v + v_star) / 2`` (J): the kinetic energy it removes."""
         M, Mi, f0, v0, law = self.mass_matrix, self.inverse_mass, self.f0, self.v0, self.law
         if law not in _POTENTIALS:
@@ -732,8 +733,9 @@ class ChainA5:
         Bt = B.T.tocsr()
         G = (B @ Mi @ Bt).tocsr()                         # slip-space inverse mass (m x m)
         I = sp.identity(B.shape[0], format="csr")
-        v, s_star = np.array(v_star, float), B @ v_star
-        s, lus = s_star, 0
+        s_star, lus = B @ v_star, 0
+        v = np.array(v_star if v_start is None else v_start, float)
+        s = B @ v
 
         def objective(v_, s_):
             dv_ = v_ - v_star
