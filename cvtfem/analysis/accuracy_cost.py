@@ -494,7 +494,8 @@ def local_error_table(problem: Problem, methods, hs, reference_rtol: float = 1e-
             raise InputError("--hs", h, f"must allow the reference run (DOP853 at rtol {reference_rtol:g}): "
                              f"{ref.message}")
         exact.append(ref.y[:, -1])
-    system = as_system(kw["fun"], x0, n2=problem.n2, jac=kw.get("jac"), jac_sparsity=kw.get("jac_sparsity"))
+    system = as_system(kw["fun"], x0, n2=problem.n2, jac=kw.get("jac"), jac_sparsity=kw.get("jac_sparsity"),
+                       split=kw.get("split"))
     rows = []
     for label, method, opts in methods:
         nominal = METHODS[method](system, None, **opts).order

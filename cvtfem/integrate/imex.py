@@ -30,6 +30,8 @@ class StrangFriction(Stepper):
     ``stages``, ``spectral_radius``, ``rho_every``) on ``f_E``, the system's own backward Euler on ``f_I``."""
 
     name, order = "strang-friction", 1
+    #: Runs only on a system with a :class:`~cvtfem.integrate.system.StiffSplit` (generic method loops skip it).
+    needs_split = True
     OPTIONS = frozenset({"explicit", "scheme", "stages", "spectral_radius", "rho_every"})
 
     def __init__(self, system: OdeSystem, stats=None, explicit: str = "dumka3", scheme: str = "strang",
