@@ -4,6 +4,7 @@ system without a split."""
 import numpy as np
 import pytest
 
+from cvtfem.analysis.steppers import make_stepper
 from cvtfem.elements.chain.geometry import reference_geometry
 from cvtfem.elements.contact.friction import friction_gain
 from cvtfem.errors import InputError
@@ -68,3 +69,12 @@ def test_strang_friction_needs_the_split_and_runs_on_the_model(model):
         solve(m.rhs, (0.0, 1e-7), x0, n2=m.n2, method="strang-friction", h=1e-7)
     res = solve(m, (0.0, 2e-7), x0, method="strang-friction", h=1e-7, scheme="frozen")
     assert res.success and np.all(np.isfinite(res.y))
+    # the stepper of `cvtfem run` (the loop's split passed along)
+    run = make_stepper("strang-friction", m.rhs, 0.0, x0, 2e-7, 1e-3, 1e-6, 1e-7, m.jac, m.n2,
+                       split=m.stiff_split)
+    while run.status == "running" and run.step():
+        pass
+    ref = solve(m, (0.0, 2e-7), x0, method="strang-friction", h=1e-7).y[:, -1]        # the default scheme
+    assert run.status == "finished"
+    # equal to the friction solves' tolerance (1e-6 v0 on the slips; Newton's start guess is the last solve's)
+    assert np.abs(run.last.x1 - ref).max() <= 1e-7 * np.abs(ref).max()
