@@ -59,7 +59,8 @@ class OdeSystem:
         The discrete-state automaton: called once per event with the boolean mask of all
         indicators firing together (simultaneous events); may return a new state (impacts).
     split : :class:`StiffSplit` or None
-        The RHS split into an explicit and a stiff part (the splitting methods of :mod:`cvtfem.integrate.imex`).
+        The RHS split into an explicit and a stiff part (the splitting methods of :mod:`cvtfem.integrate.imex`);
+        :func:`as_system` also takes it as a tuple of its fields (what a model's ``stiff_split`` gives).
     """
 
     fun: Callable[[float, np.ndarray], np.ndarray]
@@ -140,8 +141,10 @@ def as_system(fun, y0: np.ndarray, *, n2: int = 0, jac=None, jac_sparsity=None, 
             events, direction, terminal = events_from_callables(events)
     if switch is not None and not callable(switch):
         raise InputError("switch", switch, "must be callable as switch(t, x, fired) -> x or None")
-    if split is not None and not isinstance(split, StiffSplit):
-        raise InputError("split", split, "must be a StiffSplit(explicit, solve) or None")
+    if isinstance(split, tuple) and not isinstance(split, StiffSplit) and len(split) in (2, 3):
+        split = StiffSplit(*split)                       # a model's (explicit, solve[, hold])
+    if split is not None and not (isinstance(split, StiffSplit) and callable(split.explicit) and callable(split.solve)):
+        raise InputError("split", split, "must be a StiffSplit(explicit, solve, hold=None), such a tuple, or None")
     return OdeSystem(fun=fun, n=n, n2=int(n2), jac=jac, jac_sparsity=jac_sparsity, events=events,
                      event_direction=direction, event_terminal=terminal, switch=switch, split=split)
 

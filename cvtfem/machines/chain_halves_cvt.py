@@ -29,7 +29,6 @@ from cvtfem.elements.chain.halves import ChainA5
 from cvtfem.elements.chain.halves_placement import half_centres, rolling_link_directions, rolling_spacing
 from cvtfem.elements.chain.placement import Placement, place_on_path
 from cvtfem.errors import InputError, NumericalError
-from cvtfem.integrate.system import StiffSplit
 from cvtfem.machines.chain_a_cvt import PLATE_HEIGHT, PLATE_THICKNESS, POISSON, ChainACVT
 from cvtfem.machines.chain_cvt import ChainCVT
 from cvtfem.machines.static_balance import lifted_newton
@@ -351,13 +350,14 @@ class ChainHalvesCVT(ChainACVT):
 
     # ----- the halves' internal friction split off (stiff, solved implicitly) ------------------------------------
     @cached_property
-    def stiff_split(self) -> StiffSplit | None:
+    def stiff_split(self) -> tuple | None:
         """``x' = f_E(x) + f_I(x)`` with ``f_I`` the halves' internal friction (axial (1.221) and rolling; velocity rows
-        and the dissipated-work row only): :meth:`rhs_explicit` and :meth:`friction_solve`; None off the one-pass path
-        (numpy chain backend, elastic shafts)."""
+        and the dissipated-work row only): ``(rhs_explicit, friction_solve, friction_hold)``, the fields of
+        :class:`cvtfem.integrate.system.StiffSplit`; None off the one-pass path (numpy chain backend, elastic
+        shafts)."""
         if not self._one_pass or self.family.chain.f0 == 0.0:
             return None
-        return StiffSplit(self.rhs_explicit, self.friction_solve, self.friction_hold)
+        return self.rhs_explicit, self.friction_solve, self.friction_hold
 
     @cached_property
     def _frictionless_args(self) -> tuple:

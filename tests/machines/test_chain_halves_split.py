@@ -36,9 +36,9 @@ def friction_rate(m, x):
 
 def test_explicit_plus_friction_equals_the_rhs(model):
     m, x0 = model
-    assert m.stiff_split is not None
+    assert m.stiff_split == (m.rhs_explicit, m.friction_solve, m.friction_hold)
     for x in _states(m, x0):
-        f, fE, fI = m.rhs(0.0, x), m.stiff_split.explicit(0.0, x), friction_rate(m, x)
+        f, fE, fI = m.rhs(0.0, x), m.rhs_explicit(0.0, x), friction_rate(m, x)
         assert np.abs(fI).max() > 1e-3 * np.abs(f).max()
         assert np.abs(f - fE - fI).max() <= 1e-12 * np.abs(f).max()
 
@@ -48,7 +48,7 @@ def test_friction_solve_is_backward_euler_and_books_the_kinetic_energy(model):
     ch, nc, n2, iw = m.family.chain, m.family.size, m.n2, 2 * m.n2 + m.control.size + 2
     for x in _states(m, x0, 2):
         for h in (1e-7, 2e-6):
-            x1, lus = m.stiff_split.solve(0.0, x, h)
+            x1, lus = m.friction_solve(0.0, x, h)
             assert np.array_equal(x1[:n2], x[:n2]) and np.array_equal(x1[n2 + nc:iw], x[n2 + nc:iw])
             dv = x1[n2:n2 + nc] - x[n2:n2 + nc]
             fI = friction_rate(m, x1)
@@ -57,7 +57,7 @@ def test_friction_solve_is_backward_euler_and_books_the_kinetic_energy(model):
             assert x1[iw] - x[iw] == pytest.approx(T[0] - T[1], rel=1e-9) and T[0] > T[1]
             # held forces: the accelerations and their power at another state
             d = (x1 - x) / h
-            rate = m.stiff_split.hold(x0, d)
+            rate = m.friction_hold(x0, d)
             Mdv = ch.mass_matrix @ d[n2:n2 + nc]
             assert np.array_equal(rate[n2:n2 + nc], d[n2:n2 + nc])
             assert rate[iw] == pytest.approx(-Mdv @ x0[n2:n2 + nc], rel=1e-12)
