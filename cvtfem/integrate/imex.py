@@ -76,6 +76,7 @@ class StrangFriction(Stepper):
             pred[n2:] += hi * fe[n2:]                 # positions frozen: the explicit impulse of the step (or half)
             d = (self._implicit(t, pred, hi) - pred) / hi
             self._frozen = d
+            self.inner._start = (t, x.copy(), fe + self.system.split.hold(x, d))    # its first stage, known
             y = self.inner.attempt(t, x, h).x1
         else:
             y = self._implicit(t, x, 0.5 * h)
