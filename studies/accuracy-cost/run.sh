@@ -152,6 +152,7 @@ if [[ $part == all || $part == imex-short ]]; then
   nice .venv/bin/python studies/accuracy-cost/a5_friction_owners.py "$cache" 2e-4 | tee "$out/variant-e-friction-owners.log"
   is --fixed strang-friction,strang-friction:scheme=frozen,strang-friction:scheme=frozen-mid --steps 1e-6,2e-6 \
     --adaptive ""
+  is --fixed strang-friction:scheme=frozen-mid,dumka3 --steps 2.5e-6,3e-6 --adaptive ""
   is --fixed strang-friction:scheme=frozen-mid:explicit=rk4 --steps 4e-7 --adaptive ""
   is --fixed dumka3 --steps 1e-6,2e-6 --adaptive ""
   is --from-cache | tee "$out/variant-e-imex-short.log"
