@@ -1,12 +1,19 @@
-"""Strang splitting of a stiff part the model solves itself: ``I(h/2) o E(h) o I(h/2)`` (the halves' friction of A5).
+"""Splitting methods for a stiff part the model solves itself (the halves' friction of A5): ``strang-friction``.
 
-The system carries a :class:`~cvtfem.integrate.system.StiffSplit` ``x' = f_E + f_I``.  A step is a backward-Euler
-half step of ``f_I`` (the model's own nonlinear solve; for A5 the halves' internal friction with the positions
-frozen, :meth:`~cvtfem.machines.chain_halves_cvt.ChainHalvesCVT.friction_solve`), one step of an explicit method on
-``f_E`` alone, and another half step of ``f_I``.  Order 1 in general (backward Euler's half steps; Strang's order 2
-needs a second-order ``I``), unconditionally stable for a dissipative ``f_I``; the explicit method's stage count
-follows the spectral radius of ``f_E`` alone.  Fixed steps only (no error estimate).  The friction solves count as
-``nnewton`` (iterations) and ``nlu`` (one sparse LU each), timed in ``t_lu``.
+The system carries a :class:`~cvtfem.integrate.system.StiffSplit` ``x' = f_E + f_I``: ``f_E`` goes to an explicit
+method whose stage count follows the spectral radius of ``f_E`` alone, ``f_I`` to the model's own backward Euler
+(for A5 the halves' internal friction with the positions frozen,
+:meth:`~cvtfem.machines.chain_halves_cvt.ChainHalvesCVT.friction_solve`).  Schemes (:data:`SCHEMES`):
+
+* ``strang``: ``I(h/2) o E(h) o I(h/2)``; order 1 (backward Euler's half steps; Strang's order 2 needs a
+  second-order ``I``), stable for a dissipative ``f_I`` at any step;
+* ``frozen``: the forces of one backward-Euler step of ``f_I`` after the explicit impulse ``h f_E(x)`` (velocity
+  rows), held constant over the explicit step; their work is booked at the power they deliver along it (the split's
+  ``hold``), so the energy balance stays the explicit method's;
+* ``frozen-mid``: the same from a half step after half the impulse (the forces of the step's middle).
+
+Fixed steps only (no error estimate).  The friction solves count as ``nnewton`` (iterations) and ``nlu`` (one sparse
+LU each), timed in ``t_lu``.
 """
 from __future__ import annotations
 
@@ -18,16 +25,13 @@ __all__ = ["StrangFriction"]
 
 #: The explicit methods a split step may use.
 EXPLICIT = ("dumka3", "rk4", "rock4", "dopri45")
-#: ``strang``: ``I(h/2) o E(h) o I(h/2)``; ``frozen``: the stiff part's forces from one backward-Euler step of
-#: ``f_I`` after the explicit impulse ``h f_E(x)`` (velocity rows), held constant over the explicit method's step
-#: (their work booked at the power they deliver along it: the split's ``hold``); ``frozen-mid``: the same from a
-#: backward-Euler half step after half the explicit impulse (the forces of the step's middle).
+#: How a step combines the two parts (module docstring).
 SCHEMES = ("strang", "frozen", "frozen-mid")
 
 
 class StrangFriction(Stepper):
-    """``I(h/2) o E(h) o I(h/2)``: ``explicit`` (a registered explicit method, default DUMKA3, with its options
-    ``stages``, ``spectral_radius``, ``rho_every``) on ``f_E``, the system's own backward Euler on ``f_I``."""
+    """``explicit`` (a registered explicit method, default DUMKA3, with its options ``stages``, ``spectral_radius``,
+    ``rho_every``) on ``f_E``, the system's own backward Euler on ``f_I``, combined by ``scheme`` (:data:`SCHEMES`)."""
 
     name, order = "strang-friction", 1
     #: Runs only on a system with a :class:`~cvtfem.integrate.system.StiffSplit` (generic method loops skip it).
@@ -40,8 +44,8 @@ class StrangFriction(Stepper):
         from cvtfem.integrate.methods import METHODS
 
         if system.split is None:
-            raise InputError("method", self.name, "needs a system with a stiff split (StiffSplit): the A5 chain on rigid "
-                                                  "shafts with internal friction (variants (e), (zh)) has one")
+            raise InputError("method", self.name, "needs a system with a stiff split (StiffSplit): the A5 chain on "
+                                                  "rigid shafts with internal friction (variants (e), (zh)) has one")
         if explicit not in EXPLICIT:
             raise InputError("explicit", explicit, f"must be one of {EXPLICIT}")
         cls = METHODS[explicit]
@@ -54,7 +58,11 @@ class StrangFriction(Stepper):
         if scheme != "strang" and system.split.hold is None:
             raise InputError("scheme", scheme, "needs the split's `hold` (the work rate of the held forces)")
         split = system.split
-        fun = split.explicit if scheme == "strang" else (lambda t, x: split.explicit(t, x) + split.hold(x, self._frozen))
+        if scheme == "strang":
+            fun = split.explicit
+        else:
+            def fun(t, x):
+                return split.explicit(t, x) + split.hold(x, self._frozen)
         inner = OdeSystem(fun=fun, n=system.n, n2=system.n2)
         self.inner = cls(inner, self.stats, **options)
         self.inner.need_error = False
@@ -76,7 +84,7 @@ class StrangFriction(Stepper):
             pred[n2:] += hi * fe[n2:]                 # positions frozen: the explicit impulse of the step (or half)
             d = (self._implicit(t, pred, hi) - pred) / hi
             self._frozen = d
-            self.inner._start = (t, x.copy(), fe + self.system.split.hold(x, d))    # its first stage, known
+            self.inner._start = (t, x.copy(), fe + self.system.split.hold(x, d))    # its F at the start: known
             y = self.inner.attempt(t, x, h).x1
         else:
             y = self._implicit(t, x, 0.5 * h)

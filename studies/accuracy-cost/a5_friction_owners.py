@@ -1,12 +1,13 @@
 """Which friction owns which eigenvalue of variant (e) at a running state (docs/accuracy-cost.md, session 11, step 1).
 
-From the study's start state (the w-short cache, quasi-static at ratio 0.45), DUMKA3 at 2e-6 s runs to ``T`` (s); at
-that state the largest-magnitude eigenvalues (ARPACK, ``k`` of them) of the model Jacobian ``J``, of ``J`` with the
-velocity Jacobian of one group of the halves' internal friction removed (``-M^-1 B_g^T diag(c f') B_g``: axial
-half-half, axial half-pack, rolling contact, the two plate-hole contacts), with all of them removed (the explicit part
-``f_E`` of ``strang-friction``), with both axial ones removed, and with each group's slopes divided by 10 (its friction speed times 10 where the law
-is linear in the slip).  The pin-sheave friction's share: the same with the scene's ``cvt.friction.v0`` times 10.
-    .venv/bin/python studies/accuracy-cost/a5_friction_owners.py out/studies/w-short-cache 2e-4 > owners.log
+From the study's start state (the w-short cache, quasi-static at ratio 0.45), DUMKA3 at 2e-6 s runs to ``T`` (s).  At
+that state: the largest-magnitude eigenvalues (ARPACK) of the model Jacobian ``J``; of ``J`` with the velocity
+Jacobian of one group of the halves' internal friction removed (``-M^-1 B_g^T diag(c f') B_g``: axial half-half,
+axial half-pack, rolling contact, the two plate-hole contacts) and with that group's slopes divided by 10 (its
+friction speed times 10 where the law is linear in the slip); with both axial groups removed; with all removed (the
+explicit part ``f_E`` of ``strang-friction``).  The pin-sheave friction's share: ``J`` and ``f_E`` with the scene's
+``cvt.friction.v0`` times 10.
+    .venv/bin/python studies/accuracy-cost/a5_friction_owners.py out/studies/w-short-cache 2e-4
 """
 import sys
 import time
