@@ -32,6 +32,7 @@ _SPECS: dict[str, object] = {
     "trapezoidal": "cvtfem.integrate.theta:Trapezoidal",
     "implicit-euler": "cvtfem.integrate.theta:ImplicitEuler",
     "dumka3": "cvtfem.integrate.dumka3:DUMKA3",
+    "strang-friction": "cvtfem.integrate.imex:StrangFriction",
     "rock2": "cvtfem.integrate.rock:ROCK2",
     "rock4": "cvtfem.integrate.rock:ROCK4",
     "rkc": "cvtfem.integrate.stabilized:RKC",

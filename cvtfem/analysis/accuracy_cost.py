@@ -69,6 +69,11 @@ class PinForceProblem(Problem):
     p_ref: np.ndarray = field(default_factory=lambda: np.zeros(0))
     output: str = PIN_FORCE
 
+    def solve_kwargs(self) -> dict:
+        """:class:`Problem`'s, with the loop's stiff split (A5's halves' friction) where it has one."""
+        split = getattr(self.loop, "stiff_split", None)
+        return {**super().solve_kwargs(), **({"split": split} if split is not None else {})}
+
     def pin_forces(self, y, t=None) -> np.ndarray:
         """The output (samples, components) at the states ``y`` (n, samples) and times ``t`` (default
         ``t_eval``): a chain's pin axial forces (N) from the chain family's output alone (the contacts and loops
@@ -489,7 +494,8 @@ def local_error_table(problem: Problem, methods, hs, reference_rtol: float = 1e-
             raise InputError("--hs", h, f"must allow the reference run (DOP853 at rtol {reference_rtol:g}): "
                              f"{ref.message}")
         exact.append(ref.y[:, -1])
-    system = as_system(kw["fun"], x0, n2=problem.n2, jac=kw.get("jac"), jac_sparsity=kw.get("jac_sparsity"))
+    system = as_system(kw["fun"], x0, n2=problem.n2, jac=kw.get("jac"), jac_sparsity=kw.get("jac_sparsity"),
+                       split=kw.get("split"))
     rows = []
     for label, method, opts in methods:
         nominal = METHODS[method](system, None, **opts).order

@@ -372,7 +372,8 @@ class _Run:
                                first_step=0.0 if fresh_solver else first_step, error_check=sol.error_check,
                                events=self.events, switch=self.switch,
                                jac_sparsity=getattr(loop, "jac_sparsity", None),
-                               stall_steps=STALL_STEPS, stall_h=STALL_FRACTION * t_end)
+                               stall_steps=STALL_STEPS, stall_h=STALL_FRACTION * t_end,
+                               split=getattr(loop, "stiff_split", None))
         except BaseException as err:
             if writer is not None:
                 writer.close("failed", str(err))

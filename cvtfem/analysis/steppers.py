@@ -8,7 +8,7 @@ from cvtfem.errors import InputError
 
 def make_stepper(method: str, fun, t0: float, y0, t_end: float, rtol: float, atol: float, h: float = 0.0,
                  jac=None, n2: int = 0, first_step: float = 0.0, error_check: int = 0, *, events=None,
-                 jac_sparsity=None, stall_steps: int = 0, stall_h: float = 0.0, switch=None):
+                 jac_sparsity=None, stall_steps: int = 0, stall_h: float = 0.0, switch=None, split=None):
     """The :class:`~cvtfem.integrate.stepping.Stepping` of a run from ``(t0, y0)`` to ``t_end``.
 
     ``method``: any registered name (``h > 0``: fixed step for playground methods, first step for scipy's
@@ -16,7 +16,7 @@ def make_stepper(method: str, fun, t0: float, y0, t_end: float, rtol: float, ato
     ``first_step > 0`` (a resumed run: the step size saved at the checkpoint) overrides ``h`` as the first
     step of adaptive methods; ``error_check``: local-error check of fixed steps every that many steps;
     ``events``: ``(indicators, direction, terminal)``; ``switch``: ``switch(t, x, fired) -> x or None`` at events;
-    ``stall_steps``/``stall_h``: the stall guard.
+    ``stall_steps``/``stall_h``: the stall guard; ``split``: the model's stiff split (``strang-friction``).
     """
     from cvtfem.integrate import METHODS, SCIPY_METHODS
     from cvtfem.integrate.stepping import Stepping, make_engine
@@ -26,7 +26,8 @@ def make_stepper(method: str, fun, t0: float, y0, t_end: float, rtol: float, ato
         raise InputError("solver.method", method, "must be one of " + ", ".join(
             tuple(SCIPY_METHODS) + tuple(sorted(METHODS))) + " for `cvtfem run`")
     y0 = np.asarray(y0, float)
-    system = as_system(fun, y0, n2=n2, jac=jac, jac_sparsity=jac_sparsity, events=events, switch=switch)
+    system = as_system(fun, y0, n2=n2, jac=jac, jac_sparsity=jac_sparsity, events=events, switch=switch,
+                       split=split)
     native = method in METHODS
     start = (first_step or None) if native else (first_step or h or None)
     try:

@@ -132,7 +132,8 @@ def run_local(args: argparse.Namespace, window) -> int:
     from cvtfem.post.integrators import write_csv
     from cvtfem.scene.loader import load_scene
 
-    names = [m for m in args.methods.split(",") if m.strip()] or list(METHODS)
+    names = [m for m in args.methods.split(",") if m.strip()] or [m for m, cls in METHODS.items()
+                                                                    if not getattr(cls, "needs_split", False)]
     methods = [parse_method(m) for m in names]
     for _, method, _ in methods:
         if method not in METHODS:

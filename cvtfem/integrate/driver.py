@@ -56,7 +56,7 @@ def solve(fun, t_span, y0, method: str = "dopri45", h: float | None = None, rtol
           switch=None, adaptive: bool | None = None, event_location: str = "dense",
           max_steps: int = 10_000_000, max_events: int = 100_000, raise_on_failure: bool = False,
           growth_limit: float | None = GROWTH_LIMIT, event_samples: int = EVENT_SAMPLES,
-          error_check: int = 0, controller: str | None = None, **options) -> OdeResult:
+          error_check: int = 0, controller: str | None = None, split=None, **options) -> OdeResult:
     """Integrate ``x' = F(t, x)`` over ``t_span`` with one of the playground's methods.
 
     Parameters
@@ -102,6 +102,9 @@ def solve(fun, t_span, y0, method: str = "dopri45", h: float | None = None, rtol
         integral, smoother step sequences at a stability limit) or ``"predictive"`` (Gustafsson, shrinks
         ``h`` when the error grows from step to step); None: the method's default (``"predictive"``
         for ``rodas4``, ``rodas5p`` and ``radau5``, else ``"i"``). All take no growth right after a rejection.
+    split : :class:`~cvtfem.integrate.system.StiffSplit` or None
+        The RHS split into an explicit and a stiff part, for the splitting method ``strang-friction``; a model
+        passed as ``fun`` gives its own (its ``stiff_split``).
     **options : method options (``d``, ``alpha``, ``newton``, ``stages``, ``sequence`` ...);
         an option the method ignores warns with :class:`IgnoredOptionWarning`.
     """
@@ -121,7 +124,7 @@ def solve(fun, t_span, y0, method: str = "dopri45", h: float | None = None, rtol
             raise InputError("t_eval", "array", "must be sorted and lie within t_span")
     if method not in METHODS and method not in SCIPY_METHODS:
         raise InputError("method", method, f"must be one of {sorted(METHODS) + sorted(SCIPY_METHODS)}")
-    system = as_system(fun, y0, n2=n2, jac=jac, jac_sparsity=jac_sparsity, events=events, switch=switch)
+    system = as_system(fun, y0, n2=n2, jac=jac, jac_sparsity=jac_sparsity, events=events, switch=switch, split=split)
     scipy = method in SCIPY_METHODS
     if scipy:
         from cvtfem.integrate.scipy_bridge import SCIPY_OPTIONS

@@ -14,7 +14,22 @@ import scipy.sparse as sp
 
 from cvtfem.errors import InputError
 
-__all__ = ["OdeSystem", "as_system", "events_from_callables"]
+__all__ = ["OdeSystem", "StiffSplit", "as_system", "events_from_callables"]
+
+
+@dataclass(frozen=True)
+class StiffSplit:
+    """``x' = f_E(t, x) + f_I(t, x)`` with a stiff part ``f_I`` the model solves itself.
+
+    ``explicit(t, x)`` is ``f_E``; ``solve(t, x, h)`` returns ``(x_new, iterations)``: backward Euler of
+    ``x' = f_I(t, x)`` over ``h`` from ``x`` (``x_new = x + h f_I(t, x_new)``, each iteration one sparse LU);
+    ``hold(x, d)`` (optional) the rate at ``x`` of the stiff part's forces held constant: ``d``'s velocity rows (the
+    forces' accelerations) and the work rows at the power those forces deliver at ``x``.
+    """
+
+    explicit: Callable[[float, np.ndarray], np.ndarray]
+    solve: Callable[[float, np.ndarray, float], tuple]
+    hold: Callable[[np.ndarray, np.ndarray], np.ndarray] | None = None
 
 
 @dataclass(frozen=True)
@@ -43,6 +58,9 @@ class OdeSystem:
     switch : callable ``switch(t, x, fired) -> x_new or None``
         The discrete-state automaton: called once per event with the boolean mask of all
         indicators firing together (simultaneous events); may return a new state (impacts).
+    split : :class:`StiffSplit` or None
+        The RHS split into an explicit and a stiff part (the splitting methods of :mod:`cvtfem.integrate.imex`);
+        :func:`as_system` also takes it as a tuple of its fields (what a model's ``stiff_split`` gives).
     """
 
     fun: Callable[[float, np.ndarray], np.ndarray]
@@ -54,6 +72,7 @@ class OdeSystem:
     event_direction: np.ndarray | None = None
     event_terminal: np.ndarray | None = None
     switch: Callable | None = None
+    split: StiffSplit | None = None
 
     @property
     def n1(self) -> int:
@@ -81,7 +100,7 @@ def events_from_callables(events) -> tuple[Callable, np.ndarray, np.ndarray]:
 
 
 def as_system(fun, y0: np.ndarray, *, n2: int = 0, jac=None, jac_sparsity=None, events=None,
-              switch=None) -> OdeSystem:
+              switch=None, split=None) -> OdeSystem:
     """Build an :class:`OdeSystem` from ``solve``'s arguments, validating them.
 
     ``fun`` may already be an :class:`OdeSystem` (then the other arguments must be absent) or
@@ -96,7 +115,8 @@ def as_system(fun, y0: np.ndarray, *, n2: int = 0, jac=None, jac_sparsity=None, 
         model = fun
         return as_system(model.rhs, y0, n2=model.n2, jac=getattr(model, "jac", None),
                          jac_sparsity=getattr(model, "jac_sparsity", None),
-                         events=_model_events(model), switch=getattr(model, "switch", None))
+                         events=_model_events(model), switch=getattr(model, "switch", None),
+                         split=getattr(model, "stiff_split", None))
     if not callable(fun):
         raise InputError("fun", fun, "must be callable as fun(t, y) -> array")
     n = len(y0)
@@ -121,8 +141,12 @@ def as_system(fun, y0: np.ndarray, *, n2: int = 0, jac=None, jac_sparsity=None, 
             events, direction, terminal = events_from_callables(events)
     if switch is not None and not callable(switch):
         raise InputError("switch", switch, "must be callable as switch(t, x, fired) -> x or None")
+    if isinstance(split, tuple) and not isinstance(split, StiffSplit) and len(split) in (2, 3):
+        split = StiffSplit(*split)                       # a model's (explicit, solve[, hold])
+    if split is not None and not (isinstance(split, StiffSplit) and callable(split.explicit) and callable(split.solve)):
+        raise InputError("split", split, "must be a StiffSplit(explicit, solve, hold=None), such a tuple, or None")
     return OdeSystem(fun=fun, n=n, n2=int(n2), jac=jac, jac_sparsity=jac_sparsity, events=events,
-                     event_direction=direction, event_terminal=terminal, switch=switch)
+                     event_direction=direction, event_terminal=terminal, switch=switch, split=split)
 
 
 def _model_events(model):

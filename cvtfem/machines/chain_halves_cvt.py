@@ -325,13 +325,17 @@ class ChainHalvesCVT(ChainACVT):
         equal to ``evaluate(t, x)[0]`` to round-off (``tests/machines/test_chain_halves_one_pass.py``)."""
         if not self._one_pass:
             return super().rhs(t, x)
+        return self._rhs_with(t, x, self.family.chain._kernel_args)
+
+    def _rhs_with(self, t: float, x, chain_args: tuple):
+        """The one-pass :meth:`rhs` with the chain's compiled pass on the kernel constants ``chain_args``."""
         n2, nz = self.n2, self.control.size
         nc, iphi, iz, _ = self._idx
         v = x[n2:2 * n2]
         w = v[iphi]
         F, M, dz, _ = self._controls(t, w, x[2 * n2:2 * n2 + nz])
         Q = np.zeros(n2)
-        D = HK.add_forces_power(Q, x, v, *self.family.chain._kernel_args)
+        D = HK.add_forces_power(Q, x, v, *chain_args)
         Pf = self._contact_forces(x[:n2], v, Q)[0]
         Q[iphi] += M
         Q[iz] -= self.sheaves_per_z * F
@@ -342,6 +346,55 @@ class ChainHalvesCVT(ChainACVT):
         out[n2 + iz] = Q[iz] / self.m_sheave
         out[2 * n2:2 * n2 + nz] = dz
         out[2 * n2 + nz:] = (M[0] * w[0], -M[1] * w[1], D - Pf, -self.sheaves_per_z * float(F @ v[iz]))
+        return out
+
+    # ----- the halves' internal friction split off (stiff, solved implicitly) ------------------------------------
+    @cached_property
+    def stiff_split(self) -> tuple | None:
+        """``x' = f_E(x) + f_I(x)`` with ``f_I`` the halves' internal friction (axial (1.221) and rolling; velocity rows
+        and the dissipated-work row only): ``(rhs_explicit, friction_solve, friction_hold)``, the fields of
+        :class:`cvtfem.integrate.system.StiffSplit`; None off the one-pass path (numpy chain backend, elastic
+        shafts)."""
+        if not self._one_pass or self.family.chain.f0 == 0.0:
+            return None
+        return self.rhs_explicit, self.friction_solve, self.friction_hold
+
+    @cached_property
+    def _frictionless_args(self) -> tuple:
+        return self.family.chain.without_friction()._kernel_args
+
+    def rhs_explicit(self, t: float, x):
+        """:meth:`rhs` without the halves' internal friction (their ``f_0 = 0``): ``f_E`` of :attr:`stiff_split`."""
+        return self._rhs_with(t, x, self._frictionless_args)
+
+    def friction_solve(self, t: float, x, h: float) -> tuple[np.ndarray, int]:
+        """Backward Euler over ``h`` (s) of ``x' = f_I(x)`` (positions frozen): the chain's velocities from
+        :meth:`ChainA5.friction_step` and its dissipated work added to the work integral ``D - P_fr``, so the run's
+        energy balance closes exactly.  Newton starts from the friction's acceleration of the previous solve (a guess
+        only: the solution is unique).  Returns the new state and the Newton iterations (each one sparse LU)."""
+        chain, nc, n2 = self.family.chain, self.family.size, self.n2
+        key = x[:nc].tobytes()
+        if self._slips[0] != key:
+            self._slips = (key, *chain.friction_slips(x[:nc]))
+        v_star = x[n2:n2 + nc]
+        guess = None if self._friction_accel is None else v_star + h * self._friction_accel
+        v, W, its = chain.friction_step(self._slips[1], self._slips[2], v_star, h, guess)
+        self._friction_accel = (v - v_star) / h
+        out = np.array(x, float)
+        out[n2:n2 + nc] = v
+        out[2 * n2 + self.control.size + 2] += W
+        return out, its
+
+    _slips: tuple = (None, None, None)
+    _friction_accel = None
+
+    def friction_hold(self, x, d):
+        """The rate at ``x`` of the friction forces ``M d_v`` held constant (``d_v``: ``d``'s chain velocity rows,
+        m/s^2): those accelerations, and their dissipated power ``-(M d_v) . v`` on the work row ``D - P_fr``."""
+        nc, n2 = self.family.size, self.n2
+        out = np.zeros(self.size)
+        out[n2:n2 + nc] = d[n2:n2 + nc]
+        out[2 * n2 + self.control.size + 2] = -float((self.family.chain.mass_matrix @ d[n2:n2 + nc]) @ x[n2:n2 + nc])
         return out
 
     @cached_property

@@ -3,7 +3,7 @@
 # numerics-and-periodic section 9) into studies/accuracy-cost/results/.  Run from the repository root:
 #     bash studies/accuracy-cost/run.sh            # all (about 2 h of one core)
 #     bash studies/accuracy-cost/run.sh chain-S2   # the chain-S2 part only (also chain-A1, band, local, variant-e,
-#                                                  # variant-e-4ms, w-short, w-4ms)
+#                                                  # variant-e-4ms, w-short, w-4ms, imex-short)
 # Each test-2 run prints its speed-up table (Table 2.4 style); the logs go next to the results.
 set -euo pipefail
 cd "$(dirname "$0")/../.."
@@ -139,4 +139,22 @@ if [[ $part == all || $part == variant-e || $part == variant-e-spectra ]]; then 
     nice .venv/bin/python studies/accuracy-cost/a5_friction_spectra.py "$(e_scene $v linear-saturated)" \
       "$out/variant-$v-linear-saturated-friction-spectra.png" | tee "$out/variant-$v-linear-saturated-friction-spectra.log"
   done
+fi
+# Session 11: the halves' internal friction (axial (1.221) and rolling) split off and solved implicitly (strang-friction:
+# Strang splitting, or the friction forces of a backward-Euler step held over an explicit DUMKA3/RK4 step), on the
+# short window of w-short (same cache: its references and start).  The friction owners at 0.2 ms come from
+# a5_friction_owners.py.
+if [[ $part == all || $part == imex-short ]]; then
+  cache=out/studies/w-short-cache
+  is() { nice "$cvtfem" study accuracy-cost "$(e_scene e linear-saturated)" --skip-spectrum --window 2e-4:4e-4 \
+           --sample 1e-6 --repeats 1 --reference DOP853:1e-7 --check dopri78:1e-7 --cache "$cache" \
+           --csv "$out/variant-e-imex-short.csv" --json "$out/variant-e-imex-short.json" "$@"; }
+  nice .venv/bin/python studies/accuracy-cost/a5_friction_owners.py "$cache" 2e-4 | tee "$out/variant-e-friction-owners.log"
+  is --fixed strang-friction,strang-friction:scheme=frozen,strang-friction:scheme=frozen-mid --steps 1e-6,2e-6 \
+    --adaptive ""
+  is --fixed strang-friction:scheme=frozen-mid,dumka3 --steps 2.5e-6,3e-6 --adaptive ""
+  is --fixed strang-friction:scheme=frozen-mid:explicit=rk4 --steps 4e-7 --adaptive ""
+  is --fixed dumka3 --steps 1e-6,2e-6 --adaptive ""
+  is --from-cache | tee "$out/variant-e-imex-short.log"
+  uptime | tee -a "$out/variant-e-imex-short.log"
 fi

@@ -74,6 +74,8 @@ def adaptive_methods() -> dict[str, int]:
     the trapezoidal rule, so left out)."""
     out = {}
     for name, cls in METHODS.items():
+        if getattr(cls, "needs_split", False):           # splitting methods run only on a system with a StiffSplit
+            continue
         stepper = cls(as_system(lambda t, y: -y, np.ones(2)))
         if stepper.error_order is not None and name != "theta":
             out[name] = stepper.order

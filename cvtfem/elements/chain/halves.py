@@ -48,14 +48,15 @@ from types import SimpleNamespace
 
 import numpy as np
 import scipy.sparse as sp
+import scipy.sparse.linalg as spla
 
 from cvtfem.elements.chain import halves_kernel as HK
 from cvtfem.elements.chain import plates as P
 from cvtfem.elements.chain import plates_kernel as PK
 from cvtfem.elements.chain.asymmetric import (_M_PAR, _M_PERP, ChainA1, _cross, _dot, _kx, shape_functions,
                                               shape_slopes)
-from cvtfem.elements.contact.friction import LAWS, friction_gain
-from cvtfem.errors import InputError
+from cvtfem.elements.contact.friction import LAWS, friction_gain, friction_slope
+from cvtfem.errors import InputError, NumericalError
 from cvtfem.outputs import OutputSpec
 
 #: Gauss stations and weights of the half-half and half-plate contacts along the pin (sum of weights 2).
@@ -65,6 +66,30 @@ PLATE_MODELS = ("A4", "A3", "A3-keep")
 #: Contacts per pin: (name, carrier half A, other half B, sigma): sigma +1 convex-convex, -1 B inside A's hole.
 CONTACTS = (("roll", 0, 1, 1.0), ("hole_next", 0, 1, -1.0), ("hole_prev", 1, 0, -1.0))
 TERMS = ("half_axial", "half_bending", "plates", "twist", "contacts", "stoppers")
+
+
+def _potential_saturated(x, f0, v0):
+    return f0 * v0 * np.where(x < v0, 0.5 * (x / v0) ** 2, x / v0 - 0.5)
+
+
+def _potential_tanh(x, f0, v0):
+    y = x / v0
+    return f0 * v0 * (y + np.log1p(np.exp(-2 * y)) - np.log(2.0))
+
+
+def _potential_smoothed(x, f0, v0):
+    y = x / v0
+    return f0 * v0 * np.where(y < 1, 0.75 * y * y - y ** 4 / 8, y - 0.375)
+
+
+def _potential_arctan(x, f0, v0):
+    a = 0.5 * np.pi * x / v0
+    return f0 * v0 * (2 / np.pi) ** 2 * (a * np.arctan(a) - 0.5 * np.log1p(a * a))
+
+
+#: ``Phi(v) = int_0^v f`` (J/N, i.e. m/s times the coefficient) of the friction laws, for the implicit friction step.
+_POTENTIALS = {"linear-saturated": _potential_saturated, "nonsmooth": _potential_saturated, "tanh": _potential_tanh,
+               "smoothed": _potential_smoothed, "arctan": _potential_arctan}
 
 
 def shape_curvatures(xi: np.ndarray, l: float) -> np.ndarray:
@@ -614,6 +639,132 @@ class ChainA5:
         tied.k_tie = float(roll_tie)
         tied._kernel_args = HK.pack(tied, CONTACTS)
         return tied
+
+    def without_friction(self) -> "ChainA5":
+        """The same chain with ``f_0 = 0``: the forces less the halves' internal friction (the explicit part of the
+        split of :meth:`friction_slips`)."""
+        free = copy.copy(self)
+        free.f0 = 0.0
+        free._kernel_args = HK.pack(free, CONTACTS)
+        return free
+
+    def link_tensions(self, q: np.ndarray) -> np.ndarray:
+        """Link tensions (N) of the plates at ``q``: the normal-force proxies of the axial friction (1.221)."""
+        if self.backend == "numba":
+            a = self._kernel_args
+            return HK.link_tensions(np.asarray(q, float), a[0], *a[2:4], *a[6:11], a[15], a[16])
+        return self.outputs(q)["chain.link_tension"]
+
+    def friction_slips(self, q: np.ndarray, groups: bool = False) -> tuple:
+        """``(B, c)``: with the positions ``q`` frozen every slip of the halves' internal friction is linear in the
+        velocities, ``s = B v`` (m/s; rows: the half-half axial slip of each pin, the half-pack slips of half -, half +,
+        then the rolling slip of each contact and Gauss station where it is closed), and the friction forces are
+        ``F = -B^T (c psi(|s|) s)`` with the normal forces ``c`` (N) and the law's gain ``psi`` (:meth:`friction_forces`
+        exactly, to round-off).  With ``groups`` also each row's group: 0 axial half-half, 1 axial half-pack, then
+        ``2 + k`` for contact ``k`` of :data:`CONTACTS` (rolling, hole of the next link, of the previous one)."""
+        n, di, l = self.n_pins, self.dof_index, self.l
+        u = self.split(np.asarray(q, float))[0]
+        p = np.arange(n)
+        Tp = np.maximum(self.link_tensions(q), 0.0)
+        rows, cols, vals, c = [], [], [], []
+
+        def add(block_rows, block_cols, block_vals):
+            rows.append(np.broadcast_to(block_rows, block_vals.shape).ravel())
+            cols.append(np.broadcast_to(block_cols, block_vals.shape).ravel())
+            vals.append(block_vals.ravel())
+
+        one = np.ones(n)
+        add(p, di[:, 18], one)                                            # v_hh = w_0+' - w_0-'
+        add(p, di[:, 8], -one)
+        c.append(0.5 * (Tp + Tp[self._prev]))
+        for hf, Tn in ((0, Tp), (1, Tp[self._prev])):                    # v_hp = w_0' - q'
+            add(n * (1 + hf) + p, di[:, 10 * hf + 8], one)
+            add(n * (1 + hf) + p, di[:, 20], -one)
+            c.append(Tn)
+        fr = self._frames(u)
+        H = shape_functions(GAUSS_XI, l)                                  # (4, S)
+        Ux = np.einsum("is,hinc->hsnc", H, u)
+        ws = (l / 2 * GAUSS_W)[:, None]
+        m = 3 * n
+        al, ic = self.axis_link, np.arange(2)
+        for name, A, Bh, sig in CONTACTS:
+            offA, RA, offB, RB, rho0, k = self._arcs[name]
+            rA = offA[0] * fr["th"][A] + offA[1] * fr["nh"][A]
+            rB = offB[0] * fr["th"][Bh] + offB[1] * fr["nh"][Bh]
+            d = Ux[Bh] + rB - Ux[A] - rA
+            rho = np.sqrt(_dot(d, d))
+            tt = _kx(d / rho[..., None])
+            N = ws * self._contact_w[name][None] * k * np.maximum(-sig * (rho - rho0), 0.0)    # (S, n)
+            coef = {Bh: _dot(tt, _kx(rB)) - sig * RB, A: -(_dot(tt, _kx(rA)) + RA)}          # on thd of each half
+            for s_ in range(len(GAUSS_XI)):
+                r = m + p
+                for h_, sgn in ((Bh, 1.0), (A, -1.0)):
+                    cu = di[:, 10 * h_ + 2 * np.arange(4)[:, None] + ic[None, :]]           # (n, 4, 2)
+                    add(r[:, None, None], cu, sgn * H[:, s_][None, :, None] * tt[s_][:, None, :])
+                    e = al[h_]                                            # thd_e = nl_e . (U+_{e+1} - U-_e)' / rho_e
+                    g = (coef[h_][s_] / fr["rho"][e])[:, None] * fr["nl"][e]
+                    add(r[:, None], di[self._next[e]][:, 10 + ic], g)
+                    add(r[:, None], di[e][:, ic], -g)
+                c.append(N[s_])
+                m += n
+        B = sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))), shape=(m, self.n2))
+        c = np.concatenate(c)
+        keep = np.flatnonzero(c > 0)
+        label = np.concatenate([np.zeros(n, int), np.ones(2 * n, int), np.repeat(2 + np.arange(len(CONTACTS)),
+                                                                                 len(GAUSS_XI) * n)])
+        return (B[keep], c[keep], label[keep]) if groups else (B[keep], c[keep])
+
+    def friction_step(self, B: sp.csr_matrix, c: np.ndarray, v_star: np.ndarray, h: float, v_start=None,
+                      tol: float = 1e-6, max_lu: int = 100) -> tuple[np.ndarray, float, int]:
+        """Backward Euler of the halves' friction alone with the positions frozen: ``v`` with
+        ``M (v - v_star) = h F(v)``, ``F = -B^T (c psi(|Bv|) Bv)`` (:meth:`friction_slips`).
+
+        ``v`` minimises the convex ``(v - v_star)^T M (v - v_star) / 2 + h sum c Phi(|Bv|)`` (``Phi' = f``).  Each
+        iteration tries a Newton step (tangent slopes ``c f'``; its matrix ``M + h B^T D B`` inverted through the
+        slips' ``I + h D B M^-1 B^T``); where it does not lower that function (a slip that
+        the tangent of a saturated law sends far off), the majorise-minimise step (secant slopes ``c psi``: the
+        quadratic through the current slips lies above ``Phi`` for laws with falling ``psi``, so the function
+        falls) instead, from ``v_start`` (default ``v_star``; the solution does not depend on it), until a step
+        changes the slips by less than ``tol v_0``.  Returns ``(v, W, LUs)`` with
+        the work the step dissipates ``W = -h F(v) . (v + v_star) / 2`` (J): the kinetic energy it removes."""
+        M, Mi, f0, v0, law = self.mass_matrix, self.inverse_mass, self.f0, self.v0, self.law
+        if law not in _POTENTIALS:
+            raise InputError("friction_law", law, f"must be one of {sorted(_POTENTIALS)} for the implicit friction")
+        Bt = B.T.tocsr()
+        G = (B @ Mi @ Bt).tocsr()                         # slip-space inverse mass (m x m)
+        I = sp.identity(B.shape[0], format="csr")
+        s_star, lus = B @ v_star, 0
+        v = np.array(v_star if v_start is None else v_start, float)
+        s = B @ v
+
+        def objective(v_, s_):
+            dv_ = v_ - v_star
+            return 0.5 * dv_ @ (M @ dv_) + h * c @ _POTENTIALS[law](np.abs(s_), f0, v0)
+
+        def step(slopes, g):
+            """``-(M + h B^T D B)^-1 g`` in the slips' space (Woodbury): ``M^-1`` is block diagonal, the slips few."""
+            y = Mi @ g
+            w = spla.splu((I + h * G.multiply(slopes[:, None])).tocsc()).solve(slopes * (B @ y))
+            dv = h * (Mi @ (Bt @ w)) - y
+            return dv, B @ dv
+
+        while lus < max_lu:
+            gain = friction_gain(np.abs(s), f0, v0, law)
+            g = M @ (v - v_star) + h * (Bt @ (c * gain * s))
+            dv, ds = step(c * friction_slope(np.abs(s), f0, v0, law), g)
+            lus += 1
+            done = np.max(np.abs(ds), initial=0.0) <= tol * v0
+            if not done and objective(v + dv, s + ds) > objective(v, s) + 1e-4 * (g @ dv):
+                dv, ds = step(c * gain, g)
+                lus += 1
+            v, s = v + dv, s + ds
+            if done or np.max(np.abs(ds), initial=0.0) <= tol * v0:
+                break
+        else:
+            raise NumericalError(f"the implicit friction step (h = {h:g} s) did not converge in {max_lu} LUs",
+                                 component="ChainA5.friction_step")
+        r = c * friction_gain(np.abs(s), f0, v0, law) * s
+        return v, float(h * r @ (0.5 * (s + s_star))), lus
 
     def forces(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
         """``Q = -dPi/dq - dPhi/dv + Q_friction`` in one pass (:func:`halves_kernel.forces` with ``use_numba``)."""

@@ -884,6 +884,22 @@ def _axial_friction_slopes(xd, p, T_next, T_prev, f0, v0, law, out):
         out[j, 2] = -r_hp
 
 
+@njit(cache=True)
+def link_tensions(q, gl, L, c_twist, plate_w, plate_d, plate_c, plate_c1, plate_c2, par, ints):
+    """Tension (N) of every link, the normal-force proxy of the axial friction (1.221): the sum of its plates'
+    tensions, as :func:`add_forces_power` computes it (the plate tension is elastic: no velocity enters)."""
+    n = L.shape[0]
+    T = np.zeros(n)
+    x, xd, loc, Dv = np.zeros(22), np.zeros(22), np.zeros(22), np.zeros((1, 1))
+    wk, none = _link_work(), _keep(0)
+    for e in range(n):
+        for j in range(22):
+            x[j] = q[gl[e, j]]
+        T[e] = _link(x, xd, e, L, c_twist, plate_w, plate_d, plate_c, plate_c1, plate_c2, par, ints[1], loc, Dv,
+                     False, wk, none)
+    return T
+
+
 # ---------------------------------------------------------------------------------------------- passes
 @njit(cache=True)
 def forces(q, v, gl, gp, L, c_twist, b_joint, cs, plate_w, plate_d, plate_c, plate_c1, plate_c2, arc, idx, sig,

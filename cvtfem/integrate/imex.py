@@ -1,0 +1,95 @@
+"""Splitting methods for a stiff part the model solves itself (the halves' friction of A5): ``strang-friction``.
+
+The system carries a :class:`~cvtfem.integrate.system.StiffSplit` ``x' = f_E + f_I``: ``f_E`` goes to an explicit
+method whose stage count follows the spectral radius of ``f_E`` alone, ``f_I`` to the model's own backward Euler
+(for A5 the halves' internal friction with the positions frozen,
+:meth:`~cvtfem.machines.chain_halves_cvt.ChainHalvesCVT.friction_solve`).  Schemes (:data:`SCHEMES`):
+
+* ``strang``: ``I(h/2) o E(h) o I(h/2)``; order 1 (backward Euler's half steps; Strang's order 2 needs a
+  second-order ``I``), stable for a dissipative ``f_I`` at any step;
+* ``frozen``: the forces of one backward-Euler step of ``f_I`` after the explicit impulse ``h f_E(x)`` (velocity
+  rows), held constant over the explicit step; their work is booked at the power they deliver along it (the split's
+  ``hold``), so the energy balance stays the explicit method's;
+* ``frozen-mid``: the same from a half step after half the impulse (the forces of the step's middle).
+
+Fixed steps only (no error estimate).  The friction solves count as ``nnewton`` (iterations) and ``nlu`` (one sparse
+LU each), timed in ``t_lu``.
+"""
+from __future__ import annotations
+
+from cvtfem.errors import InputError
+from cvtfem.integrate.base import Attempt, Stepper
+from cvtfem.integrate.system import OdeSystem
+
+__all__ = ["StrangFriction"]
+
+#: The explicit methods a split step may use.
+EXPLICIT = ("dumka3", "rk4", "rock4", "dopri45")
+#: How a step combines the two parts (module docstring).
+SCHEMES = ("strang", "frozen", "frozen-mid")
+
+
+class StrangFriction(Stepper):
+    """``explicit`` (a registered explicit method, default DUMKA3, with its options ``stages``, ``spectral_radius``,
+    ``rho_every``) on ``f_E``, the system's own backward Euler on ``f_I``, combined by ``scheme`` (:data:`SCHEMES`)."""
+
+    name, order = "strang-friction", 1
+    #: Runs only on a system with a :class:`~cvtfem.integrate.system.StiffSplit` (generic method loops skip it).
+    needs_split = True
+    OPTIONS = frozenset({"explicit", "scheme", "stages", "spectral_radius", "rho_every"})
+
+    def __init__(self, system: OdeSystem, stats=None, explicit: str = "dumka3", scheme: str = "strang",
+                 **options) -> None:
+        super().__init__(system, stats)
+        from cvtfem.integrate.methods import METHODS
+
+        if system.split is None:
+            raise InputError("method", self.name, "needs a system with a stiff split (StiffSplit): the A5 chain on "
+                                                  "rigid shafts with internal friction (variants (e), (zh)) has one")
+        if explicit not in EXPLICIT:
+            raise InputError("explicit", explicit, f"must be one of {EXPLICIT}")
+        cls = METHODS[explicit]
+        unknown = set(options) - cls.OPTIONS
+        if unknown:
+            raise InputError("options", sorted(unknown), f"must be options of {explicit}: {sorted(cls.OPTIONS)}")
+        if scheme not in SCHEMES:
+            raise InputError("scheme", scheme, f"must be one of {SCHEMES}")
+        self.scheme, self._frozen = scheme, None
+        if scheme != "strang" and system.split.hold is None:
+            raise InputError("scheme", scheme, "needs the split's `hold` (the work rate of the held forces)")
+        split = system.split
+        if scheme == "strang":
+            fun = split.explicit
+        else:
+            def fun(t, x):
+                return split.explicit(t, x) + split.hold(x, self._frozen)
+        inner = OdeSystem(fun=fun, n=system.n, n2=system.n2)
+        self.inner = cls(inner, self.stats, **options)
+        self.inner.need_error = False
+
+    def _implicit(self, t, x, h):
+        st = self.stats
+        with st.timer("t_lu"):
+            x1, its = self.system.split.solve(t, x, h)
+        st.add("nnewton", its)
+        st.add("nlu", its)
+        return x1
+
+    def attempt(self, t, x, h):
+        if self.scheme != "strang":
+            fe = self.system.split.explicit(t, x)
+            self.stats.add("nfev")
+            pred, n2 = x.copy(), self.system.n2
+            hi = h if self.scheme == "frozen" else 0.5 * h
+            pred[n2:] += hi * fe[n2:]                 # positions frozen: the explicit impulse of the step (or half)
+            d = (self._implicit(t, pred, hi) - pred) / hi
+            self._frozen = d
+            self.inner._start = (t, x.copy(), fe + self.system.split.hold(x, d))    # its F at the start: known
+            y = self.inner.attempt(t, x, h).x1
+        else:
+            y = self._implicit(t, x, 0.5 * h)
+            y = self.inner.attempt(t, y, h).x1
+            y = self._implicit(t + h, y, 0.5 * h)
+        self.stages = self.inner.stages
+        self.inner.accept(Attempt(t, y, h, y))
+        return Attempt(t, x, h, y)
