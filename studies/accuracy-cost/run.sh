@@ -3,7 +3,7 @@
 # numerics-and-periodic section 9) into studies/accuracy-cost/results/.  Run from the repository root:
 #     bash studies/accuracy-cost/run.sh            # all (about 2 h of one core)
 #     bash studies/accuracy-cost/run.sh chain-S2   # the chain-S2 part only (also chain-A1, band, local, variant-e,
-#                                                  # variant-e-4ms, w-short, w-4ms)
+#                                                  # variant-e-4ms, w-short, w-4ms, variant-b-4ms)
 # Each test-2 run prints its speed-up table (Table 2.4 style); the logs go next to the results.
 set -euo pipefail
 cd "$(dirname "$0")/../.."
@@ -96,6 +96,18 @@ if [[ $part == all || $part == variant-e-4ms ]]; then
   uptime | tee -a "$out/variant-e-4ms.log"
   nice .venv/bin/python studies/accuracy-cost/force_trace.py "$out/variant-e-4ms.json" "$cache" rk4:1e-6,rk4:2e-6 \
     "$out/variant-e-4ms-trace.png" | tee -a "$out/variant-e-4ms.log"
+fi
+# Session 11: variant (b) itself (chain A1, refined contact H2, ELASTIC shafts: the scene as the preset builds it),
+# chapter-2 regime, E over the source's [1, 5] ms from the quasi-static start, with its spectrum at the start.
+if [[ $part == all || $part == variant-b-4ms ]]; then
+  cache=out/studies/variant-b-4ms-cache
+  b4() { nice "$cvtfem" study accuracy-cost studies/accuracy-cost/scenes/variant-b-chapter2-linear-saturated.toml \
+           --window 1e-3:5e-3 --sample 1e-6 --repeats 1 --reference DOP853:1e-6 --check dopri78:1e-6 --cache "$cache" \
+           --png "$out/variant-b-4ms.png" --csv "$out/variant-b-4ms.csv" --json "$out/variant-b-4ms.json" "$@"; }
+  b4 --fixed rk4 --steps 5e-8 --adaptive "" --spectrum-png "$out/variant-b-4ms-spectrum.png"
+  b4 --skip-spectrum --fixed rk4,dumka3 --steps 5e-7,1e-6,2e-6 --adaptive rock4,dumka3,dopri45 --rtols 1e-1,1e-2,1e-3
+  b4 --skip-spectrum --from-cache | tee "$out/variant-b-4ms.log"
+  uptime | tee -a "$out/variant-b-4ms.log"
 fi
 # Session 10: W-methods with a reused Jacobian (sw24 with jac_every, ros34pw2) against DUMKA3, rock4 and RK4 on variant
 # (e), FROM THE QUASI-STATIC START (converged at ratio 0.45 since session 9's iteration budget; the cache keeps the start
