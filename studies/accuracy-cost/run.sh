@@ -3,7 +3,8 @@
 # numerics-and-periodic section 9) into studies/accuracy-cost/results/.  Run from the repository root:
 #     bash studies/accuracy-cost/run.sh            # all (about 2 h of one core)
 #     bash studies/accuracy-cost/run.sh chain-S2   # the chain-S2 part only (also chain-A1, band, local, variant-e,
-#                                                  # variant-e-4ms, w-short, w-4ms, imex-short)
+#                                                  # variant-e-4ms, w-short, w-4ms, imex-short, variant-b-4ms,
+#                                                  # w-4ms-dumka3)
 # Each test-2 run prints its speed-up table (Table 2.4 style); the logs go next to the results.
 set -euo pipefail
 cd "$(dirname "$0")/../.."
@@ -97,6 +98,18 @@ if [[ $part == all || $part == variant-e-4ms ]]; then
   nice .venv/bin/python studies/accuracy-cost/force_trace.py "$out/variant-e-4ms.json" "$cache" rk4:1e-6,rk4:2e-6 \
     "$out/variant-e-4ms-trace.png" | tee -a "$out/variant-e-4ms.log"
 fi
+# Session 11: variant (b) itself (chain A1, refined contact H2, ELASTIC shafts: the scene as the preset builds it),
+# chapter-2 regime, E over the source's [1, 5] ms from the quasi-static start, with its spectrum at the start.
+if [[ $part == all || $part == variant-b-4ms ]]; then
+  cache=out/studies/variant-b-4ms-cache
+  b4() { nice "$cvtfem" study accuracy-cost studies/accuracy-cost/scenes/variant-b-chapter2-linear-saturated.toml \
+           --window 1e-3:5e-3 --sample 1e-6 --repeats 1 --reference DOP853:1e-6 --check dopri78:1e-6 --cache "$cache" \
+           --png "$out/variant-b-4ms.png" --csv "$out/variant-b-4ms.csv" --json "$out/variant-b-4ms.json" "$@"; }
+  b4 --fixed rk4 --steps 5e-8 --adaptive "" --spectrum-png "$out/variant-b-4ms-spectrum.png"
+  b4 --skip-spectrum --fixed rk4,dumka3 --steps 5e-7,1e-6,2e-6 --adaptive rock4,dumka3,dopri45 --rtols 1e-1,1e-2,1e-3
+  b4 --skip-spectrum --from-cache | tee "$out/variant-b-4ms.log"
+  uptime | tee -a "$out/variant-b-4ms.log"
+fi
 # Session 10: W-methods with a reused Jacobian (sw24 with jac_every, ros34pw2) against DUMKA3, rock4 and RK4 on variant
 # (e), FROM THE QUASI-STATIC START (converged at ratio 0.45 since session 9's iteration budget; the cache keeps the start
 # state, so each further process skips the minute of the solve).  First a window of [0.2, 0.4] ms (references DOP853
@@ -144,6 +157,19 @@ fi
 # Strang splitting, or the friction forces of a backward-Euler step held over an explicit DUMKA3/RK4 step), on the
 # short window of w-short (same cache: its references and start).  The friction owners at 0.2 ms come from
 # a5_friction_owners.py.
+# Session 11: DUMKA3 at a fixed 3e-6 s over [1, 5] ms (accepted on the short window, 9.9x over RK4 there), beside
+# 2e-6 s and the RK4 baseline, in a cache of its own (the session-10 rows of w-4ms stay as they are).
+if [[ $part == all || $part == w-4ms-dumka3 ]]; then
+  cache=out/studies/w-4ms-dumka3-cache
+  wd() { nice "$cvtfem" study accuracy-cost "$(e_scene e linear-saturated)" --skip-spectrum --window 1e-3:5e-3 \
+           --sample 1e-6 --repeats 1 --reference DOP853:1e-6 --check dopri78:1e-6 --cache "$cache" \
+           --png "$out/variant-e-w-4ms-dumka3.png" --csv "$out/variant-e-w-4ms-dumka3.csv" \
+           --json "$out/variant-e-w-4ms-dumka3.json" "$@"; }
+  wd --fixed rk4 --steps 5e-8 --adaptive ""
+  wd --fixed dumka3 --steps 2e-6,3e-6 --adaptive ""
+  wd --from-cache | tee "$out/variant-e-w-4ms-dumka3.log"
+  uptime | tee -a "$out/variant-e-w-4ms-dumka3.log"
+fi
 if [[ $part == all || $part == imex-short ]]; then
   cache=out/studies/w-short-cache
   is() { nice "$cvtfem" study accuracy-cost "$(e_scene e linear-saturated)" --skip-spectrum --window 2e-4:4e-4 \

@@ -558,14 +558,14 @@ def _pair(loc, Qth, A, B, H, s, v0, v1, kA, kB):
 
 
 @njit(cache=True)
-def _half_bending(x, xd, h, th, nh, thd, par, elastic, loc, Qth, nab):
-    """Half bending (1.216) of half ``h`` on axes turning with its link (with ``elastic``), and its co-rotational
+def _half_bending(x, xd, h, th, nh, thd, par, loc, Qth, nab):
+    """Half bending (1.216) of half ``h`` on axes turning with its link, and its co-rotational
     damping (section 5.4); returns the power of the damping forces (W)."""
     l, A_tau, A_n, beta = par[0], par[3], par[4], par[5]
     o = 10 * h + 4                                                # u_2 of the half
     t0, t1, n0, n1 = th[h, 0], th[h, 1], nh[h, 0], nh[h, 1]
     gth = 0.0
-    for k in range(2 if elastic else 0):
+    for k in range(2):
         a0 = (4 * x[o + 2 * k] + 2 * x[o + 2 - 2 * k]) / l
         a1 = (4 * x[o + 2 * k + 1] + 2 * x[o + 3 - 2 * k]) / l
         at, an = A_tau * (t0 * a0 + t1 * a1), A_n * (n0 * a0 + n1 * a1)
@@ -632,26 +632,23 @@ def _pin_geometry(x, p, cs, arc, idx, sig_, cw, par, tau, rho, th, nh, H, Hp, Hp
 
 
 @njit(cache=True)
-def _pin(x, xd, p, T_next, T_prev, b_joint, cs, arc, idx, sig_, cw, par, law, elastic, lateral, cached, loc, wk):
+def _pin(x, xd, p, T_next, T_prev, b_joint, cs, arc, idx, sig_, cw, par, law, lateral, loc, wk):
     """Everything of pin ``p`` but its links, on 29 local coordinates ``x`` and velocities ``xd``: half ``-`` (0..9,
     A1 order), half ``+`` (10..19), ``q_p`` (20) and the ends of the links giving the half axes (1.215): start and
     end ``u_0`` of the ``-`` half's link (21..24), of the ``+`` half's link (25..28), copies allowed.  Half axial
     (1.214), half bending (1.216), the three arc contacts at two Gauss stations (penalty, roll damping, tie,
     rolling friction), stoppers, axial friction (1.221) with the link tensions ``T_next`` (link ``(p, p+1)``) and
     ``T_prev`` (``(p-1, p)``) and joint damping (1.80); half torques go to the link ends.  Adds to ``loc`` (29,);
-    without ``elastic`` only the velocity-dependent forces (their differences then keep their own round-off),
-    without ``lateral`` only the axial terms (half axial, stoppers, axial friction: all that ``w``, ``q_p`` reach);
-    with ``cached`` the geometry (frames, stations, contact normals and forces) of the previous call is reused
-    (only ``xd`` changed since).
+    without ``lateral`` only the axial terms (half axial, stoppers, axial friction: all that ``w``, ``q_p`` reach).
     """
     tau, rho, thd, th, nh, Qth, H, Hp, Hpp, Ux, Vx, kA, kB, nab, Hs, CG, pw = wk
     l, c_half, b_half, b_roll, k_tie = par[0], par[1], par[2], par[9], par[10]
     k_stop, d_stop, f0, v0 = par[11], par[12], par[13], par[14]
     for h in range(2):
         o = 10 * h
-        loc[o + 9] -= (2 * c_half * (2 * x[o + 9] - l) if elastic else 0.0) + 4 * b_half * xd[o + 9]
+        loc[o + 9] -= 2 * c_half * (2 * x[o + 9] - l) + 4 * b_half * xd[o + 9]
         pw[0] -= 4 * b_half * xd[o + 9] * xd[o + 9]
-    for h in range(2 if elastic else 0):                          # stoppers (erratum 13)
+    for h in range(2):                                            # stoppers (erratum 13)
         s = x[10 * h + 8] - x[20]
         f = k_stop * max(abs(s) - d_stop, 0.0) * np.sign(s)
         loc[10 * h + 8] -= f
@@ -671,14 +668,13 @@ def _pin(x, xd, p, T_next, T_prev, b_joint, cs, arc, idx, sig_, cw, par, law, el
             pw[0] += R * v_hp
     if not lateral:
         return
-    if not cached:
-        _pin_geometry(x, p, cs, arc, idx, sig_, cw, par, tau, rho, th, nh, H, Hp, Hpp, Ux, Hs, CG)
+    _pin_geometry(x, p, cs, arc, idx, sig_, cw, par, tau, rho, th, nh, H, Hp, Hpp, Ux, Hs, CG)
     for j in range(2):                                            # spin rates of the links
         o = 21 + 4 * j
         thd[j] = (-tau[j, 1] * (xd[o + 2] - xd[o]) + tau[j, 0] * (xd[o + 3] - xd[o + 1])) / rho[j]
         Qth[j] = 0.0
     for h in range(2):
-        pw[0] += _half_bending(x, xd, h, th, nh, thd, par, elastic, loc, Qth, nab)
+        pw[0] += _half_bending(x, xd, h, th, nh, thd, par, loc, Qth, nab)
     for s in range(2):
         Hst = Hs[s]
         for h in range(2):
@@ -694,7 +690,7 @@ def _pin(x, xd, p, T_next, T_prev, b_joint, cs, arc, idx, sig_, cw, par, law, el
             dist, n0, n1, g, N = CG[s, ic, 0], CG[s, ic, 1], CG[s, ic, 2], CG[s, ic, 3], CG[s, ic, 4]
             kA[0], kA[1], kB[0], kB[1] = CG[s, ic, 5], CG[s, ic, 6], CG[s, ic, 7], CG[s, ic, 8]
             t0, t1 = -n1, n0
-            if N != 0.0 and elastic:
+            if N != 0.0:
                 _pair(loc, Qth, A, B, Hst, N * sig, n0, n1, kA, kB)
             vr0, vr1 = Vx[B, 0] - Vx[A, 0], Vx[B, 1] - Vx[A, 1]
             if b_roll != 0.0 and ic == 0 and g < 0:
@@ -702,7 +698,7 @@ def _pin(x, xd, p, T_next, T_prev, b_joint, cs, arc, idx, sig_, cw, par, law, el
                               - (n0 * kA[0] + n1 * kA[1]) * thd[A])
                 _pair(loc, Qth, A, B, Hst, -wgt * b_roll * gdot * sig, n0, n1, kA, kB)
                 pw[0] -= wgt * b_roll * gdot * gdot
-            if k_tie != 0.0 and ic == 0 and elastic:              # g_t = R_A ang(n, tau_A) + R_B ang(n, tau_B)
+            if k_tie != 0.0 and ic == 0:                          # g_t = R_A ang(n, tau_A) + R_B ang(n, tau_B)
                 gt = (RA * np.arctan2(n0 * tau[A, 1] - n1 * tau[A, 0], n0 * tau[A, 0] + n1 * tau[A, 1])
                       + RB * np.arctan2(n0 * tau[B, 1] - n1 * tau[B, 0], n0 * tau[B, 0] + n1 * tau[B, 1]))
                 st = wgt * k_tie * gt
@@ -943,7 +939,7 @@ def add_forces_power(Q, q, v, gl, gp, L, c_twist, b_joint, cs, plate_w, plate_d,
     for p in range(n):
         for j in range(29):
             y[j], yd[j], lp[j] = q[gp[p, j]], v[gp[p, j]], 0.0
-        _pin(y, yd, p, T[p], T[(p - 1) % n], b_joint, cs, arc, idx, sig, cw, par, law, True, True, False, lp, pk)
+        _pin(y, yd, p, T[p], T[(p - 1) % n], b_joint, cs, arc, idx, sig, cw, par, law, True, lp, pk)
         for j in range(29):
             Q[gp[p, j]] += lp[j]
     return -(wk[-1][0] + pk[-1][0])
@@ -1058,7 +1054,7 @@ def jacobian(q, v, gl, gp, L, c_twist, b_joint, cs, plate_w, plate_d, plate_c, p
                 g = g_p if sgn == 0 else g_m
                 g[:] = 0.0
                 ppw[0] = 0.0
-                _pin(y, yd, p, T[p], T[pv], b_joint, cs, arc, idx, sig, cw, par, law, True, lateral, False, g, pk)
+                _pin(y, yd, p, T[p], T[pv], b_joint, cs, arc, idx, sig, cw, par, law, lateral, g, pk)
                 dP += ppw[0] if sgn == 0 else -ppw[0]
             for k in range(jj, 29):
                 if first[p, k] == jj:
