@@ -28,6 +28,8 @@ from pathlib import Path
 import numpy as np
 
 from cvtfem.analysis.stored_state import stored_model, stored_states
+from cvtfem.elements.chain.sheave_contact_refined import RefinedSheaveContact
+from cvtfem.elements.chain.symmetric import END_SLOPE_FACTOR
 from cvtfem.io.results import read_results
 
 TERMS = ("axis", "spin", "tilt")
@@ -35,10 +37,17 @@ DIRS = ("circ", "radial", "axial")
 SHAFTS = ("driving", "driven")
 
 
+def contact_kernel(model):
+    """``(kernel, mirror)``: the pair kernel of the model's contact and the number of pin ends one contact stands
+    for (2 for the mirrored pair of the symmetric chains, 1 for single ends)."""
+    con = model.contact
+    return (con.pair, 1) if hasattr(con, "pair") else (con, 2)
+
+
 def kernel_contacts(model, q, v):
-    """``(pins, shafts, X, d)``: the pin of each contact, its shaft, the H2 kernel's inputs (m, 21) in the kernel's
-    (mirrored, sheave) frame and the kernel's details, for rigid (ChainACVT) and elastic shafts (ElasticChainACVT)."""
-    if hasattr(model, "_mapped_set"):
+    """``(pins, shafts, X, d)``: the pin of each contact, its shaft, the kernel's inputs in the kernel's (mirrored,
+    sheave) frame and the kernel's details, for rigid (ChainCVT, ChainACVT) and elastic shafts (ElasticChainACVT)."""
+    if hasattr(model, "_mapped_set") and contact_kernel(model)[0].__class__ is RefinedSheaveContact:
         e, k, j, _, _, Z, (_, d) = model._mapped_set(q, v, details=True)
         n = model.refined_chain_inputs + 6
         K, dK = model._refined_frame(Z[:, :n], k, j)
@@ -48,112 +57,113 @@ def kernel_contacts(model, q, v):
     return model.pin_of(ends), shafts, X, d
 
 
-def split_slip(X, d, centres, slope_factor):
-    """Per contact: the tangential slip of each term (3, m, 3), the unit vectors ``e``, ``nu`` (m, 3) and the
-    kernel's slip (m, 3) for the check.  ``X`` as :func:`kernel_contacts`'s (10 positions with slopes)."""
+def split_slip(con, X, d, centres):
+    """Per contact: the tangential slip of each term (3, m, 3) and the unit vectors ``e``, ``nu`` (m, 3) of the pin
+    end about its shaft.  H2 (:class:`RefinedSheaveContact`, inputs as its ``local``): the three terms; H1
+    (:class:`SheaveContact`): the pin-axis end is the contact point, all of the slip is ``axis``."""
     m = len(X)
-    npos = 10
-    up, u3, z = X[:, 2:4], X[:, 6], X[:, 9]
-    vp, u3d, zd, w = X[:, npos + 2:npos + 4], X[:, npos + 6], X[:, npos + 9], X[:, -1]
-    g = slope_factor * X[:, 7:9]
-    gd = slope_factor * X[:, npos + 7:npos + 9]
+    if not isinstance(con, RefinedSheaveContact):
+        dvec = X[:, :2] - centres
+        e2 = dvec / np.linalg.norm(dvec, axis=1)[:, None]
+        zero = np.zeros((m, 3))
+        return (np.stack([d["slip"], zero, zero]), np.column_stack([e2, np.zeros(m)]),
+                np.column_stack([-e2[:, 1], e2[:, 0], np.zeros(m)]))
+    npos = con.n_pos
+    up, u3, z = X[:, 2:4], X[:, 6], X[:, npos - 1]
+    vp, u3d, zd, w = X[:, npos + 2:npos + 4], X[:, npos + 6], X[:, 2 * npos - 1], X[:, -1]
+    if con.slopes:
+        g, gd = END_SLOPE_FACTOR * X[:, 7:9], END_SLOPE_FACTOR * X[:, npos + 7:npos + 9]
+    else:
+        g = gd = np.zeros((m, 2))
     dvec = up - centres
-    r = np.linalg.norm(dvec, axis=1)
-    e2 = dvec / r[:, None]
+    e2 = dvec / np.linalg.norm(dvec, axis=1)[:, None]
     e = np.column_stack([e2, np.zeros(m)])
     nu = np.column_stack([-e2[:, 1], e2[:, 0], np.zeros(m)])
     k = np.array([0.0, 0.0, 1.0])
     x = d["offset"]
     rho = np.column_stack([x, d["point"][:, 2] - u3])
-    om = d["spin_rate"]
-    g3 = np.column_stack([g, np.zeros(m)])
-    gd3 = np.column_stack([gd, np.zeros(m)])
-    x3 = np.column_stack([x, np.zeros(m)])
+    g3, gd3, x3 = (np.column_stack([a, np.zeros(m)]) for a in (g, gd, x))
     axis = np.column_stack([vp[:, 0] + w * dvec[:, 1], vp[:, 1] - w * dvec[:, 0], u3d - zd])
-    spin = om[:, None] * np.cross(k + g3, rho) - w[:, None] * np.cross(k, x3)
+    spin = d["spin_rate"][:, None] * np.cross(k + g3, rho) - w[:, None] * np.cross(k, x3)
     tilt = np.cross(np.cross(np.broadcast_to(k, (m, 3)), gd3), rho)
     n = d["normal"]
-    proj = [t - np.sum(n * t, axis=1)[:, None] * n for t in (axis, spin, tilt)]
-    return np.stack(proj), e, nu, d["slip"]
+    return np.stack([t - np.sum(n * t, axis=1)[:, None] * n for t in (axis, spin, tilt)]), e, nu
 
 
-def arc_rank(pins, shafts, X, centres, n_pins, ranks):
-    """Position class of each contact on its arc: 0..ranks-1 from the entry, -1..-ranks to the exit (negative), else
-    ``ranks`` (the arc); pins on a shaft's arc are a run of consecutive indices, ordered along the travel by the
-    shaft's spin."""
+def arc_rank(pins, shafts, u, w, centres, ranks):
+    """Position class of each contact on its arc: 0..ranks-1 from the entry, -1..-ranks to the exit, else ``ranks``
+    (the arc).  The pins touching a shaft are a run of consecutive indices (cyclic), ordered along the travel by
+    the shaft's spin ``w`` (2,) rad/s; ``u`` (n, 2) the pin positions."""
+    n_pins = len(u)
     cls = np.full(len(pins), ranks)
     for sh in (0, 1):
         sel = np.nonzero(shafts == sh)[0]
         if len(sel) == 0:
             continue
         p = np.unique(pins[sel])
-        # the run of consecutive pins (cyclic): start after the largest gap
         gaps = np.diff(np.concatenate([p, [p[0] + n_pins]]))
         start = p[(np.argmax(gaps) + 1) % len(p)]
-        order = (p - start) % n_pins                       # 0 .. run length - 1 along increasing index
+        order = (p - start) % n_pins
         length = order.max() + 1
-        i = sel[np.argmin(order[np.searchsorted(p, pins[sel])])]
-        dv = X[i, 2:4] - centres[sh]
-        # does the next pin index lie ahead along the spin?  tangential velocity of the pin ~ w k x d
-        step = X[i, 4:6] - X[i, 2:4]
-        ahead = np.sign(X[i, -1]) * np.sign(dv[0] * step[1] - dv[1] * step[0])
+        dv, step = u[start] - centres[sh], u[(start + 1) % n_pins] - u[start]
+        ahead = np.sign(w[sh]) * np.sign(dv[0] * step[1] - dv[1] * step[0])   # higher index further on
         pos = order[np.searchsorted(p, pins[sel])]
         if ahead < 0:
             pos = length - 1 - pos
-        c = np.where(pos < ranks, pos, np.where(pos >= length - ranks, pos - length, ranks))
-        cls[sel] = c
+        cls[sel] = np.where(pos < ranks, pos, np.where(pos >= length - ranks, pos - length, ranks))
     return cls
 
 
 def decompose(path, t_from, t_to, ranks):
+    """Sums over the stored rows in ``[t_from, t_to]`` per (shaft, arc class): friction power by term and
+    direction (3, 3) W, contact count, slip speed, normal force, force-weighted slip; the largest mismatch of the
+    terms' sum against the kernel's slip (m/s)."""
     r = read_results(path)
     model = stored_model(r)
     t, x = stored_states(r, model)
     rows = np.nonzero((t >= t_from - 1e-12) & (t <= t_to + 1e-12))[0]
-    from cvtfem.elements.chain.symmetric import END_SLOPE_FACTOR
-
-    centres_all = np.asarray(model.contact.pair.centres, float)
-    n_pins = model.family.n
+    con, mirror = contact_kernel(model)
+    centres_all = np.asarray(con.centres, float)
+    nc, iphi = model._idx[0], model._idx[1]
     labels = list(range(ranks)) + [ranks] + list(range(-ranks, 0))
-    acc = {(sh, c): dict(P=np.zeros((3, 3)), n=0, slip=np.zeros(3), speed=0.0, comp=np.zeros((3, 3)),
-                         N=0.0, Nspeed=0.0) for sh in (0, 1) for c in labels}
+    acc = {(sh, c): dict(P=np.zeros((3, 3)), n=0, speed=0.0, comp=np.zeros((3, 3)), N=0.0, Nspeed=0.0, sat=0,
+                         Ffr=0.0, torque=0.0)
+           for sh in (0, 1) for c in labels}
     mean_speed = {0: [], 1: []}
     check = 0.0
     for row in rows:
         q, v, _, _ = model.split(x[row])
         pins, shafts, X, d = kernel_contacts(model, q, v)
-        on = d["N"] > 0                                       # touching (the broad phase's candidates include free ends)
-        pins, shafts, X, d = pins[on], shafts[on], X[on], {key: val[on] for key, val in d.items()}
-        centres = centres_all[shafts]
-        terms, e, nu, slip = split_slip(X, d, centres, END_SLOPE_FACTOR)
-        check = max(check, float(np.abs(terms.sum(axis=0) - slip).max()))
-        cls = arc_rank(pins, shafts, X, centres_all, n_pins, ranks)
-        F = d["F_fr"]
+        on = d["N"] > 0                                   # touching (the broad phase's candidates include free ends)
+        pins, shafts, X = pins[on], shafts[on], X[on]
+        d = {key: val[on] for key, val in d.items() if np.ndim(val) and len(val) == len(on)}
+        terms, e, nu = split_slip(con, X, d, centres_all[shafts])
+        check = max(check, float(np.abs(terms.sum(axis=0) - d["slip"]).max()))
+        cls = arc_rank(pins, shafts, model.pin_positions(q[:nc]), v[iphi], centres_all, ranks)
+        F, N = mirror * d["F_fr"], d["N"]
         basis = np.stack([nu, e, np.broadcast_to([0.0, 0.0, 1.0], e.shape)])      # circ, radial, axial
-        speed = np.linalg.norm(slip, axis=1)
-        N = d["N"]
+        speed = np.linalg.norm(d["slip"], axis=1)
         for sh in (0, 1):
-            on = shafts == sh
-            if on.any():
-                mean_speed[sh].append(speed[on].mean())
-        for sh in (0, 1):
+            if (shafts == sh).any():
+                mean_speed[sh].append(speed[shafts == sh].mean())
             for c in labels:
                 s = (shafts == sh) & (cls == c)
                 if not s.any():
                     continue
                 a = acc[(sh, c)]
-                # power by term (rows) and direction (columns): F_dir * term_dir
-                Fd = np.einsum("bmi,mi->bm", basis[:, s], F[s])                  # (3 dirs, m)
-                Td = np.einsum("bmi,tmi->tbm", basis[:, s], terms[:, s])         # (3 terms, 3 dirs, m)
+                Fd = np.einsum("bmi,mi->bm", basis[:, s], F[s])                  # (3 directions, m)
+                Td = np.einsum("bmi,tmi->tbm", basis[:, s], terms[:, s])         # (3 terms, 3 directions, m)
                 a["P"] += (Td * Fd[None]).sum(axis=2)
-                a["comp"] += np.abs(Td).sum(axis=2)
-                a["n"] += int(s.sum())
-                a["speed"] += speed[s].sum()
-                a["N"] += N[s].sum()
-                a["Nspeed"] += (N[s] * speed[s]).sum()
-    nrow = len(rows)
-    return dict(acc=acc, rows=nrow, labels=labels, check=check, mean_speed=mean_speed, t=(t[rows[0]], t[rows[-1]]),
-                model=model, results=r)
+                a["comp"] += mirror * np.abs(Td).sum(axis=2)
+                a["n"] += mirror * int(s.sum())
+                a["speed"] += mirror * speed[s].sum()
+                a["N"] += mirror * N[s].sum()
+                a["Nspeed"] += mirror * (N[s] * speed[s]).sum()
+                a["sat"] += mirror * int((speed[s] > con.v0).sum())
+                a["Ffr"] += np.linalg.norm(F[s], axis=1).sum()
+                a["torque"] += (Fd[0] * d["radius"][s]).sum()
+    return dict(acc=acc, rows=len(rows), labels=labels, check=check, mean_speed=mean_speed,
+                t=(t[rows[0]], t[rows[-1]]), results=r, f0=con.f0, v0=con.v0)
 
 
 def report(res, ranks) -> str:
@@ -165,9 +175,16 @@ def report(res, ranks) -> str:
     i0, i1 = np.argmin(abs(tt - t0)), np.argmin(abs(tt - t1))
     dW = W[i1] - W[i0]
     P_in = dW[0] / (t1 - t0)
+    E = np.asarray(r.series["energy"]).reshape(-1)
+    sel = slice(i0, i1 + 1)
+    ratio = np.asarray(r.series["ratio"]).reshape(-1)[sel].mean()
+    F12 = (np.asarray(r.series["driving.clamping_force"]).reshape(-1)[sel]
+           / np.asarray(r.series["driven.clamping_force"]).reshape(-1)[sel]).mean()
+    res["summary"] = dict(eff=dW[1] / dW[0], eff_c=(dW[1] + E[i1] - E[i0]) / dW[0], ratio=ratio, F12=F12)
     lines = [f"{r.path}: {nrow} rows over {t0 * 1e3:.1f}-{t1 * 1e3:.1f} ms; input power {P_in / 1e3:.2f} kW "
-             f"(work integrals: in {dW[0]:.2f} J, out {dW[1]:.2f} J, dissipated {dW[2]:.3f} J); "
-             f"largest |sum of terms - kernel slip| {res['check']:.1e} m/s"]
+             f"(work integrals: in {dW[0]:.2f} J, out {dW[1]:.2f} J, dissipated {dW[2]:.3f} J); efficiency "
+             f"{dW[1] / dW[0]:.4f}, kinetic-energy corrected {(dW[1] + E[i1] - E[i0]) / dW[0]:.4f}; mean ratio "
+             f"{ratio:.4f}, F1/F2 {F12:.3f}; largest |sum of terms - kernel slip| {res['check']:.1e} m/s"]
     tot = np.zeros((3, 3))
     for sh in (0, 1):
         ms = np.mean(res["mean_speed"][sh])
@@ -187,6 +204,18 @@ def report(res, ranks) -> str:
                          f"  {a['N'] / a['n']:7.0f}   {P.sum():8.1f}  = {P.sum(axis=1)[0]:8.1f} {P.sum(axis=1)[1]:8.1f} "
                          f"{P.sum(axis=1)[2]:8.1f}   {P.sum(axis=0)[0]:8.1f} {P.sum(axis=0)[1]:8.1f} {P.sum(axis=0)[2]:8.1f}"
                          "   " + " | ".join(",".join(f"{v:.3f}" for v in comp[j]) for j in range(3)))
+        n = sum(acc[(sh, c)]["n"] for c in res["labels"])
+        sat = sum(acc[(sh, c)]["sat"] for c in res["labels"])
+        Ffr = sum(acc[(sh, c)]["Ffr"] for c in res["labels"])
+        Nsum = sum(acc[(sh, c)]["N"] for c in res["labels"])
+        torque = sum(acc[(sh, c)]["torque"] for c in res["labels"])
+        lines.append(f"  pin ends sliding faster than v0 = {res['v0']:g} m/s: {sat / n * 100:.1f} %; friction used "
+                     f"sum|F_fr| / (f0 sum N) = {Ffr / (res['f0'] * Nsum):.3f}; circumferential friction torque "
+                     f"{abs(torque) / nrow:.1f} N m; sum N {Nsum / nrow / 1e3:.2f} kN")
+        edge = sum(acc[(sh, c)]["P"].sum() for c in res["labels"] if c != ranks) / nrow
+        res["summary"][sh] = dict(loss=-Psh.sum() / P_in, slip=ms, sat=sat / n, used=Ffr / (res["f0"] * Nsum),
+                                  edge=edge / Psh.sum(), spin=Psh.sum(axis=1)[1] / Psh.sum(),
+                                  radial=Psh.sum(axis=0)[1] / Psh.sum())
         lines.append(f"  total friction power {Psh.sum():.1f} W ({-Psh.sum() / P_in * 100:.2f} % of the input); "
                      f"by term axis/spin/tilt {Psh.sum(axis=1).round(1)}; by direction circ/radial/axial "
                      f"{Psh.sum(axis=0).round(1)}")
@@ -198,15 +227,26 @@ def report(res, ranks) -> str:
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("results")
+    ap.add_argument("results", nargs="+")
     ap.add_argument("--from", dest="t_from", type=float, default=0.02)
     ap.add_argument("--to", dest="t_to", type=float, default=np.inf)
     ap.add_argument("--ranks", type=int, default=3)
     ap.add_argument("--txt")
     a = ap.parse_args(argv)
-    res = decompose(a.results, a.t_from, a.t_to, a.ranks)
-    text = report(res, a.ranks)
-    print(text)
+    texts, rows = [], []
+    for path in a.results:
+        res = decompose(path, a.t_from, a.t_to, a.ranks)
+        texts.append(report(res, a.ranks))
+        print(texts[-1] + "\n")
+        s = res["summary"]
+        rows.append(f"{Path(path).stem:28s} {s['eff']:.4f} {s['eff_c']:.4f} {s['ratio']:.4f} {s['F12']:.3f}  " + "  ".join(
+            f"{100 * s[k]['loss']:5.2f} {s[k]['slip']:6.3f} {100 * s[k]['sat']:5.1f} {s[k]['used']:5.3f} "
+            f"{100 * s[k]['edge']:5.1f} {100 * s[k]['spin']:5.1f} {100 * s[k]['radial']:5.1f}" for k in (0, 1)))
+    head = ("run                          eff    eff_c  ratio  F1/F2   per shaft (driving, driven): loss %, mean slip "
+            "m/s, sliding > v0 %, friction used, edge share %, spin share %, radial share %")
+    texts.append("\n".join([head] + rows))
+    print(texts[-1])
+    text = "\n\n".join(texts)
     if a.txt:
         Path(a.txt).parent.mkdir(parents=True, exist_ok=True)
         Path(a.txt).write_text(text + "\n")
