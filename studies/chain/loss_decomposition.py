@@ -127,7 +127,7 @@ def decompose(path, t_from, t_to, ranks):
     nc, iphi = model._idx[0], model._idx[1]
     labels = list(range(ranks)) + [ranks] + list(range(-ranks, 0))
     acc = {(sh, c): dict(P=np.zeros((3, 3)), n=0, speed=0.0, comp=np.zeros((3, 3)), N=0.0, Nspeed=0.0, sat=0,
-                         Ffr=0.0, torque=0.0)
+                         Ffr=0.0, torque=0.0, offset=0.0)
            for sh in (0, 1) for c in labels}
     mean_speed = {0: [], 1: []}
     check = 0.0
@@ -162,6 +162,8 @@ def decompose(path, t_from, t_to, ranks):
                 a["sat"] += mirror * int((speed[s] > con.v0).sum())
                 a["Ffr"] += np.linalg.norm(F[s], axis=1).sum()
                 a["torque"] += (Fd[0] * d["radius"][s]).sum()
+                if "offset" in d:
+                    a["offset"] += mirror * np.linalg.norm(d["offset"][s], axis=1).sum()
     return dict(acc=acc, rows=len(rows), labels=labels, check=check, mean_speed=mean_speed,
                 t=(t[rows[0]], t[rows[-1]]), results=r, f0=con.f0, v0=con.v0)
 
@@ -209,6 +211,8 @@ def report(res, ranks) -> str:
         Ffr = sum(acc[(sh, c)]["Ffr"] for c in res["labels"])
         Nsum = sum(acc[(sh, c)]["N"] for c in res["labels"])
         torque = sum(acc[(sh, c)]["torque"] for c in res["labels"])
+        off = sum(acc[(sh, c)]["offset"] for c in res["labels"])
+        lines.append(f"  mean contact offset |x_*| {off / n * 1e3:.2f} mm (H1: 0)")
         lines.append(f"  pin ends sliding faster than v0 = {res['v0']:g} m/s: {sat / n * 100:.1f} %; friction used "
                      f"sum|F_fr| / (f0 sum N) = {Ffr / (res['f0'] * Nsum):.3f}; circumferential friction torque "
                      f"{abs(torque) / nrow:.1f} N m; sum N {Nsum / nrow / 1e3:.2f} kN")
