@@ -90,6 +90,15 @@ def split_slip(con, X, d, centres):
     return np.stack([t - np.sum(n * t, axis=1)[:, None] * n for t in (axis, spin, tilt)]), e, nu
 
 
+#: Bins of the pin angle about its shaft (world frame, from -180 deg) for the slip against the angle.
+ANGLE_BINS = 24
+
+
+def X_inplane(con, X):
+    """In-plane position (m, 2) of the pin end in the kernel's inputs (H2: pin ``p``; H1: the end)."""
+    return X[:, 2:4] if isinstance(con, RefinedSheaveContact) else X[:, :2]
+
+
 def arc_rank(pins, shafts, u, w, centres, ranks):
     """Position class of each contact on its arc: 0..ranks-1 from the entry, -1..-ranks to the exit, else ``ranks``
     (the arc).  The pins touching a shaft are a run of consecutive indices (cyclic), ordered along the travel by
@@ -130,6 +139,7 @@ def decompose(path, t_from, t_to, ranks):
                          Ffr=0.0, torque=0.0, offset=0.0)
            for sh in (0, 1) for c in labels}
     mean_speed = {0: [], 1: []}
+    bins = np.zeros((2, ANGLE_BINS, 4))          # per shaft and pin angle: count, radial slip, circ slip, power
     check = 0.0
     for row in rows:
         q, v, _, _ = model.split(x[row])
@@ -143,6 +153,12 @@ def decompose(path, t_from, t_to, ranks):
         F, N = mirror * d["F_fr"], d["N"]
         basis = np.stack([nu, e, np.broadcast_to([0.0, 0.0, 1.0], e.shape)])      # circ, radial, axial
         speed = np.linalg.norm(d["slip"], axis=1)
+        slip = d["slip"]
+        ang = np.arctan2(X_inplane(con, X)[:, 1] - centres_all[shafts, 1], X_inplane(con, X)[:, 0] - centres_all[shafts, 0])
+        b = ((ang + np.pi) / (2 * np.pi) * ANGLE_BINS).astype(int) % ANGLE_BINS
+        for col, val in enumerate((np.ones(len(b)), np.sum(slip * e, axis=1), np.sum(slip * nu, axis=1),
+                                   mirror * np.sum(d["F_fr"] * slip, axis=1))):
+            np.add.at(bins[:, :, col], (shafts, b), val)
         for sh in (0, 1):
             if (shafts == sh).any():
                 mean_speed[sh].append(speed[shafts == sh].mean())
@@ -165,7 +181,7 @@ def decompose(path, t_from, t_to, ranks):
                 if "offset" in d:
                     a["offset"] += mirror * np.linalg.norm(d["offset"][s], axis=1).sum()
     return dict(acc=acc, rows=len(rows), labels=labels, check=check, mean_speed=mean_speed,
-                t=(t[rows[0]], t[rows[-1]]), results=r, f0=con.f0, v0=con.v0)
+                t=(t[rows[0]], t[rows[-1]]), results=r, f0=con.f0, v0=con.v0, bins=bins)
 
 
 def report(res, ranks) -> str:
@@ -220,6 +236,11 @@ def report(res, ranks) -> str:
         res["summary"][sh] = dict(loss=-Psh.sum() / P_in, slip=ms, sat=sat / n, used=Ffr / (res["f0"] * Nsum),
                                   edge=edge / Psh.sum(), spin=Psh.sum(axis=1)[1] / Psh.sum(),
                                   radial=Psh.sum(axis=0)[1] / Psh.sum())
+        B = res["bins"][sh]
+        keep = B[:, 0] > 0
+        lines.append("  by pin angle (deg): " + "  ".join(
+            f"{-180 + 360 * (i + 0.5) / ANGLE_BINS:.0f}: radial {B[i, 1] / B[i, 0]:+.3f} circ {B[i, 2] / B[i, 0]:+.3f} "
+            f"P {B[i, 3] / nrow:.0f} W" for i in np.nonzero(keep)[0]))
         lines.append(f"  total friction power {Psh.sum():.1f} W ({-Psh.sum() / P_in * 100:.2f} % of the input); "
                      f"by term axis/spin/tilt {Psh.sum(axis=1).round(1)}; by direction circ/radial/axial "
                      f"{Psh.sum(axis=0).round(1)}")
