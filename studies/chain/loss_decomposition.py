@@ -181,7 +181,8 @@ def decompose(path, t_from, t_to, ranks):
                 if "offset" in d:
                     a["offset"] += mirror * np.linalg.norm(d["offset"][s], axis=1).sum()
     return dict(acc=acc, rows=len(rows), labels=labels, check=check, mean_speed=mean_speed,
-                t=(t[rows[0]], t[rows[-1]]), results=r, f0=con.f0, v0=con.v0, bins=bins)
+                t=(t[rows[0]], t[rows[-1]]), results=r, f0=con.f0, v0=con.v0, bins=bins,
+                row_index=rows)
 
 
 def report(res, ranks) -> str:
@@ -241,6 +242,8 @@ def report(res, ranks) -> str:
         lines.append("  by pin angle (deg): " + "  ".join(
             f"{-180 + 360 * (i + 0.5) / ANGLE_BINS:.0f}: radial {B[i, 1] / B[i, 0]:+.3f} circ {B[i, 2] / B[i, 0]:+.3f} "
             f"P {B[i, 3] / nrow:.0f} W" for i in np.nonzero(keep)[0]))
+        stored = float(np.mean(np.asarray(r.series["contact.friction_power"])[res["row_index"], sh]))
+        lines.append(f"  stored contact.friction_power over the same rows {stored:.1f} W (the run's own model)")
         lines.append(f"  total friction power {Psh.sum():.1f} W ({-Psh.sum() / P_in * 100:.2f} % of the input); "
                      f"by term axis/spin/tilt {Psh.sum(axis=1).round(1)}; by direction circ/radial/axial "
                      f"{Psh.sum(axis=0).round(1)}")
