@@ -1,11 +1,10 @@
-"""Where the pin-sheave friction loss of an A-family chain run with H2 lives (session 11, issue 14's efficiency).
+"""Where the pin-sheave friction loss of a chain run lives (session 11, issue 14's efficiency).
 
-Run:  .venv/bin/python studies/chain/loss_decomposition.py RESULTS.h5 [--from 0.02] [--to 0.03] [--ranks 3]
-      [--txt out/studies/chain/loss_variant_a.txt]
+Run:  .venv/bin/python studies/chain/loss_decomposition.py RESULTS.h5 [RESULTS.h5 ...] [--from 0.02] [--to 0.03]
+      [--ranks 3] [--txt out/studies/chain/loss_variant_a.txt]
 
-RESULTS is a ``cvtfem run`` of chain-A1 with ``cvt.effects.contact = "hertz-refined"`` on rigid (variant (a)) or
-elastic shafts (variant (b)) that stores the full state (``output.state = true``; e.g.
-``studies/chain/loss-variant-a.toml``).  At every stored row in the window the contacts are evaluated again from
+RESULTS is a ``cvtfem run`` of chain-A1 or chain-S2 with H1 or H2 (``cvt.effects.contact``), A1 with H2 also on
+elastic shafts (variant (b)), that stores the full state (``output.state = true``; ``studies/chain/loss-*.toml``).  At every stored row in the window the contacts are evaluated again from
 ``q`` and ``v`` in the kernel's (mirrored, sheave) frame and the relative velocity of the material points at the
 contact point ``R_*`` is split exactly into three terms (their sum is the kernel's, checked per row):
 
@@ -18,7 +17,10 @@ The friction power ``F . v_r`` (``F`` tangential, so ``F . v_r = F . (sum of the
 direction (circumferential ``nu``, radial ``e``, axial ``k`` of the pin end about its shaft), per shaft and per
 position of the pin on its arc: the first ``--ranks`` pins from the entry, the last ones to the exit, the rest
 ("arc").  Mean slip speeds are plain means over the pin ends touching a shaft (as ``cvtfem history``) and
-force-weighted ones.  Units in the printout: W, m/s, N.
+force-weighted ones; the slip and friction power against the pin's angle about its shaft; the share of ends
+sliding faster than ``v0``, the friction used ``sum |F_fr| / (f0 sum N)``, the mean contact offset ``|x_*|`` and, as
+a check that the rebuilt model is the run's, the stored ``contact.friction_power``.  H1 contacts (on the pin axis)
+have the ``axis`` term only.  Several files end with a one-line-per-file summary.  Units in the printout: W, m/s, N.
 """
 from __future__ import annotations
 
@@ -32,8 +34,6 @@ from cvtfem.elements.chain.sheave_contact_refined import RefinedSheaveContact
 from cvtfem.elements.chain.symmetric import END_SLOPE_FACTOR
 from cvtfem.io.results import read_results
 
-TERMS = ("axis", "spin", "tilt")
-DIRS = ("circ", "radial", "axial")
 SHAFTS = ("driving", "driven")
 
 
@@ -69,7 +69,7 @@ def split_slip(con, X, d, centres):
         return (np.stack([d["slip"], zero, zero]), np.column_stack([e2, np.zeros(m)]),
                 np.column_stack([-e2[:, 1], e2[:, 0], np.zeros(m)]))
     npos = con.n_pos
-    up, u3, z = X[:, 2:4], X[:, 6], X[:, npos - 1]
+    up, u3 = X[:, 2:4], X[:, 6]
     vp, u3d, zd, w = X[:, npos + 2:npos + 4], X[:, npos + 6], X[:, 2 * npos - 1], X[:, -1]
     if con.slopes:
         g, gd = END_SLOPE_FACTOR * X[:, 7:9], END_SLOPE_FACTOR * X[:, npos + 7:npos + 9]
