@@ -299,7 +299,7 @@ def test_stiff_shafts_converge_to_the_rigid_variant_a(scene, rigid, rigid_start)
 
 @pytest.mark.slow
 def test_cvtfem_run_variant_b_keeps_the_stationary_regime_and_balances_energy(cli, tmp_path):
-    """`cvtfem run` of the variant-b preset (the stationary regime, rock4 rtol 1e-3, law (1.48); output every 10 us)
+    """`cvtfem run` of the variant-b preset (the stationary regime, its default solver, law (1.48); output every 10 us)
     over 0.2 ms from the quasi-static start: every output finite, the input speed within 1 % of 3500 rpm throughout,
     the speed ratio starting at 2.4 and rising in the start's transient (2.46 at 0.2 ms: the ratio acceptance
     needs the loops' settling, docs/transmission.md), the work integrals close the energy balance (input = output +
