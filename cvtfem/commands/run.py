@@ -15,7 +15,8 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("run", help="time run of a CVT scene (band and chain models), results to HDF5")
     p.add_argument("scene", metavar="SCENE", nargs="?", default=None,
                    help="scene file (.toml) or preset name (e.g. band-4dof); omitted with --resume")
-    p.add_argument("--until", type=float, default=None, metavar="T", help="simulated end time, s (default solver.t_end); with --resume: continue the run, killed or "
+    p.add_argument("--until", type=float, default=None, metavar="T",
+                   help="simulated end time, s (default solver.t_end); with --resume: continue the run, killed or "
                         "finished, to T")
     p.add_argument("--results", default=None, metavar="FILE",
                    help="HDF5 results file (default: out/runs/<scene>.h5; 'none' for no file)")
