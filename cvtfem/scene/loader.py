@@ -178,7 +178,37 @@ def scene_from_dict(data: Mapping[str, Any], source: str = "<dict>") -> Scene:
     """Validate a parsed scene document (presets expanded here)."""
     resolved = resolve_presets(data)
     validated = validate(SCENE, resolved)
+    _refuse_unread(validated, data)
     return Scene(data=Node(validated), kind=scene_kind(validated), source=source)
+
+
+def _refuse_unread(validated: Mapping[str, Any], data: Mapping[str, Any]) -> None:
+    """A key the scene's CVT model does not read (:func:`~cvtfem.scene.schema.cvt.unread_keys`) that the scene sets
+    to another value than its presets give is an :class:`InputError`, not a value silently ignored; a scene without
+    presets (it must write every key) and a stored resolved scene (the presets' values) pass."""
+    from cvtfem.scene.schema.cvt import unread_keys
+
+    if validated.get("cvt") is None or data.get("preset") in (None, ""):
+        return
+    model = validated["cvt"]["model"]
+    unread = unread_keys(model)
+    if not unread:
+        return
+    presets = resolve_presets({"preset": data["preset"]})
+    for key, what in unread.items():
+        written, given = _lookup(data, key), _lookup(presets, key)
+        if written is not None and given is not None and written != given:
+            raise InputError(key, written, f"is not read by `{model}`: it is {what}; leave it at its presets' value "
+                             f"{given!r} (a changed value would be ignored)")
+
+
+def _lookup(doc: Mapping[str, Any], key: str) -> Any:
+    """The value at a dotted key of a nested document, None where a part is missing."""
+    for part in key.split("."):
+        if not isinstance(doc, Mapping) or part not in doc:
+            return None
+        doc = doc[part]
+    return doc
 
 
 def load_scene(spec: str | Path, overrides: Mapping[str, Any] | None = None) -> Scene:

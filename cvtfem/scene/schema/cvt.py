@@ -155,6 +155,22 @@ CVT = Table("cvt", "A chain CVT: two shafts with sheave pairs and a chain.", (
 ), optional=True, checks=(lambda t, p: _check_cvt(t, p),))
 
 
+#: Keys of a CVT scene the discrete chain models do not read, with what they describe: a scene that changes one for a
+#: chain model is refused (:func:`cvtfem.scene.loader.scene_from_dict`) rather than run with the value ignored.
+CHAIN_UNREAD = {
+    **{f"cvt.{shaft}.{key}": f"the shaft compliance of band-6+2n+8 ({what}); a chain on elastic shafts takes it "
+       "from `shaft_diameter`, `shaft_length` and `bearing_stiffness`, on rigid shafts there is none"
+       for shaft in ("driving", "driven") for key, what in (("radial_stiffness", "c_U"), ("tilt_stiffness", "c_psi"))},
+    "cvt.chain.band_transverse_stiffness": "the band's transverse compliance c of the 6+2n band models; a discrete "
+                                           "chain's comes from its pins and the Hertz contact",
+}
+
+
+def unread_keys(model: str) -> dict[str, str]:
+    """Dotted keys the CVT model ``model`` does not read, each with what it describes (see :data:`CHAIN_UNREAD`)."""
+    return CHAIN_UNREAD if model.startswith("chain") else {}
+
+
 def _check_ordered(table: Mapping[str, Any], path: str, low: str, high: str) -> None:
     if table[low] >= table[high]:
         raise InputError(f"{path}.{high}", table[high], f"must be greater than `{low}` = {table[low]:g}")

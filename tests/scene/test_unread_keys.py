@@ -1,0 +1,39 @@
+"""A key the scene's model does not read is refused when the scene changes it (house rule: never a silently ignored
+key). Found in session 11: `cvt.driving.tilt_stiffness` 10x higher ran variant (b) step for step as before."""
+from __future__ import annotations
+
+import tomllib
+
+import pytest
+
+from cvtfem.errors import InputError
+from cvtfem.scene.loader import load_scene, scene_from_dict
+from cvtfem.scene.schema.cvt import CHAIN_UNREAD
+
+
+@pytest.mark.parametrize("key", sorted(CHAIN_UNREAD))
+def test_a_chain_scene_changing_a_band_only_key_is_refused(key):
+    shaft, name = key.split(".")[1:]
+    doc = {"preset": ["variant-b", "regime-stationary"], "cvt": {shaft: {name: 1.2345e9}}}
+    with pytest.raises(InputError, match=rf"`{key}` is not read by `chain-A1`.*got 1234500000"):
+        scene_from_dict(doc)
+
+
+def test_the_same_keys_pass_where_they_are_read_or_unchanged():
+    band = scene_from_dict({"preset": "band-6+2n+8", "cvt": {"driving": {"tilt_stiffness": 1.2345e9}}})
+    assert band.cvt.driving.tilt_stiffness == 1.2345e9                   # band-6+2n+8 reads it
+    chain = load_scene("variant-b")
+    same = scene_from_dict({"preset": "variant-b",
+                            "cvt": {"driving": {"tilt_stiffness": chain.cvt.driving.tilt_stiffness}}})
+    assert same.cvt.driving.tilt_stiffness == chain.cvt.driving.tilt_stiffness   # the presets' value: accepted
+    stored = scene_from_dict(tomllib.loads(chain.to_toml()))             # a results file's resolved scene
+    assert stored.data == chain.data
+
+
+def test_cvtfem_run_refuses_it_in_one_line(tmp_path, cli):
+    scene = tmp_path / "s.toml"
+    scene.write_text('preset = "chain-S2"\n[cvt.driven]\nradial_stiffness = 3e8\n')
+    res = cli("run", str(scene), "--until", "1e-5", "--results", "none")
+    assert res.returncode == 2 and "Traceback" not in res.stderr
+    line = res.stderr.strip()
+    assert len(line.splitlines()) == 1 and "`cvt.driven.radial_stiffness`" in line and "chain-S2" in line, line
