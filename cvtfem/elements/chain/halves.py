@@ -55,7 +55,8 @@ from cvtfem.elements.chain import plates as P
 from cvtfem.elements.chain import plates_kernel as PK
 from cvtfem.elements.chain.asymmetric import (_M_PAR, _M_PERP, ChainA1, _cross, _dot, _kx, shape_functions,
                                               shape_slopes)
-from cvtfem.elements.contact.friction import LAWS, friction_gain, friction_slope
+from cvtfem.elements.contact.friction import (LAWS, POTENTIAL_LAWS, friction_gain, friction_potential,
+                                              friction_slope)
 from cvtfem.errors import InputError, NumericalError
 from cvtfem.outputs import OutputSpec
 
@@ -66,30 +67,6 @@ PLATE_MODELS = ("A4", "A3", "A3-keep")
 #: Contacts per pin: (name, carrier half A, other half B, sigma): sigma +1 convex-convex, -1 B inside A's hole.
 CONTACTS = (("roll", 0, 1, 1.0), ("hole_next", 0, 1, -1.0), ("hole_prev", 1, 0, -1.0))
 TERMS = ("half_axial", "half_bending", "plates", "twist", "contacts", "stoppers")
-
-
-def _potential_saturated(x, f0, v0):
-    return f0 * v0 * np.where(x < v0, 0.5 * (x / v0) ** 2, x / v0 - 0.5)
-
-
-def _potential_tanh(x, f0, v0):
-    y = x / v0
-    return f0 * v0 * (y + np.log1p(np.exp(-2 * y)) - np.log(2.0))
-
-
-def _potential_smoothed(x, f0, v0):
-    y = x / v0
-    return f0 * v0 * np.where(y < 1, 0.75 * y * y - y ** 4 / 8, y - 0.375)
-
-
-def _potential_arctan(x, f0, v0):
-    a = 0.5 * np.pi * x / v0
-    return f0 * v0 * (2 / np.pi) ** 2 * (a * np.arctan(a) - 0.5 * np.log1p(a * a))
-
-
-#: ``Phi(v) = int_0^v f`` (J/N, i.e. m/s times the coefficient) of the friction laws, for the implicit friction step.
-_POTENTIALS = {"linear-saturated": _potential_saturated, "nonsmooth": _potential_saturated, "tanh": _potential_tanh,
-               "smoothed": _potential_smoothed, "arctan": _potential_arctan}
 
 
 def shape_curvatures(xi: np.ndarray, l: float) -> np.ndarray:
@@ -728,8 +705,8 @@ class ChainA5:
         changes the slips by less than ``tol v_0``.  Returns ``(v, W, LUs)`` with
         the work the step dissipates ``W = -h F(v) . (v + v_star) / 2`` (J): the kinetic energy it removes."""
         M, Mi, f0, v0, law = self.mass_matrix, self.inverse_mass, self.f0, self.v0, self.law
-        if law not in _POTENTIALS:
-            raise InputError("friction_law", law, f"must be one of {sorted(_POTENTIALS)} for the implicit friction")
+        if law not in POTENTIAL_LAWS:
+            raise InputError("friction_law", law, f"must be one of {sorted(POTENTIAL_LAWS)} for the implicit friction")
         Bt = B.T.tocsr()
         G = (B @ Mi @ Bt).tocsr()                         # slip-space inverse mass (m x m)
         I = sp.identity(B.shape[0], format="csr")
@@ -739,7 +716,7 @@ class ChainA5:
 
         def objective(v_, s_):
             dv_ = v_ - v_star
-            return 0.5 * dv_ @ (M @ dv_) + h * c @ _POTENTIALS[law](np.abs(s_), f0, v0)
+            return 0.5 * dv_ @ (M @ dv_) + h * c @ friction_potential(np.abs(s_), f0, v0, law)
 
         def step(slopes, g):
             """``-(M + h B^T D B)^-1 g`` in the slips' space (Woodbury): ``M^-1`` is block diagonal, the slips few."""

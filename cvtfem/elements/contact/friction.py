@@ -46,6 +46,27 @@ def friction_coefficient(v, f0: float, v0: float, law: str = "linear-saturated",
     return np.where(x < 1.0, f0 * x, f0)
 
 
+#: Laws with a closed-form :func:`friction_potential`.
+POTENTIAL_LAWS = ("linear-saturated", "nonsmooth", "tanh", "smoothed", "arctan")
+
+
+def friction_potential(v, f0: float, v0: float, law: str = "linear-saturated"):
+    """``Phi(v) = int_0^v f(u) du`` (m/s, times the coefficient) for ``v >= 0``: the convex potential whose
+    derivative is :func:`friction_coefficient` (an implicit friction step minimises it); laws
+    :data:`POTENTIAL_LAWS`."""
+    if law not in POTENTIAL_LAWS:
+        raise InputError("law", law, f"must be one of {', '.join(POTENTIAL_LAWS)} for the friction potential")
+    y = np.asarray(v, dtype=float) / v0
+    if law == "tanh":
+        return f0 * v0 * (y + np.log1p(np.exp(-2 * y)) - np.log(2.0))
+    if law == "arctan":
+        a = 0.5 * np.pi * y
+        return f0 * v0 * (2 / np.pi) ** 2 * (a * np.arctan(a) - 0.5 * np.log1p(a * a))
+    if law == "smoothed":
+        return f0 * v0 * np.where(y < 1, 0.75 * y * y - y ** 4 / 8, y - 0.375)
+    return f0 * v0 * np.where(y < 1, 0.5 * y * y, y - 0.5)
+
+
 def friction_slope(v, f0: float, v0: float, law: str = "linear-saturated", eps: float = 0.1):
     """``df/dv`` (s/m) for ``v >= 0``; at a kink of ``linear-saturated`` the right-hand slope."""
     _check(law, eps)

@@ -4,8 +4,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from cvtfem.elements.contact.friction import (LAWS, friction_coefficient, friction_force, friction_gain,
-                                              friction_slope, friction_vector)
+from cvtfem.elements.contact.friction import (LAWS, POTENTIAL_LAWS, friction_coefficient, friction_force,
+                                              friction_gain, friction_potential, friction_slope, friction_vector)
 from cvtfem.errors import InputError
 
 F0, V0, EPS = 0.1, 1e-3, 0.2
@@ -20,6 +20,24 @@ def test_slope_equals_difference_quotient_and_gain_is_f_over_v(law):
     assert np.allclose(friction_slope(v, F0, V0, law, EPS), fd, rtol=1e-6, atol=1e-6 * F0 / V0)
     assert np.allclose(friction_gain(v, F0, V0, law, EPS) * v, friction_coefficient(v, F0, V0, law, EPS),
                        rtol=1e-13, atol=0)
+
+
+@pytest.mark.parametrize("law", POTENTIAL_LAWS)
+def test_potential_is_zero_at_rest_and_its_derivative_is_the_law(law):
+    """``Phi(0) = 0``, ``Phi' = f`` by central differences, and ``Phi`` convex (the implicit friction step minimises
+    it); a law without a closed form is an InputError naming it."""
+    v = V0 * np.concatenate([np.geomspace(1e-4, 1e3, 300), [0.5, 0.99, 1.01, 2.0]])
+    h = 1e-6 * V0
+    fd = (friction_potential(v + h, F0, V0, law) - friction_potential(v - h, F0, V0, law)) / (2 * h)
+    assert friction_potential(0.0, F0, V0, law) == pytest.approx(0.0, abs=1e-18)
+    assert np.allclose(fd, friction_coefficient(v, F0, V0, law), rtol=1e-6, atol=1e-8 * F0)
+    w = np.linspace(0, 5 * V0, 501)
+    assert np.all(np.diff(friction_potential(w, F0, V0, law), 2) >= -1e-18)
+
+
+def test_potential_of_the_table21_law_is_refused():
+    with pytest.raises(InputError, match="`law`.*smooth"):
+        friction_potential(1.0, F0, V0, "smooth")
 
 
 @pytest.mark.parametrize("law", LAWS)
