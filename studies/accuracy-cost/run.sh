@@ -4,7 +4,7 @@
 #     bash studies/accuracy-cost/run.sh            # all (about 2 h of one core)
 #     bash studies/accuracy-cost/run.sh chain-S2   # the chain-S2 part only (also chain-A1, band, local, variant-e,
 #                                                  # variant-e-4ms, w-short, w-4ms, imex-short, variant-b-4ms,
-#                                                  # w-4ms-dumka3)
+#                                                  # w-4ms-dumka3, variant-b-4ms-smoothed)
 # Each test-2 run prints its speed-up table (Table 2.4 style); the logs go next to the results.
 set -euo pipefail
 cd "$(dirname "$0")/../.."
@@ -110,6 +110,18 @@ if [[ $part == all || $part == variant-b-4ms ]]; then
   b4 --skip-spectrum --fixed "" --adaptive dumka3 --rtols 3e-2          # the preset's default since session 11
   b4 --skip-spectrum --from-cache | tee "$out/variant-b-4ms.log"
   uptime | tee -a "$out/variant-b-4ms.log"
+fi
+# Session 12: variant (b) with the smoothed pin-sheave friction law (C1 at v0), the same protocol as variant-b-4ms.
+if [[ $part == all || $part == variant-b-4ms-smoothed ]]; then
+  cache=out/studies/variant-b-4ms-smoothed-cache
+  bs() { nice "$cvtfem" study accuracy-cost studies/accuracy-cost/scenes/variant-b-chapter2-smoothed.toml \
+           --window 1e-3:5e-3 --sample 1e-6 --repeats 1 --reference DOP853:1e-6 --check dopri78:1e-6 --cache "$cache" \
+           --png "$out/variant-b-4ms-smoothed.png" --csv "$out/variant-b-4ms-smoothed.csv" \
+           --json "$out/variant-b-4ms-smoothed.json" "$@"; }
+  bs --fixed rk4 --steps 5e-8 --adaptive "" --spectrum-png "$out/variant-b-4ms-smoothed-spectrum.png"
+  bs --skip-spectrum --fixed rk4,dumka3 --steps 1e-6,2e-6 --adaptive rock4,dumka3 --rtols 1e-2,3e-2,1e-3
+  bs --skip-spectrum --from-cache | tee "$out/variant-b-4ms-smoothed.log"
+  uptime | tee -a "$out/variant-b-4ms-smoothed.log"
 fi
 # Session 10: W-methods with a reused Jacobian (sw24 with jac_every, ros34pw2) against DUMKA3, rock4 and RK4 on variant
 # (e), FROM THE QUASI-STATIC START (converged at ratio 0.45 since session 9's iteration budget; the cache keeps the start
