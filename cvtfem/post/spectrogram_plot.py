@@ -11,6 +11,20 @@ from cvtfem.post.spectrogram import OrderIntensity, OrderSpectrum, Spectrogram
 
 #: Dynamic range shown in the spectrogram, dB below its largest value.
 DB_RANGE = 80.0
+#: Spacing of the line labels at the right edge, as a fraction of the frequency axis.
+LABEL_GAP = 0.035
+
+
+def _labelled(ends: list) -> list:
+    """The ``(name, f)`` line ends that get a label: all of them if they fit along the edge at
+    :data:`LABEL_GAP`; otherwise the whole multiples (no ``k/3``) first, then every m-th of what is left,
+    so the stack never runs off the axes (every line is still drawn)."""
+    room = int(1.0 / LABEL_GAP)
+    if len(ends) <= room:
+        return ends
+    whole = [e for e in ends if "/3" not in e[0]]
+    ends = whole if whole else ends
+    return ends[::-(-len(ends) // room)]
 
 
 def plot_spectrogram(spec: Spectrogram, path: str | Path, lines=(), line_times=None, title: str = "",
@@ -42,8 +56,9 @@ def plot_spectrogram(spec: Spectrogram, path: str | Path, lines=(), line_times=N
             ax.plot(tl[inside], f, lw=0.9, **style)
             if f[-1] <= fmax:
                 ends.append((name, float(f[-1])))
+        ends = _labelled(ends)
         if ends:                                   # labels stacked without overlap at the right edge
-            ys = spread(np.array([y for _, y in ends]), 0.035 * fmax, 0.0, fmax)
+            ys = spread(np.array([y for _, y in ends]), LABEL_GAP * fmax, 0.0, fmax)
             for (name, y0), y in zip(ends, ys):
                 ax.annotate(name, (edges_t[-1], y0), xytext=(edges_t[-1] + 0.01 * (edges_t[-1] - edges_t[0]), y),
                             textcoords="data", fontsize=7, va="center", annotation_clip=False,

@@ -189,3 +189,15 @@ def test_command_takes_a_given_chain_frequency(capsys, run_file, tmp_path):
     inten = np.loadtxt(icsv, delimiter=",", skiprows=1)
     assert inten[np.nanargmax(inten[:, 1]), 0] == pytest.approx(168.0, abs=12.0)    # 100 Hz bins / 8.9 Hz
     assert f"f_chain {f_link / 168:.5g}" in capsys.readouterr().out
+
+
+def test_line_labels_fit_along_the_edge():
+    """More excitation lines than label slots: the whole multiples are labelled, thinned to the slots, in order;
+    few lines keep every label."""
+    from cvtfem.post.spectrogram_plot import LABEL_GAP, _labelled
+
+    ends = [(sg._link_label(k), k / 3 * 1000.0) for k in range(1, 75)]
+    kept = _labelled(ends)
+    assert len(kept) <= int(1 / LABEL_GAP) and all("/3" not in name for name, _ in kept)
+    assert [f for _, f in kept] == sorted(f for _, f in kept) and kept[0][0] == "f_link"
+    assert _labelled(ends[:10]) == ends[:10]
