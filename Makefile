@@ -21,21 +21,26 @@ install: $(STAMP)
 demo: $(STAMP)
 	$(BIN)/cvtfem demo --out out/demo
 
+# The suite runs on every core (pytest-xdist, one worker per CPU; a test file stays on one worker, so its module
+# fixtures are built once). `PYTEST_WORKERS=0 make test` runs it in one process.
+PYTEST_WORKERS ?= auto
+XDIST = -n $(PYTEST_WORKERS) --dist loadfile
+
 test: $(STAMP)
-	$(BIN)/python -m pytest -m "not slow" -q
+	$(BIN)/python -m pytest -m "not slow" -q $(XDIST)
 
 test-slow: $(STAMP)
-	$(BIN)/python -m pytest -m slow -q
+	$(BIN)/python -m pytest -m slow -q $(XDIST)
 
 test-all: $(STAMP)
-	$(BIN)/python -m pytest -q
+	$(BIN)/python -m pytest -q $(XDIST)
 
 # The default suite under two more OpenBLAS kernels (any x86-64 CPU runs them): a test whose result flips
 # with the kernel fails here before it fails on someone else's machine. For developers; CI keeps the
 # machine's own kernel.
 test-kernels: $(STAMP)
 	for k in Sandybridge Haswell; do echo "== OPENBLAS_CORETYPE=$$k"; \
-	  OPENBLAS_CORETYPE=$$k $(BIN)/python -m pytest -m "not slow" -q -p no:cacheprovider || exit 1; done
+	  OPENBLAS_CORETYPE=$$k $(BIN)/python -m pytest -m "not slow" -q -p no:cacheprovider $(XDIST) || exit 1; done
 
 # The newest versions from the package index, unpinned, in a venv of their own (.ci/run reports the result).
 test-latest:
@@ -43,7 +48,7 @@ test-latest:
 	.venv-latest/bin/python -m pip install -q --upgrade pip
 	.venv-latest/bin/python -m pip install -q -e '.[test]'
 	.venv-latest/bin/python -m pip freeze --all --exclude-editable > .venv-latest/versions.txt
-	CVTFEM_UNPINNED=1 .venv-latest/bin/python -m pytest -m "not slow" -q -p no:cacheprovider
+	CVTFEM_UNPINNED=1 .venv-latest/bin/python -m pytest -m "not slow" -q -p no:cacheprovider $(XDIST)
 
 # Refresh constraints.txt from a fresh venv with the newest versions; run `make test` afterwards.
 lock:
