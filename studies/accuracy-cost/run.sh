@@ -4,7 +4,7 @@
 #     bash studies/accuracy-cost/run.sh            # all (about 2 h of one core)
 #     bash studies/accuracy-cost/run.sh chain-S2   # the chain-S2 part only (also chain-A1, band, local, variant-e,
 #                                                  # variant-e-4ms, w-short, w-4ms, imex-short, variant-b-4ms,
-#                                                  # w-4ms-dumka3, variant-b-4ms-smoothed)
+#                                                  # w-4ms-dumka3, variant-b-4ms-smoothed, w-4ms-smoothed)
 # Each test-2 run prints its speed-up table (Table 2.4 style); the logs go next to the results.
 set -euo pipefail
 cd "$(dirname "$0")/../.."
@@ -122,6 +122,18 @@ if [[ $part == all || $part == variant-b-4ms-smoothed ]]; then
   bs --skip-spectrum --fixed rk4,dumka3 --steps 1e-6,2e-6 --adaptive rock4,dumka3 --rtols 1e-2,3e-2,1e-3
   bs --skip-spectrum --from-cache | tee "$out/variant-b-4ms-smoothed.log"
   uptime | tee -a "$out/variant-b-4ms-smoothed.log"
+fi
+# Session 12: variant (e) with the smoothed pin-sheave friction law over the source's [1, 5] ms (rigid shafts).
+if [[ $part == all || $part == w-4ms-smoothed ]]; then
+  cache=out/studies/w-4ms-smoothed-cache
+  w4s() { nice "$cvtfem" study accuracy-cost "$(e_scene e smoothed)" --skip-spectrum --window 1e-3:5e-3 \
+           --sample 1e-6 --repeats 1 --reference DOP853:1e-6 --check dopri78:1e-6 --cache "$cache" \
+           --png "$out/variant-e-w-4ms-smoothed.png" --csv "$out/variant-e-w-4ms-smoothed.csv" \
+           --json "$out/variant-e-w-4ms-smoothed.json" "$@"; }
+  w4s --fixed rk4 --steps 5e-8 --adaptive ""
+  w4s --fixed dumka3 --steps 2e-6,3e-6 --adaptive dumka3,rock4 --rtols 3e-2,1e-2
+  w4s --from-cache | tee "$out/variant-e-w-4ms-smoothed.log"
+  uptime | tee -a "$out/variant-e-w-4ms-smoothed.log"
 fi
 # Session 10: W-methods with a reused Jacobian (sw24 with jac_every, ros34pw2) against DUMKA3, rock4 and RK4 on variant
 # (e), FROM THE QUASI-STATIC START (converged at ratio 0.45 since session 9's iteration budget; the cache keeps the start
