@@ -31,15 +31,17 @@ SCHEMES = ("strang", "frozen", "frozen-mid")
 
 class StrangFriction(Stepper):
     """``explicit`` (a registered explicit method, default DUMKA3, with its options ``stages``, ``spectral_radius``,
-    ``rho_every``) on ``f_E``, the system's own backward Euler on ``f_I``, combined by ``scheme`` (:data:`SCHEMES`)."""
+    ``rho_every``) on ``f_E``, the system's own backward Euler on ``f_I``, combined by ``scheme`` (:data:`SCHEMES`);
+    ``friction`` names a variant of the system's split (A5: ``"all"``, the pin-sheave friction in ``f_I`` too;
+    default the split itself, the halves' friction)."""
 
     name, order = "strang-friction", 1
     #: Runs only on a system with a :class:`~cvtfem.integrate.system.StiffSplit` (generic method loops skip it).
     needs_split = True
-    OPTIONS = frozenset({"explicit", "scheme", "stages", "spectral_radius", "rho_every"})
+    OPTIONS = frozenset({"explicit", "scheme", "friction", "stages", "spectral_radius", "rho_every"})
 
     def __init__(self, system: OdeSystem, stats=None, explicit: str = "dumka3", scheme: str = "strang",
-                 **options) -> None:
+                 friction: str | None = None, **options) -> None:
         super().__init__(system, stats)
         from cvtfem.integrate.methods import METHODS
 
@@ -55,9 +57,9 @@ class StrangFriction(Stepper):
         if scheme not in SCHEMES:
             raise InputError("scheme", scheme, f"must be one of {SCHEMES}")
         self.scheme, self._frozen = scheme, None
-        if scheme != "strang" and system.split.hold is None:
+        split = self.split = system.split.variant(friction)
+        if scheme != "strang" and split.hold is None:
             raise InputError("scheme", scheme, "needs the split's `hold` (the work rate of the held forces)")
-        split = system.split
         if scheme == "strang":
             fun = split.explicit
         else:
@@ -70,21 +72,21 @@ class StrangFriction(Stepper):
     def _implicit(self, t, x, h):
         st = self.stats
         with st.timer("t_lu"):
-            x1, its = self.system.split.solve(t, x, h)
+            x1, its = self.split.solve(t, x, h)
         st.add("nnewton", its)
         st.add("nlu", its)
         return x1
 
     def attempt(self, t, x, h):
         if self.scheme != "strang":
-            fe = self.system.split.explicit(t, x)
+            fe = self.split.explicit(t, x)
             self.stats.add("nfev")
             pred, n2 = x.copy(), self.system.n2
             hi = h if self.scheme == "frozen" else 0.5 * h
             pred[n2:] += hi * fe[n2:]                 # positions frozen: the explicit impulse of the step (or half)
             d = (self._implicit(t, pred, hi) - pred) / hi
             self._frozen = d
-            self.inner._start = (t, x.copy(), fe + self.system.split.hold(x, d))    # its F at the start: known
+            self.inner._start = (t, x.copy(), fe + self.split.hold(x, d))    # its F at the start: known
             y = self.inner.attempt(t, x, h).x1
         else:
             y = self._implicit(t, x, 0.5 * h)

@@ -1,0 +1,141 @@
+"""Backward Euler of regularised friction alone, the positions frozen: the implicit part of ``strang-friction``.
+
+The friction acts through slips linear in the velocities, ``s = S v`` (m/s), grouped in contacts of one row (a
+scalar slip: the halves' axial and rolling friction, :meth:`~cvtfem.elements.chain.halves.ChainA5.friction_slips`)
+or three (a slip vector in a tangent plane: the pin-sheave contacts, :mod:`~.half_end_slips`); contact ``g`` of
+normal force ``c_g`` (N) gives the forces ``-S_g^T c_g psi(|s_g|) s_g`` (:mod:`~cvtfem.elements.contact.friction`).
+One step over ``h`` from ``v*`` is the minimiser of the convex
+``(v - v*)^T M (v - v*) / 2 + h sum_g c_g Phi(|s_g|)`` (``Phi' = f``): :func:`friction_step`.  Units SI.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+from cvtfem.elements.contact.friction import (POTENTIAL_LAWS, friction_gain, friction_potential, friction_slope)
+from cvtfem.errors import InputError, NumericalError
+
+__all__ = ["FrictionSet", "friction_step"]
+
+
+@dataclass(frozen=True)
+class FrictionSet:
+    """Contacts of one law: slip rows ``S`` (sparse, ``dim`` rows per contact, columns the velocities), normal
+    forces ``c`` (N, one per contact), the law's ``f0``, ``v0`` (m/s) and name."""
+
+    S: sp.csr_matrix
+    c: np.ndarray
+    dim: int
+    f0: float
+    v0: float
+    law: str
+
+    def __post_init__(self):
+        if self.law not in POTENTIAL_LAWS:
+            raise InputError("friction_law", self.law, f"must be one of {sorted(POTENTIAL_LAWS)} for the implicit "
+                                                       "friction")
+
+    def speeds(self, s):
+        """``|s_g|`` (m/s) of the contacts from their slip rows ``s``."""
+        return np.abs(s) if self.dim == 1 else np.sqrt((s.reshape(-1, self.dim) ** 2).sum(1))
+
+    def per_row(self, a):
+        return a if self.dim == 1 else np.repeat(a, self.dim)
+
+    def forces(self, s):
+        """``c psi(|s|) s`` per slip row (N)."""
+        return self.per_row(self.c * friction_gain(self.speeds(s), self.f0, self.v0, self.law)) * s
+
+    def potential(self, s) -> float:
+        return float(self.c @ friction_potential(self.speeds(s), self.f0, self.v0, self.law))
+
+    def slopes(self, s, tangent: bool) -> sp.spmatrix:
+        """The blocks ``d(c psi s)/ds`` (``tangent``: ``c [psi (I - tt) + f' tt]``, ``t = s/|s|``) or the secant
+        ``c psi I`` (the majoriser's), block diagonal."""
+        speed = self.speeds(s)
+        gain = self.c * friction_gain(speed, self.f0, self.v0, self.law)
+        if not tangent:
+            return sp.diags(self.per_row(gain))
+        slope = self.c * friction_slope(speed, self.f0, self.v0, self.law)
+        if self.dim == 1:
+            return sp.diags(slope)
+        d = self.dim
+        t = s.reshape(-1, d) / np.where(speed > 0, speed, 1.0)[:, None]
+        blocks = gain[:, None, None] * np.eye(d) + (slope - gain)[:, None, None] * t[:, :, None] * t[:, None, :]
+        k = np.arange(len(speed) * d).reshape(-1, d)
+        rows, cols = np.broadcast_to(k[:, :, None], blocks.shape), np.broadcast_to(k[:, None, :], blocks.shape)
+        return sp.csr_matrix((blocks.ravel(), (rows.ravel(), cols.ravel())), shape=(len(s), len(s)))
+
+
+def friction_step(M: sp.spmatrix, Mi: sp.spmatrix, sets: list[FrictionSet], v_star: np.ndarray, h: float,
+                  v_start=None, border=None, tol: float = 1e-6, max_lu: int = 100) -> tuple[np.ndarray, float, int]:
+    """``v`` with ``M (v - v*) = -h S^T r(Sv)`` (``r`` the contacts' :meth:`FrictionSet.forces`) over ``h`` (s).
+
+    Newton on the convex function of the module docstring from ``v_start`` (default ``v*``; the minimiser does not
+    depend on it), its matrix ``M + h S^T D S`` inverted through the slips' ``I + h D S M^-1 S^T`` (Woodbury: the
+    mass inverse ``Mi`` is block diagonal, the slips fewer than the velocities); the velocities ``border`` (indices:
+    the shafts', which couple every contact on them) enter that matrix as a low-rank update (Woodbury again), so its
+    LU stays sparse.  Where a Newton step does not lower the function (a saturated law's tangent sends a slip far
+    off) the majorise-minimise step (secant slopes ``c psi``; lies above ``Phi`` for laws with falling ``psi``)
+    instead, until a step changes every slip by less than ``tol v0``.  Returns ``(v, W, LUs)`` with the work the
+    step dissipates ``W = h r(Sv) . S (v + v*) / 2`` (J): the kinetic energy it removes."""
+    S = sp.vstack([f.S for f in sets], format="csr")
+    St = S.T.tocsr()
+    n = S.shape[1]
+    inner = np.ones(n, bool)
+    if border is not None:
+        inner[np.asarray(border)] = False
+    Mi_in = Mi.multiply(inner[:, None]).multiply(inner[None, :]).tocsr()
+    K = (S @ Mi_in @ St).tocsr()                             # slip-space inverse mass without the border
+    U = S[:, ~inner].toarray()                               # the border's slip columns (rows x r)
+    Mb = Mi[~inner][:, ~inner].toarray()
+    I = sp.identity(S.shape[0], format="csr")
+    bounds = np.cumsum([0] + [f.S.shape[0] for f in sets])
+    parts = [slice(a, b) for a, b in zip(bounds[:-1], bounds[1:])]
+    s_star = S @ v_star
+    v = np.array(v_star if v_start is None else v_start, float)
+    s, lus = S @ v, 0
+
+    def forces(s_):
+        return np.concatenate([f.forces(s_[p]) for f, p in zip(sets, parts)])
+
+    def objective(v_, s_):
+        dv_ = v_ - v_star
+        return 0.5 * dv_ @ (M @ dv_) + h * sum(f.potential(s_[p]) for f, p in zip(sets, parts))
+
+    def step(tangent, g):
+        """``-(M + h S^T D S)^-1 g``."""
+        D = sp.block_diag([f.slopes(s[p], tangent) for f, p in zip(sets, parts)], format="csr")
+        y = Mi @ g
+        lu = spla.splu((I + h * (D @ K)).tocsc())
+        b = D @ (S @ y)
+        w = lu.solve(b)
+        if U.shape[1]:
+            P = h * (D @ U)                                  # A = A_c + P (U Mb)^T
+            Z = lu.solve(P)
+            Q = U @ Mb
+            w -= Z @ np.linalg.solve(np.eye(U.shape[1]) + Q.T @ Z, Q.T @ w)
+        dv = h * (Mi @ (St @ w)) - y
+        return dv, S @ dv
+
+    def small(ds):
+        return all(np.max(np.abs(ds[p]), initial=0.0) <= tol * f.v0 for f, p in zip(sets, parts))
+
+    while lus < max_lu:
+        g = M @ (v - v_star) + h * (St @ forces(s))
+        dv, ds = step(True, g)
+        lus += 1
+        done = small(ds)
+        if not done and objective(v + dv, s + ds) > objective(v, s) + 1e-4 * (g @ dv):
+            dv, ds = step(False, g)
+            lus += 1
+        v, s = v + dv, s + ds
+        if done or small(ds):
+            break
+    else:
+        raise NumericalError(f"the implicit friction step (h = {h:g} s) did not converge in {max_lu} LUs",
+                             component="implicit_friction.friction_step")
+    return v, float(h * forces(s) @ (0.5 * (s + s_star))), lus
