@@ -10,7 +10,11 @@ method whose stage count follows the spectral radius of ``f_E`` alone, ``f_I`` t
 * ``frozen``: the forces of one backward-Euler step of ``f_I`` after the explicit impulse ``h f_E(x)`` (velocity
   rows), held constant over the explicit step; their work is booked at the power they deliver along it (the split's
   ``hold``), so the energy balance stays the explicit method's;
-* ``frozen-mid``: the same from a half step after half the impulse (the forces of the step's middle).
+* ``frozen-mid``: the same from a half step after half the impulse (the forces of the step's middle);
+* ``imex-rk4``: an additive (IMEX) Runge-Kutta method of order 2: RK4's tableau on ``f_E`` and the stiffly accurate
+  ESDIRK :data:`IMEX_RK4_IMPLICIT` (the same nodes and weights; ``R(inf) = 0``) on ``f_I``, each implicit stage one
+  backward-Euler solve of the split at the stage's positions (three per step), ``f_I`` at the step's start as
+  ``F - f_E`` (one RHS call); the option ``explicit`` is not used.
 
 Fixed steps only (no error estimate).  The friction solves count as ``nnewton`` (iterations) and ``nlu`` (one sparse
 LU each), timed in ``t_lu``.
@@ -26,7 +30,12 @@ __all__ = ["StrangFriction"]
 #: The explicit methods a split step may use.
 EXPLICIT = ("dumka3", "rk4", "rock4", "dopri45")
 #: How a step combines the two parts (module docstring).
-SCHEMES = ("strang", "frozen", "frozen-mid")
+SCHEMES = ("strang", "frozen", "frozen-mid", "imex-rk4")
+#: The implicit tableau of ``imex-rk4`` (rows 2-4; the first stage explicit): nodes ``(0, 1/2, 1/2, 1)`` and weights
+#: ``(1, 2, 2, 1)/6`` as RK4's (so the pair has order 2), the last row the weights (stiffly accurate), the middle one
+#: chosen for ``R(inf) = 0`` (its stability function stays within the unit circle on the left half-plane).
+IMEX_RK4_IMPLICIT = ((0.0, 0.5), (0.25, -0.25, 0.5), (1 / 6, 1 / 3, 1 / 3, 1 / 6))
+_RK4_EXPLICIT = ((0.5,), (0.0, 0.5), (0.0, 0.0, 1.0))
 
 
 class StrangFriction(Stepper):
@@ -77,7 +86,30 @@ class StrangFriction(Stepper):
         st.add("nlu", its)
         return x1
 
+    def _imex_rk4(self, t, x, h):
+        """One step of ``imex-rk4`` (module docstring)."""
+        split, st = self.split, self.stats
+        KE, KI = [split.explicit(t, x)], []
+        KI.append(self.system.fun(t, x) - KE[0])
+        st.add("nfev", 2)
+        for i, (aE, aI) in enumerate(zip(_RK4_EXPLICIT, IMEX_RK4_IMPLICIT)):
+            pred = x + h * (sum(a * k for a, k in zip(aE, KE)) + sum(a * k for a, k in zip(aI[:-1], KI)))
+            hi = h * aI[-1]
+            y = self._implicit(t + h * sum(aE), pred, hi)
+            KI.append((y - pred) / hi)
+            if i < 2:
+                KE.append(split.explicit(t + h * sum(aE), y))
+                st.add("nfev")
+        KE.append(split.explicit(t + h, y))
+        st.add("nfev")
+        b = IMEX_RK4_IMPLICIT[-1]
+        return x + h * sum(bi * (ke + ki) for bi, ke, ki in zip(b, KE, KI))
+
     def attempt(self, t, x, h):
+        if self.scheme == "imex-rk4":
+            y = self._imex_rk4(t, x, h)
+            self.stages = 4
+            return Attempt(t, x, h, y)
         if self.scheme != "strang":
             fe = self.split.explicit(t, x)
             self.stats.add("nfev")

@@ -81,7 +81,9 @@ def friction_step(M: sp.spmatrix, Mi: sp.spmatrix, sets: list[FrictionSet], v_st
     LU stays sparse.  Where a Newton step does not lower the function (a saturated law's tangent sends a slip far
     off) the majorise-minimise step (secant slopes ``c psi``; lies above ``Phi`` for laws with falling ``psi``)
     instead, until a step changes every slip by less than ``tol v0``.  Returns ``(v, W, LUs)`` with the work the
-    step dissipates ``W = h r(Sv) . S (v + v*) / 2`` (J): the kinetic energy it removes."""
+    step dissipates, booked as the kinetic energy it removes ``W = (v* - v)^T M (v* + v) / 2`` (J; equal to the
+    friction's work ``h r(Sv) . S (v + v*) / 2`` to the solve's tolerance), so a run's energy balance holds to
+    round-off whatever that tolerance."""
     S = sp.vstack([f.S for f in sets], format="csr")
     St = S.T.tocsr()
     n = S.shape[1]
@@ -95,7 +97,6 @@ def friction_step(M: sp.spmatrix, Mi: sp.spmatrix, sets: list[FrictionSet], v_st
     I = sp.identity(S.shape[0], format="csr")
     bounds = np.cumsum([0] + [f.S.shape[0] for f in sets])
     parts = [slice(a, b) for a, b in zip(bounds[:-1], bounds[1:])]
-    s_star = S @ v_star
     v = np.array(v_star if v_start is None else v_start, float)
     s, lus = S @ v, 0
 
@@ -138,4 +139,4 @@ def friction_step(M: sp.spmatrix, Mi: sp.spmatrix, sets: list[FrictionSet], v_st
     else:
         raise NumericalError(f"the implicit friction step (h = {h:g} s) did not converge in {max_lu} LUs",
                              component="implicit_friction.friction_step")
-    return v, float(h * forces(s) @ (0.5 * (s + s_star))), lus
+    return v, float(0.5 * (v_star - v) @ (M @ (v_star + v))), lus
