@@ -13,8 +13,12 @@ method whose stage count follows the spectral radius of ``f_E`` alone, ``f_I`` t
 * ``frozen-mid``: the same from a half step after half the impulse (the forces of the step's middle);
 * ``imex-rk4``: an additive (IMEX) Runge-Kutta method of order 2: RK4's tableau on ``f_E`` and the stiffly accurate
   ESDIRK :data:`IMEX_RK4_IMPLICIT` (the same nodes and weights; ``R(inf) = 0``) on ``f_I``, each implicit stage one
-  backward-Euler solve of the split at the stage's positions (three per step), ``f_I`` at the step's start as
-  ``F - f_E`` (one RHS call); the option ``explicit`` is not used.
+  backward-Euler solve of the split at the stage's positions (three per step) whose rate is booked with the power of
+  its forces at the stage's velocities (the split's ``hold``: ``f_I`` of the stage state, not the solve's own
+  kinetic-energy balance over the stage), ``f_I`` at the step's start as ``F - f_E`` (one RHS call); the option
+  ``explicit`` is not used;
+* ``imex-rk4-2``: the same with an explicit third stage of the ESDIRK (``f_I = F - f_E`` there: one RHS call instead
+  of a solve), two solves per step.
 
 Fixed steps only (no error estimate).  The friction solves count as ``nnewton`` (iterations) and ``nlu`` (one sparse
 LU each), timed in ``t_lu``.
@@ -30,11 +34,13 @@ __all__ = ["StrangFriction"]
 #: The explicit methods a split step may use.
 EXPLICIT = ("dumka3", "rk4", "rock4", "dopri45")
 #: How a step combines the two parts (module docstring).
-SCHEMES = ("strang", "frozen", "frozen-mid", "imex-rk4")
-#: The implicit tableau of ``imex-rk4`` (rows 2-4; the first stage explicit): nodes ``(0, 1/2, 1/2, 1)`` and weights
-#: ``(1, 2, 2, 1)/6`` as RK4's (so the pair has order 2), the last row the weights (stiffly accurate), the middle one
-#: chosen for ``R(inf) = 0`` (its stability function stays within the unit circle on the left half-plane).
-IMEX_RK4_IMPLICIT = ((0.0, 0.5), (0.25, -0.25, 0.5), (1 / 6, 1 / 3, 1 / 3, 1 / 6))
+SCHEMES = ("strang", "frozen", "frozen-mid", "imex-rk4", "imex-rk4-2")
+#: The implicit tableaus of the IMEX schemes (rows 2-4; the first stage explicit): nodes ``(0, 1/2, 1/2, 1)`` and
+#: weights ``(1, 2, 2, 1)/6`` as RK4's (so each pair has order 2), the last row the weights (stiffly accurate), the
+#: middle rows chosen for ``R(inf) = 0`` with ``|R| <= 1`` on the left half-plane; ``imex-rk4-2`` has an explicit
+#: third stage (``a_33 = 0``: ``f_I`` evaluated there, two solves per step instead of three).
+IMEX_RK4_IMPLICIT = {"imex-rk4": ((0.0, 0.5), (0.25, -0.25, 0.5), (1 / 6, 1 / 3, 1 / 3, 1 / 6)),
+                     "imex-rk4-2": ((0.1, 0.4), (0.1, 0.4, 0.0), (1 / 6, 1 / 3, 1 / 3, 1 / 6))}
 _RK4_EXPLICIT = ((0.5,), (0.0, 0.5), (0.0, 0.0, 1.0))
 
 
@@ -87,26 +93,30 @@ class StrangFriction(Stepper):
         return x1
 
     def _imex_rk4(self, t, x, h):
-        """One step of ``imex-rk4`` (module docstring)."""
-        split, st = self.split, self.stats
-        KE, KI = [split.explicit(t, x)], []
-        KI.append(self.system.fun(t, x) - KE[0])
+        """One step of ``imex-rk4`` or ``imex-rk4-2`` (module docstring)."""
+        split, st, fun = self.split, self.stats, self.system.fun
+        KE = [split.explicit(t, x)]
+        KI = [fun(t, x) - KE[0]]
         st.add("nfev", 2)
-        for i, (aE, aI) in enumerate(zip(_RK4_EXPLICIT, IMEX_RK4_IMPLICIT)):
+        for aE, aI in zip(_RK4_EXPLICIT, IMEX_RK4_IMPLICIT[self.scheme]):
+            ti = t + h * sum(aE)
             pred = x + h * (sum(a * k for a, k in zip(aE, KE)) + sum(a * k for a, k in zip(aI[:-1], KI)))
-            hi = h * aI[-1]
-            y = self._implicit(t + h * sum(aE), pred, hi)
-            KI.append((y - pred) / hi)
-            if i < 2:
-                KE.append(split.explicit(t + h * sum(aE), y))
+            if aI[-1] > 0.0:
+                hi = h * aI[-1]
+                y = self._implicit(ti, pred, hi)
+                KE.append(split.explicit(ti, y))
+                KI.append(split.hold(y, (y - pred) / hi))    # the stage's friction rate: its power at its v
                 st.add("nfev")
-        KE.append(split.explicit(t + h, y))
-        st.add("nfev")
-        b = IMEX_RK4_IMPLICIT[-1]
+            else:                                            # an explicit stage of f_I too
+                y = pred
+                KE.append(split.explicit(ti, y))
+                KI.append(fun(ti, y) - KE[-1])
+                st.add("nfev", 2)
+        b = IMEX_RK4_IMPLICIT[self.scheme][-1]
         return x + h * sum(bi * (ke + ki) for bi, ke, ki in zip(b, KE, KI))
 
     def attempt(self, t, x, h):
-        if self.scheme == "imex-rk4":
+        if self.scheme in IMEX_RK4_IMPLICIT:
             y = self._imex_rk4(t, x, h)
             self.stages = 4
             return Attempt(t, x, h, y)

@@ -52,22 +52,52 @@ class FrictionSet:
     def potential(self, s) -> float:
         return float(self.c @ friction_potential(self.speeds(s), self.f0, self.v0, self.law))
 
-    def slopes(self, s, tangent: bool) -> sp.spmatrix:
-        """The blocks ``d(c psi s)/ds`` (``tangent``: ``c [psi (I - tt) + f' tt]``, ``t = s/|s|``) or the secant
-        ``c psi I`` (the majoriser's), block diagonal."""
-        speed = self.speeds(s)
+    def slopes(self, s, tangent: bool) -> np.ndarray:
+        """The blocks ``d(c psi s)/ds`` (contacts, dim, dim) (``tangent``: ``c [psi (I - tt) + f' tt]``,
+        ``t = s/|s|``) or the secant ``c psi I`` (the majoriser's)."""
+        d, speed = self.dim, self.speeds(s)
         gain = self.c * friction_gain(speed, self.f0, self.v0, self.law)
-        if not tangent:
-            return sp.diags(self.per_row(gain))
+        if not tangent or d == 1:
+            diag = self.c * friction_slope(speed, self.f0, self.v0, self.law) if tangent else gain
+            return diag[:, None, None] * np.eye(d)
         slope = self.c * friction_slope(speed, self.f0, self.v0, self.law)
-        if self.dim == 1:
-            return sp.diags(slope)
-        d = self.dim
         t = s.reshape(-1, d) / np.where(speed > 0, speed, 1.0)[:, None]
-        blocks = gain[:, None, None] * np.eye(d) + (slope - gain)[:, None, None] * t[:, :, None] * t[:, None, :]
-        k = np.arange(len(speed) * d).reshape(-1, d)
-        rows, cols = np.broadcast_to(k[:, :, None], blocks.shape), np.broadcast_to(k[:, None, :], blocks.shape)
-        return sp.csr_matrix((blocks.ravel(), (rows.ravel(), cols.ravel())), shape=(len(s), len(s)))
+        return gain[:, None, None] * np.eye(d) + (slope - gain)[:, None, None] * t[:, :, None] * t[:, None, :]
+
+
+class _SlipSystem:
+    """``A = I + h D K`` (``K = S M^-1 S^T`` over the inner velocities, ``D`` block diagonal by contact) on a pattern
+    built once: the rows of a contact share the union of their ``K`` rows' columns, and ``A``'s data is one weighted
+    ``bincount`` of ``K``'s per iteration; factored as the CSC of ``A^T`` (the CSR arrays as they are)."""
+
+    def __init__(self, K: sp.csr_matrix, sizes: np.ndarray):
+        m = K.shape[0]
+        gid = np.repeat(np.arange(len(sizes)), sizes)                   # each row's contact
+        first = np.concatenate([[0], np.cumsum(sizes)[:-1]])
+        rows = np.repeat(np.arange(m), np.diff(K.indptr))
+        key = np.unique(np.concatenate([gid[rows] * m + K.indices, gid * m + np.arange(m)]))
+        kg = key // m                                                   # each pattern column's contact
+        start = np.searchsorted(kg, np.arange(len(sizes)))
+        width = np.diff(np.append(start, len(key)))                     # pattern columns per contact
+        self.indptr = np.concatenate([[0], np.cumsum(width[gid])])
+        self.indices = np.concatenate([key[start[g]:start[g] + width[g]] % m for g in gid]) if m else np.zeros(0, int)
+        rank = np.searchsorted(key, gid[rows] * m + K.indices) - start[gid[rows]]
+        d = sizes[gid[rows]]                                            # each K entry feeds the d rows of its contact
+        e = np.repeat(np.arange(K.nnz), d)
+        r = first[gid[rows[e]]] + (np.arange(e.size) - np.repeat(np.cumsum(d) - d, d))       # the target row
+        self.tgt = self.indptr[r] + rank[e]
+        boff = np.concatenate([[0], np.cumsum(sizes ** 2)[:-1]])        # blocks flattened by contact
+        g = gid[r]
+        self.block = boff[g] + (r - first[g]) * sizes[g] + (rows[e] - first[g])
+        self.kdata = K.data[e]
+        self.diag = self.indptr[np.arange(m)] + np.searchsorted(key, gid * m + np.arange(m)) - start[gid]
+        self.n = self.indptr[-1]
+
+    def factor(self, h: float, blocks: np.ndarray):
+        data = np.bincount(self.tgt, h * blocks[self.block] * self.kdata, minlength=self.n)
+        data[self.diag] += 1.0
+        m = len(self.indptr) - 1
+        return spla.splu(sp.csc_matrix((data, self.indices, self.indptr), shape=(m, m)))
 
 
 def friction_step(M: sp.spmatrix, Mi: sp.spmatrix, sets: list[FrictionSet], v_star: np.ndarray, h: float,
@@ -92,11 +122,12 @@ def friction_step(M: sp.spmatrix, Mi: sp.spmatrix, sets: list[FrictionSet], v_st
         inner[np.asarray(border)] = False
     Mi_in = Mi.multiply(inner[:, None]).multiply(inner[None, :]).tocsr()
     K = (S @ Mi_in @ St).tocsr()                             # slip-space inverse mass without the border
+    K.sort_indices()
     U = S[:, ~inner].toarray()                               # the border's slip columns (rows x r)
-    Mb = Mi[~inner][:, ~inner].toarray()
-    I = sp.identity(S.shape[0], format="csr")
+    Q = U @ Mi[~inner][:, ~inner].toarray()
     bounds = np.cumsum([0] + [f.S.shape[0] for f in sets])
     parts = [slice(a, b) for a, b in zip(bounds[:-1], bounds[1:])]
+    system = _SlipSystem(K, np.concatenate([np.full(len(f.c), f.dim) for f in sets]))
     v = np.array(v_star if v_start is None else v_start, float)
     s, lus = S @ v, 0
 
@@ -109,15 +140,17 @@ def friction_step(M: sp.spmatrix, Mi: sp.spmatrix, sets: list[FrictionSet], v_st
 
     def step(tangent, g):
         """``-(M + h S^T D S)^-1 g``."""
-        D = sp.block_diag([f.slopes(s[p], tangent) for f, p in zip(sets, parts)], format="csr")
+        blocks = [f.slopes(s[p], tangent) for f, p in zip(sets, parts)]
+
+        def D(x):                                            # the block-diagonal D times x (rows, ...)
+            return np.concatenate([np.einsum("gij,gj...->gi...", b, x[p].reshape(len(b), b.shape[1], *x.shape[1:]))
+                                   .reshape(x[p].shape) for b, p in zip(blocks, parts)])
+
+        lu = system.factor(h, np.concatenate([b.ravel() for b in blocks]))
         y = Mi @ g
-        lu = spla.splu((I + h * (D @ K)).tocsc())
-        b = D @ (S @ y)
-        w = lu.solve(b)
+        w = lu.solve(D(S @ y), trans="T")
         if U.shape[1]:
-            P = h * (D @ U)                                  # A = A_c + P (U Mb)^T
-            Z = lu.solve(P)
-            Q = U @ Mb
+            Z = lu.solve(h * D(U), trans="T")                # A = A_c + (h D U) Q^T
             w -= Z @ np.linalg.solve(np.eye(U.shape[1]) + Q.T @ Z, Q.T @ w)
         dv = h * (Mi @ (St @ w)) - y
         return dv, S @ dv
