@@ -67,8 +67,9 @@ class FrictionSet:
 
 class _SlipSystem:
     """``A = I + h D K`` (``K = S M^-1 S^T`` over the inner velocities, ``D`` block diagonal by contact) on a pattern
-    built once: the rows of a contact share the union of their ``K`` rows' columns, and ``A``'s data is one weighted
-    ``bincount`` of ``K``'s per iteration; factored as the CSC of ``A^T`` (the CSR arrays as they are)."""
+    built once per pattern of ``K`` (:func:`_slip_system`): the rows of a contact share the union of their ``K`` rows'
+    columns, and ``A``'s data is one weighted ``bincount`` of ``K``'s per iteration; factored as the CSC of ``A^T``
+    (the CSR arrays as they are)."""
 
     def __init__(self, K: sp.csr_matrix, sizes: np.ndarray):
         m = K.shape[0]
@@ -76,28 +77,39 @@ class _SlipSystem:
         first = np.concatenate([[0], np.cumsum(sizes)[:-1]])
         rows = np.repeat(np.arange(m), np.diff(K.indptr))
         key = np.unique(np.concatenate([gid[rows] * m + K.indices, gid * m + np.arange(m)]))
-        kg = key // m                                                   # each pattern column's contact
-        start = np.searchsorted(kg, np.arange(len(sizes)))
-        width = np.diff(np.append(start, len(key)))                     # pattern columns per contact
-        self.indptr = np.concatenate([[0], np.cumsum(width[gid])])
-        self.indices = np.concatenate([key[start[g]:start[g] + width[g]] % m for g in gid]) if m else np.zeros(0, int)
+        start = np.searchsorted(key // m, np.arange(len(sizes)))       # each contact's first pattern column
+        width = np.diff(np.append(start, len(key)))[gid]                # pattern columns of each row
+        self.indptr = np.concatenate([[0], np.cumsum(width)])
+        self.indices = key[np.repeat(start[gid] - self.indptr[:-1], width) + np.arange(self.indptr[-1])] % m
         rank = np.searchsorted(key, gid[rows] * m + K.indices) - start[gid[rows]]
         d = sizes[gid[rows]]                                            # each K entry feeds the d rows of its contact
-        e = np.repeat(np.arange(K.nnz), d)
+        self.entry = np.repeat(np.arange(K.nnz), d)
+        e = self.entry
         r = first[gid[rows[e]]] + (np.arange(e.size) - np.repeat(np.cumsum(d) - d, d))       # the target row
         self.tgt = self.indptr[r] + rank[e]
         boff = np.concatenate([[0], np.cumsum(sizes ** 2)[:-1]])        # blocks flattened by contact
         g = gid[r]
         self.block = boff[g] + (r - first[g]) * sizes[g] + (rows[e] - first[g])
-        self.kdata = K.data[e]
-        self.diag = self.indptr[np.arange(m)] + np.searchsorted(key, gid * m + np.arange(m)) - start[gid]
-        self.n = self.indptr[-1]
+        self.diag = self.indptr[:-1] + np.searchsorted(key, gid * m + np.arange(m)) - start[gid]
 
-    def factor(self, h: float, blocks: np.ndarray):
-        data = np.bincount(self.tgt, h * blocks[self.block] * self.kdata, minlength=self.n)
+    def factor(self, K: sp.csr_matrix, h: float, blocks: np.ndarray):
+        data = np.bincount(self.tgt, h * blocks[self.block] * K.data[self.entry], minlength=self.indptr[-1])
         data[self.diag] += 1.0
         m = len(self.indptr) - 1
         return spla.splu(sp.csc_matrix((data, self.indices, self.indptr), shape=(m, m)))
+
+
+_LAST: dict = {}
+
+
+def _slip_system(K: sp.csr_matrix, sizes: np.ndarray) -> _SlipSystem:
+    """The :class:`_SlipSystem` of ``K``'s pattern, kept for the next call with the same pattern (successive solves
+    of a run mostly share it: the same contacts in touch)."""
+    key = K.indptr.tobytes() + K.indices.tobytes() + sizes.tobytes()
+    if key not in _LAST:
+        _LAST.clear()
+        _LAST[key] = _SlipSystem(K, sizes)
+    return _LAST[key]
 
 
 def friction_step(M: sp.spmatrix, Mi: sp.spmatrix, sets: list[FrictionSet], v_star: np.ndarray, h: float,
@@ -127,7 +139,7 @@ def friction_step(M: sp.spmatrix, Mi: sp.spmatrix, sets: list[FrictionSet], v_st
     Q = U @ Mi[~inner][:, ~inner].toarray()
     bounds = np.cumsum([0] + [f.S.shape[0] for f in sets])
     parts = [slice(a, b) for a, b in zip(bounds[:-1], bounds[1:])]
-    system = _SlipSystem(K, np.concatenate([np.full(len(f.c), f.dim) for f in sets]))
+    system = _slip_system(K, np.concatenate([np.full(len(f.c), f.dim) for f in sets]))
     v = np.array(v_star if v_start is None else v_start, float)
     s, lus = S @ v, 0
 
@@ -146,7 +158,7 @@ def friction_step(M: sp.spmatrix, Mi: sp.spmatrix, sets: list[FrictionSet], v_st
             return np.concatenate([np.einsum("gij,gj...->gi...", b, x[p].reshape(len(b), b.shape[1], *x.shape[1:]))
                                    .reshape(x[p].shape) for b, p in zip(blocks, parts)])
 
-        lu = system.factor(h, np.concatenate([b.ravel() for b in blocks]))
+        lu = system.factor(K, h, np.concatenate([b.ravel() for b in blocks]))
         y = Mi @ g
         w = lu.solve(D(S @ y), trans="T")
         if U.shape[1]:
