@@ -4,7 +4,7 @@
 #     bash studies/accuracy-cost/run.sh            # all (about 2 h of one core)
 #     bash studies/accuracy-cost/run.sh chain-S2   # the chain-S2 part only (also chain-A1, band, local, variant-e,
 #                                                  # variant-e-4ms, w-short, w-4ms, imex-short, variant-b-4ms,
-#                                                  # w-4ms-dumka3)
+#                                                  # w-4ms-dumka3, imex-all-short)
 # Each test-2 run prints its speed-up table (Table 2.4 style); the logs go next to the results.
 set -euo pipefail
 cd "$(dirname "$0")/../.."
