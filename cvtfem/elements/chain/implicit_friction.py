@@ -100,6 +100,20 @@ class _SlipSystem:
 
 
 _LAST: dict = {}
+_MASS: dict = {}
+
+
+def _inner_mass(Mi: sp.spmatrix, border) -> tuple[np.ndarray, sp.csr_matrix]:
+    """``(inner, Mi_in)``: the mask of the velocities off the border and ``Mi`` with the border's rows and columns
+    zeroed, kept for the next call with the same ``Mi`` and border."""
+    border = np.zeros(0, int) if border is None else np.asarray(border)
+    key = (id(Mi), border.tobytes())
+    if key not in _MASS:
+        inner = np.ones(Mi.shape[0], bool)
+        inner[border] = False
+        _MASS.clear()
+        _MASS[key] = (Mi, inner, Mi.multiply(inner[:, None]).multiply(inner[None, :]).tocsr())
+    return _MASS[key][1:]
 
 
 def _slip_system(K: sp.csr_matrix, sizes: np.ndarray) -> _SlipSystem:
@@ -128,11 +142,7 @@ def friction_step(M: sp.spmatrix, Mi: sp.spmatrix, sets: list[FrictionSet], v_st
     round-off whatever that tolerance."""
     S = sp.vstack([f.S for f in sets], format="csr")
     St = S.T.tocsr()
-    n = S.shape[1]
-    inner = np.ones(n, bool)
-    if border is not None:
-        inner[np.asarray(border)] = False
-    Mi_in = Mi.multiply(inner[:, None]).multiply(inner[None, :]).tocsr()
+    inner, Mi_in = _inner_mass(Mi, border)
     K = (S @ Mi_in @ St).tocsr()                             # slip-space inverse mass without the border
     K.sort_indices()
     U = S[:, ~inner].toarray()                               # the border's slip columns (rows x r)
