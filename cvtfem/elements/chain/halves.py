@@ -642,11 +642,13 @@ class ChainA5:
         u = self.split(np.asarray(q, float))[0]
         p = np.arange(n)
         Tp = np.maximum(self.link_tensions(q), 0.0)
+        pattern = getattr(self, "_slip_pattern", None)                  # rows and columns: the same at every q
         rows, cols, vals, c = [], [], [], []
 
         def add(block_rows, block_cols, block_vals):
-            rows.append(np.broadcast_to(block_rows, block_vals.shape).ravel())
-            cols.append(np.broadcast_to(block_cols, block_vals.shape).ravel())
+            if pattern is None:
+                rows.append(np.broadcast_to(block_rows, block_vals.shape).ravel())
+                cols.append(np.broadcast_to(block_cols, block_vals.shape).ravel())
             vals.append(block_vals.ravel())
 
         one = np.ones(n)
@@ -683,7 +685,13 @@ class ChainA5:
                     add(r[:, None], di[e][:, ic], -g)
                 c.append(N[s_])
                 m += n
-        B = sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))), shape=(m, self.n2))
+        if pattern is None:                         # the CSR pattern and where each value adds in it, built once
+            key = np.concatenate(rows) * self.n2 + np.concatenate(cols)
+            unique, where = np.unique(key, return_inverse=True)
+            indptr = np.searchsorted(unique // self.n2, np.arange(m + 1))
+            pattern = self._slip_pattern = (where, unique % self.n2, indptr)
+        where, indices, indptr = pattern
+        B = sp.csr_matrix((np.bincount(where, np.concatenate(vals), len(indices)), indices, indptr), shape=(m, self.n2))
         c = np.concatenate(c)
         keep = np.flatnonzero(c > 0)
         label = np.concatenate([np.zeros(n, int), np.ones(2 * n, int), np.repeat(2 + np.arange(len(CONTACTS)),
