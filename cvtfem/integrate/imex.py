@@ -10,7 +10,15 @@ method whose stage count follows the spectral radius of ``f_E`` alone, ``f_I`` t
 * ``frozen``: the forces of one backward-Euler step of ``f_I`` after the explicit impulse ``h f_E(x)`` (velocity
   rows), held constant over the explicit step; their work is booked at the power they deliver along it (the split's
   ``hold``), so the energy balance stays the explicit method's;
-* ``frozen-mid``: the same from a half step after half the impulse (the forces of the step's middle).
+* ``frozen-mid``: the same from a half step after half the impulse (the forces of the step's middle);
+* ``imex-rk4``: an additive (IMEX) Runge-Kutta method of order 2: RK4's tableau on ``f_E`` and the stiffly accurate
+  ESDIRK :data:`IMEX_RK4_IMPLICIT` (the same nodes and weights; ``R(inf) = 0``) on ``f_I``, each implicit stage one
+  backward-Euler solve of the split at the stage's positions (three per step) whose rate is booked with the power of
+  its forces at the stage's velocities (the split's ``hold``: ``f_I`` of the stage state, not the solve's own
+  kinetic-energy balance over the stage), ``f_I`` at the step's start as ``F - f_E`` (one RHS call); the option
+  ``explicit`` is not used;
+* ``imex-rk4-2``: the same with an explicit third stage of the ESDIRK (``f_I = F - f_E`` there: one RHS call instead
+  of a solve), two solves per step.
 
 Fixed steps only (no error estimate).  The friction solves count as ``nnewton`` (iterations) and ``nlu`` (one sparse
 LU each), timed in ``t_lu``.
@@ -26,20 +34,29 @@ __all__ = ["StrangFriction"]
 #: The explicit methods a split step may use.
 EXPLICIT = ("dumka3", "rk4", "rock4", "dopri45")
 #: How a step combines the two parts (module docstring).
-SCHEMES = ("strang", "frozen", "frozen-mid")
+SCHEMES = ("strang", "frozen", "frozen-mid", "imex-rk4", "imex-rk4-2")
+#: The implicit tableaus of the IMEX schemes (rows 2-4; the first stage explicit): nodes ``(0, 1/2, 1/2, 1)`` and
+#: weights ``(1, 2, 2, 1)/6`` as RK4's (so each pair has order 2), the last row the weights (stiffly accurate), the
+#: middle rows chosen for ``R(inf) = 0`` with ``|R| <= 1`` on the left half-plane; ``imex-rk4-2`` has an explicit
+#: third stage (``a_33 = 0``: ``f_I`` evaluated there, two solves per step instead of three).
+IMEX_RK4_IMPLICIT = {"imex-rk4": ((0.0, 0.5), (0.25, -0.25, 0.5), (1 / 6, 1 / 3, 1 / 3, 1 / 6)),
+                     "imex-rk4-2": ((0.1, 0.4), (0.1, 0.4, 0.0), (1 / 6, 1 / 3, 1 / 3, 1 / 6))}
+_RK4_EXPLICIT = ((0.5,), (0.0, 0.5), (0.0, 0.0, 1.0))
 
 
 class StrangFriction(Stepper):
     """``explicit`` (a registered explicit method, default DUMKA3, with its options ``stages``, ``spectral_radius``,
-    ``rho_every``) on ``f_E``, the system's own backward Euler on ``f_I``, combined by ``scheme`` (:data:`SCHEMES`)."""
+    ``rho_every``) on ``f_E``, the system's own backward Euler on ``f_I``, combined by ``scheme`` (:data:`SCHEMES`);
+    ``friction`` names a variant of the system's split (A5: ``"all"``, the pin-sheave friction in ``f_I`` too;
+    default the split itself, the halves' friction)."""
 
     name, order = "strang-friction", 1
     #: Runs only on a system with a :class:`~cvtfem.integrate.system.StiffSplit` (generic method loops skip it).
     needs_split = True
-    OPTIONS = frozenset({"explicit", "scheme", "stages", "spectral_radius", "rho_every"})
+    OPTIONS = frozenset({"explicit", "scheme", "friction", "stages", "spectral_radius", "rho_every"})
 
     def __init__(self, system: OdeSystem, stats=None, explicit: str = "dumka3", scheme: str = "strang",
-                 **options) -> None:
+                 friction: str | None = None, **options) -> None:
         super().__init__(system, stats)
         from cvtfem.integrate.methods import METHODS
 
@@ -55,9 +72,9 @@ class StrangFriction(Stepper):
         if scheme not in SCHEMES:
             raise InputError("scheme", scheme, f"must be one of {SCHEMES}")
         self.scheme, self._frozen = scheme, None
-        if scheme != "strang" and system.split.hold is None:
+        split = self.split = system.split.variant(friction)
+        if scheme != "strang" and split.hold is None:
             raise InputError("scheme", scheme, "needs the split's `hold` (the work rate of the held forces)")
-        split = system.split
         if scheme == "strang":
             fun = split.explicit
         else:
@@ -70,21 +87,48 @@ class StrangFriction(Stepper):
     def _implicit(self, t, x, h):
         st = self.stats
         with st.timer("t_lu"):
-            x1, its = self.system.split.solve(t, x, h)
+            x1, its = self.split.solve(t, x, h)
         st.add("nnewton", its)
         st.add("nlu", its)
         return x1
 
+    def _imex_rk4(self, t, x, h):
+        """One step of ``imex-rk4`` or ``imex-rk4-2`` (module docstring)."""
+        split, st, fun = self.split, self.stats, self.system.fun
+        KE = [split.explicit(t, x)]
+        KI = [fun(t, x) - KE[0]]
+        st.add("nfev", 2)
+        for aE, aI in zip(_RK4_EXPLICIT, IMEX_RK4_IMPLICIT[self.scheme]):
+            ti = t + h * sum(aE)
+            pred = x + h * (sum(a * k for a, k in zip(aE, KE)) + sum(a * k for a, k in zip(aI[:-1], KI)))
+            if aI[-1] > 0.0:
+                hi = h * aI[-1]
+                y = self._implicit(ti, pred, hi)
+                KE.append(split.explicit(ti, y))
+                KI.append(split.hold(y, (y - pred) / hi))    # the stage's friction rate: its power at its v
+                st.add("nfev")
+            else:                                            # an explicit stage of f_I too
+                y = pred
+                KE.append(split.explicit(ti, y))
+                KI.append(fun(ti, y) - KE[-1])
+                st.add("nfev", 2)
+        b = IMEX_RK4_IMPLICIT[self.scheme][-1]
+        return x + h * sum(bi * (ke + ki) for bi, ke, ki in zip(b, KE, KI))
+
     def attempt(self, t, x, h):
+        if self.scheme in IMEX_RK4_IMPLICIT:
+            y = self._imex_rk4(t, x, h)
+            self.stages = 4
+            return Attempt(t, x, h, y)
         if self.scheme != "strang":
-            fe = self.system.split.explicit(t, x)
+            fe = self.split.explicit(t, x)
             self.stats.add("nfev")
             pred, n2 = x.copy(), self.system.n2
             hi = h if self.scheme == "frozen" else 0.5 * h
             pred[n2:] += hi * fe[n2:]                 # positions frozen: the explicit impulse of the step (or half)
             d = (self._implicit(t, pred, hi) - pred) / hi
             self._frozen = d
-            self.inner._start = (t, x.copy(), fe + self.system.split.hold(x, d))    # its F at the start: known
+            self.inner._start = (t, x.copy(), fe + self.split.hold(x, d))    # its F at the start: known
             y = self.inner.attempt(t, x, h).x1
         else:
             y = self._implicit(t, x, 0.5 * h)

@@ -24,12 +24,23 @@ class StiffSplit:
     ``explicit(t, x)`` is ``f_E``; ``solve(t, x, h)`` returns ``(x_new, iterations)``: backward Euler of
     ``x' = f_I(t, x)`` over ``h`` from ``x`` (``x_new = x + h f_I(t, x_new)``, each iteration one sparse LU);
     ``hold(x, d)`` (optional) the rate at ``x`` of the stiff part's forces held constant: ``d``'s velocity rows (the
-    forces' accelerations) and the work rows at the power those forces deliver at ``x``.
+    forces' accelerations) and the work rows at the power those forces deliver at ``x``.  ``variants`` (optional)
+    other splits of the same system by name, each as such a tuple ``(explicit, solve[, hold])`` (A5: ``"all"``, all
+    friction in the stiff part); :meth:`variant` picks one.
     """
 
     explicit: Callable[[float, np.ndarray], np.ndarray]
     solve: Callable[[float, np.ndarray, float], tuple]
     hold: Callable[[np.ndarray, np.ndarray], np.ndarray] | None = None
+    variants: dict | None = None
+
+    def variant(self, name: str | None) -> "StiffSplit":
+        """This split (``name`` None) or its variant ``name``."""
+        if name is None:
+            return self
+        if name not in (self.variants or {}):
+            raise InputError("friction", name, f"must be one of the split's variants {sorted(self.variants or {})}")
+        return StiffSplit(*self.variants[name])
 
 
 @dataclass(frozen=True)
@@ -141,10 +152,11 @@ def as_system(fun, y0: np.ndarray, *, n2: int = 0, jac=None, jac_sparsity=None, 
             events, direction, terminal = events_from_callables(events)
     if switch is not None and not callable(switch):
         raise InputError("switch", switch, "must be callable as switch(t, x, fired) -> x or None")
-    if isinstance(split, tuple) and not isinstance(split, StiffSplit) and len(split) in (2, 3):
-        split = StiffSplit(*split)                       # a model's (explicit, solve[, hold])
+    if isinstance(split, tuple) and not isinstance(split, StiffSplit) and len(split) in (2, 3, 4):
+        split = StiffSplit(*split)                       # a model's (explicit, solve[, hold[, variants]])
     if split is not None and not (isinstance(split, StiffSplit) and callable(split.explicit) and callable(split.solve)):
-        raise InputError("split", split, "must be a StiffSplit(explicit, solve, hold=None), such a tuple, or None")
+        raise InputError("split", split, "must be a StiffSplit(explicit, solve, hold=None, variants=None), such a "
+                                         "tuple, or None")
     return OdeSystem(fun=fun, n=n, n2=int(n2), jac=jac, jac_sparsity=jac_sparsity, events=events,
                      event_direction=direction, event_terminal=terminal, switch=switch, split=split)
 

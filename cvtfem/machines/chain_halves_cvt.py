@@ -23,11 +23,15 @@ import scipy.sparse as sp
 
 from cvtfem.assembly import fixed_pattern as FP
 from cvtfem.elements.base import Block
+from cvtfem.elements.chain import half_end_contact_kernel as HEK
+from cvtfem.elements.chain import half_end_slips as HES
 from cvtfem.elements.chain import halves_kernel as HK
 from cvtfem.elements.chain import sheave_contact_kernel as SK
 from cvtfem.elements.chain.halves import ChainA5
 from cvtfem.elements.chain.halves_placement import half_centres, rolling_link_directions, rolling_spacing
+from cvtfem.elements.chain.implicit_friction import FrictionSet, friction_step
 from cvtfem.elements.chain.placement import Placement, place_on_path
+from cvtfem.elements.contact.friction import POTENTIAL_LAWS
 from cvtfem.errors import InputError, NumericalError
 from cvtfem.machines.chain_a_cvt import PLATE_HEIGHT, PLATE_THICKNESS, POISSON, ChainACVT
 from cvtfem.machines.chain_cvt import ChainCVT
@@ -270,6 +274,11 @@ class ChainHalvesCVT(ChainACVT):
     #: span halves' axial positions hold nothing; at ratio 0.45 (chapter 2) the uniform chain of variant (e) stopped at
     #: 7.4e-4 of F2 after the default 150 and converges to 3.7e-5 after 461 (docs/accuracy-cost.md, session 9).
     NEWTON_ITERATIONS: ClassVar[int] = 600
+    #: The implicit friction solve of all friction (:meth:`friction_solve_all`) stops when a Newton step changes every
+    #: slip by less than this fraction of its law's ``v0`` (the kinetic energy it removes is booked exactly whatever
+    #: the tolerance).  On the short window (imex-rk4, 2e-6 s) 1e-6, 1e-4, 1e-2, 0.1, 1 gave 4.4, 3.7, 2.9, 2.3, 1.3 LUs
+    #: per solve and E 2.770e-3 (the first three), 2.768e-3, 2.894e-3 (docs/accuracy-cost.md, session 12).
+    FRICTION_TOL: ClassVar[float] = 0.1
 
     @property
     def n_ends(self) -> int:
@@ -327,8 +336,9 @@ class ChainHalvesCVT(ChainACVT):
             return super().rhs(t, x)
         return self._rhs_with(t, x, self.family.chain._kernel_args)
 
-    def _rhs_with(self, t: float, x, chain_args: tuple):
-        """The one-pass :meth:`rhs` with the chain's compiled pass on the kernel constants ``chain_args``."""
+    def _rhs_with(self, t: float, x, chain_args: tuple, contact_args: tuple | None = None):
+        """The one-pass :meth:`rhs` with the chain's compiled pass on the kernel constants ``chain_args`` (and the H2
+        contacts' on ``contact_args`` where given, :mod:`~cvtfem.elements.chain.half_end_contact_kernel`)."""
         n2, nz = self.n2, self.control.size
         nc, iphi, iz, _ = self._idx
         v = x[n2:2 * n2]
@@ -336,7 +346,10 @@ class ChainHalvesCVT(ChainACVT):
         F, M, dz, _ = self._controls(t, w, x[2 * n2:2 * n2 + nz])
         Q = np.zeros(n2)
         D = HK.add_forces_power(Q, x, v, *chain_args)
-        Pf = self._contact_forces(x[:n2], v, Q)[0]
+        if contact_args is None:
+            Pf = self._contact_forces(x[:n2], v, Q)[0]
+        else:
+            Pf = self._contact_forces_with(x, Q, contact_args)
         Q[iphi] += M
         Q[iz] -= self.sheaves_per_z * F
         out = np.empty(self.size)
@@ -348,16 +361,19 @@ class ChainHalvesCVT(ChainACVT):
         out[2 * n2 + nz:] = (M[0] * w[0], -M[1] * w[1], D - Pf, -self.sheaves_per_z * float(F @ v[iz]))
         return out
 
-    # ----- the halves' internal friction split off (stiff, solved implicitly) ------------------------------------
+    # ----- the friction split off (stiff, solved implicitly) ------------------------------------------------------
     @cached_property
     def stiff_split(self) -> tuple | None:
         """``x' = f_E(x) + f_I(x)`` with ``f_I`` the halves' internal friction (axial (1.221) and rolling; velocity rows
-        and the dissipated-work row only): ``(rhs_explicit, friction_solve, friction_hold)``, the fields of
-        :class:`cvtfem.integrate.system.StiffSplit`; None off the one-pass path (numpy chain backend, elastic
-        shafts)."""
+        and the dissipated-work row only): ``(rhs_explicit, friction_solve, friction_hold, variants)``, the fields of
+        :class:`cvtfem.integrate.system.StiffSplit`, with the variant ``"all"`` where the pin-sheave friction can join
+        ``f_I`` (:attr:`_sheave_friction`): all friction implicit (:meth:`rhs_explicit_all`,
+        :meth:`friction_solve_all`); None off the one-pass path (numpy chain backend, elastic shafts)."""
         if not self._one_pass or self.family.chain.f0 == 0.0:
             return None
-        return self.rhs_explicit, self.friction_solve, self.friction_hold
+        variants = {"all": (self.rhs_explicit_all, self.friction_solve_all, self.friction_hold)} if (
+            self._sheave_friction) else {}
+        return self.rhs_explicit, self.friction_solve, self.friction_hold, variants
 
     @cached_property
     def _frictionless_args(self) -> tuple:
@@ -377,24 +393,115 @@ class ChainHalvesCVT(ChainACVT):
         if self._slips[0] != key:
             self._slips = (key, *chain.friction_slips(x[:nc]))
         v_star = x[n2:n2 + nc]
-        guess = None if self._friction_accel is None else v_star + h * self._friction_accel
+        accel = self._friction_accel.get("halves")
+        guess = None if accel is None else v_star + h * accel
         v, W, its = chain.friction_step(self._slips[1], self._slips[2], v_star, h, guess)
-        self._friction_accel = (v - v_star) / h
+        self._friction_accel["halves"] = (v - v_star) / h
         out = np.array(x, float)
         out[n2:n2 + nc] = v
         out[2 * n2 + self.control.size + 2] += W
         return out, its
 
     _slips: tuple = (None, None, None)
-    _friction_accel = None
+
+    @cached_property
+    def _friction_accel(self) -> dict:
+        """The friction accelerations of the last solve of each split (Newton's start guess)."""
+        return {}
+
+    # ----- all friction implicit: the pin-sheave friction of the H2 half ends joins f_I ---------------------------
+    @cached_property
+    def _sheave_friction(self) -> tuple | None:
+        """``(frictionless contact constants, pin-sheave law (f0, v0, name))`` where the pin-sheave friction can be
+        split off (the compiled H2 contact of variant (e), a law with a potential, ``f0 > 0``), else None."""
+        ck = self._compiled_contact
+        if self._contact_kernel is not HEK or ck is None:
+            return None
+        h2 = self.contact.pair.pair
+        if h2.law not in POTENTIAL_LAWS or h2.f0 == 0.0:
+            return None
+        par = np.array(ck[6], float)
+        par[0] = 0.0
+        return (*ck[:6], par, ck[7]), (float(h2.f0), float(h2.v0), h2.law)
+
+    def rhs_explicit_all(self, t: float, x):
+        """:meth:`rhs` without any friction (the halves' ``f_0 = 0``, the pin-sheave ``f0 = 0``): ``f_E`` of the
+        split's variant ``"all"``."""
+        return self._rhs_with(t, x, self._frictionless_args, self._sheave_friction[0])
+
+    def _contact_forces_with(self, x, Q, contact_args: tuple) -> float:
+        """The H2 contact forces on the constants ``contact_args`` added to ``Q``; returns their friction power (W)."""
+        Pf, bad = HEK.forces(np.concatenate([x[:2 * self.n2], self._constants]), *self._pair_table, *contact_args, Q)
+        if bad >= 0:
+            raise NumericalError(f"H2 contact: a pin-half end on the shaft axis (pair {bad})",
+                                 component="contact.refined")
+        return Pf
+
+    def sheave_slips(self, x) -> tuple[sp.csr_matrix, np.ndarray]:
+        """``(G, N)``: the slips of the pin-sheave contacts in touch at the positions of ``x``, ``s = G v`` (3 rows per
+        contact, m/s; columns the velocities ``v`` (n2,)), and their normal forces ``N`` (N): the contacts' friction
+        forces are ``-G^T (N psi(|s|) s)`` (:func:`~cvtfem.elements.chain.half_end_slips.slip_map`)."""
+        n2, table = self.n2, self._pair_table
+        P, K = table[0].shape[0], table[0].shape[2]
+        N, size = np.empty(P), 3 * P * HES.N_VEL * K
+        r, c, d = np.empty(size, np.int64), np.empty(size, np.int64), np.empty(size)
+        m, k, bad = HES.slip_map(np.concatenate([x[:2 * n2], self._constants]), *table[:3], *self._compiled_contact,
+                                 n2, N, r, c, d)
+        if bad >= 0:
+            raise NumericalError(f"H2 contact: a pin-half end on the shaft axis (pair {bad})",
+                                 component="contact.refined")
+        return sp.csr_matrix((d[:k], (r[:k], c[:k])), shape=(3 * m, n2)), N[:m]
+
+    def friction_sets(self, x) -> list:
+        """The :class:`~cvtfem.elements.chain.implicit_friction.FrictionSet` of all friction at the positions of
+        ``x``: the halves' (:meth:`ChainA5.friction_slips`, on the chain's velocities) and the pin-sheave contacts'
+        (:meth:`sheave_slips`)."""
+        chain, nc, n2 = self.family.chain, self.family.size, self.n2
+        B, c = chain.friction_slips(x[:nc])
+        B = sp.csr_matrix((B.data, B.indices, B.indptr), shape=(B.shape[0], n2))
+        G, N = self.sheave_slips(x)
+        return [FrictionSet(B, c, 1, chain.f0, chain.v0, chain.law), FrictionSet(G, N, 3, *self._sheave_friction[1])]
+
+    @cached_property
+    def _masses(self) -> tuple:
+        """``(M, M^-1, border)``: the mass matrix of all velocities (chain, shafts, sheaves), its inverse and the
+        shafts' and sheaves' indices."""
+        nc, iphi, iz, _ = self._idx
+        ch = self.family.chain
+        border = np.concatenate([iphi, iz])
+        diag = np.empty(self.n2 - nc)
+        diag[iphi - nc], diag[iz - nc] = self.J, self.m_sheave
+        M = sp.block_diag([ch.mass_matrix, sp.diags(diag)], format="csr")
+        Mi = sp.block_diag([ch.inverse_mass, sp.diags(1 / diag)], format="csr")
+        return M, Mi, border
+
+    def friction_solve_all(self, t: float, x, h: float) -> tuple[np.ndarray, int]:
+        """:meth:`friction_solve` of all friction (:meth:`friction_sets`) on all velocities (chain, shafts and sheaves:
+        :func:`~cvtfem.elements.chain.implicit_friction.friction_step`, the shafts' and sheaves' as its border)."""
+        n2 = self.n2
+        key = x[:n2].tobytes()
+        if self._all_sets[0] != key:
+            self._all_sets = (key, self.friction_sets(x))
+        v_star = x[n2:2 * n2]
+        accel = self._friction_accel.get("all")
+        guess = None if accel is None else v_star + h * accel
+        M, Mi, border = self._masses
+        v, W, its = friction_step(M, Mi, self._all_sets[1], v_star, h, guess, border=border, tol=self.FRICTION_TOL)
+        self._friction_accel["all"] = (v - v_star) / h
+        out = np.array(x, float)
+        out[n2:2 * n2] = v
+        out[2 * n2 + self.control.size + 2] += W
+        return out, its
+
+    _all_sets: tuple = (None, None)
 
     def friction_hold(self, x, d):
-        """The rate at ``x`` of the friction forces ``M d_v`` held constant (``d_v``: ``d``'s chain velocity rows,
-        m/s^2): those accelerations, and their dissipated power ``-(M d_v) . v`` on the work row ``D - P_fr``."""
-        nc, n2 = self.family.size, self.n2
+        """The rate at ``x`` of the friction forces ``M d_v`` held constant (``d_v``: ``d``'s velocity rows, m/s^2 and
+        rad/s^2): those accelerations, and their dissipated power ``-(M d_v) . v`` on the work row ``D - P_fr``."""
+        n2 = self.n2
         out = np.zeros(self.size)
-        out[n2:n2 + nc] = d[n2:n2 + nc]
-        out[2 * n2 + self.control.size + 2] = -float((self.family.chain.mass_matrix @ d[n2:n2 + nc]) @ x[n2:n2 + nc])
+        out[n2:2 * n2] = d[n2:2 * n2]
+        out[2 * n2 + self.control.size + 2] = -float((self._masses[0] @ d[n2:2 * n2]) @ x[n2:2 * n2])
         return out
 
     @cached_property

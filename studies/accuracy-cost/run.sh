@@ -4,7 +4,8 @@
 #     bash studies/accuracy-cost/run.sh            # all (about 2 h of one core)
 #     bash studies/accuracy-cost/run.sh chain-S2   # the chain-S2 part only (also chain-A1, band, local, variant-e,
 #                                                  # variant-e-4ms, w-short, w-4ms, imex-short, variant-b-4ms,
-#                                                  # w-4ms-dumka3, variant-b-4ms-smoothed, w-4ms-smoothed)
+#                                                  # w-4ms-dumka3, variant-b-4ms-smoothed, w-4ms-smoothed,
+#                                                  # imex-all-short)
 # Each test-2 run prints its speed-up table (Table 2.4 style); the logs go next to the results.
 set -euo pipefail
 cd "$(dirname "$0")/../.."
@@ -208,4 +209,28 @@ if [[ $part == all || $part == imex-short ]]; then
   is --fixed dumka3 --steps 1e-6,2e-6 --adaptive ""
   is --from-cache | tee "$out/variant-e-imex-short.log"
   uptime | tee -a "$out/variant-e-imex-short.log"
+fi
+# Session 12: all friction of (e) implicit (the split variant "all": the halves' and the pin-sheave friction in f_I),
+# RK4 on f_E (its radius 1.37e6 1/s without any friction: a5_all_friction_radius.py), coupled by the IMEX schemes
+# imex-rk4 / imex-rk4-2 (order 2) or by frozen-mid, beside DUMKA3 and the RK4 baseline at 5e-8 s, on the short window
+# of w-short (same cache); the friction side's costs per piece from imex_all_costs.py.
+if [[ $part == all || $part == imex-all-short ]]; then
+  cache=out/studies/w-short-cache
+  ia() { nice "$cvtfem" study accuracy-cost "$(e_scene e linear-saturated)" --skip-spectrum --window 2e-4:4e-4 \
+           --sample 1e-6 --repeats 1 --reference DOP853:1e-7 --check dopri78:1e-7 --cache "$cache" \
+           --png "$out/variant-e-imex-all-short.png" --csv "$out/variant-e-imex-all-short.csv" \
+           --json "$out/variant-e-imex-all-short.json" "$@"; }
+  nice .venv/bin/python studies/accuracy-cost/a5_all_friction_radius.py "$cache" 2e-4 \
+    | tee "$out/variant-e-all-friction-radius.log"
+  ia --fixed strang-friction:scheme=imex-rk4:friction=all,strang-friction:scheme=imex-rk4-2:friction=all \
+    --steps 1e-6,1.5e-6,2e-6 --adaptive ""
+  ia --fixed strang-friction:scheme=imex-rk4:friction=all --steps 2.2e-6 --adaptive ""     # past RK4's limit on f_E
+  ia --fixed strang-friction:scheme=frozen-mid:explicit=rk4:friction=all --steps 1e-6,2e-6 --adaptive ""
+  ia --fixed dumka3 --steps 2e-6,3e-6 --adaptive ""
+  ia --fixed rk4 --steps 5e-8 --adaptive ""
+  ia --from-cache | tee "$out/variant-e-imex-all-short.log"
+  for scheme in imex-rk4 imex-rk4-2; do
+    nice .venv/bin/python studies/accuracy-cost/imex_all_costs.py "$cache" $scheme | tee -a "$out/variant-e-imex-all-short.log"
+  done
+  uptime | tee -a "$out/variant-e-imex-all-short.log"
 fi

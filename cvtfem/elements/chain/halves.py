@@ -48,15 +48,14 @@ from types import SimpleNamespace
 
 import numpy as np
 import scipy.sparse as sp
-import scipy.sparse.linalg as spla
 
 from cvtfem.elements.chain import halves_kernel as HK
 from cvtfem.elements.chain import plates as P
 from cvtfem.elements.chain import plates_kernel as PK
 from cvtfem.elements.chain.asymmetric import (_M_PAR, _M_PERP, ChainA1, _cross, _dot, _kx, shape_functions,
                                               shape_slopes)
-from cvtfem.elements.contact.friction import (LAWS, POTENTIAL_LAWS, friction_gain, friction_potential,
-                                              friction_slope)
+from cvtfem.elements.chain.implicit_friction import FrictionSet, friction_step
+from cvtfem.elements.contact.friction import LAWS, friction_gain
 from cvtfem.errors import InputError, NumericalError
 from cvtfem.outputs import OutputSpec
 
@@ -643,11 +642,13 @@ class ChainA5:
         u = self.split(np.asarray(q, float))[0]
         p = np.arange(n)
         Tp = np.maximum(self.link_tensions(q), 0.0)
+        pattern = getattr(self, "_slip_pattern", None)                  # rows and columns: the same at every q
         rows, cols, vals, c = [], [], [], []
 
         def add(block_rows, block_cols, block_vals):
-            rows.append(np.broadcast_to(block_rows, block_vals.shape).ravel())
-            cols.append(np.broadcast_to(block_cols, block_vals.shape).ravel())
+            if pattern is None:
+                rows.append(np.broadcast_to(block_rows, block_vals.shape).ravel())
+                cols.append(np.broadcast_to(block_cols, block_vals.shape).ravel())
             vals.append(block_vals.ravel())
 
         one = np.ones(n)
@@ -684,7 +685,13 @@ class ChainA5:
                     add(r[:, None], di[e][:, ic], -g)
                 c.append(N[s_])
                 m += n
-        B = sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))), shape=(m, self.n2))
+        if pattern is None:                         # the CSR pattern and where each value adds in it, built once
+            key = np.concatenate(rows) * self.n2 + np.concatenate(cols)
+            unique, where = np.unique(key, return_inverse=True)
+            indptr = np.searchsorted(unique // self.n2, np.arange(m + 1))
+            pattern = self._slip_pattern = (where, unique % self.n2, indptr)
+        where, indices, indptr = pattern
+        B = sp.csr_matrix((np.bincount(where, np.concatenate(vals), len(indices)), indices, indptr), shape=(m, self.n2))
         c = np.concatenate(c)
         keep = np.flatnonzero(c > 0)
         label = np.concatenate([np.zeros(n, int), np.ones(2 * n, int), np.repeat(2 + np.arange(len(CONTACTS)),
@@ -694,54 +701,12 @@ class ChainA5:
     def friction_step(self, B: sp.csr_matrix, c: np.ndarray, v_star: np.ndarray, h: float, v_start=None,
                       tol: float = 1e-6, max_lu: int = 100) -> tuple[np.ndarray, float, int]:
         """Backward Euler of the halves' friction alone with the positions frozen: ``v`` with
-        ``M (v - v_star) = h F(v)``, ``F = -B^T (c psi(|Bv|) Bv)`` (:meth:`friction_slips`).
-
-        ``v`` minimises the convex ``(v - v_star)^T M (v - v_star) / 2 + h sum c Phi(|Bv|)`` (``Phi' = f``).  Each
-        iteration tries a Newton step (tangent slopes ``c f'``; its matrix ``M + h B^T D B`` inverted through the
-        slips' ``I + h D B M^-1 B^T``); where it does not lower that function (a slip that
-        the tangent of a saturated law sends far off), the majorise-minimise step (secant slopes ``c psi``: the
-        quadratic through the current slips lies above ``Phi`` for laws with falling ``psi``, so the function
-        falls) instead, from ``v_start`` (default ``v_star``; the solution does not depend on it), until a step
-        changes the slips by less than ``tol v_0``.  Returns ``(v, W, LUs)`` with
-        the work the step dissipates ``W = -h F(v) . (v + v_star) / 2`` (J): the kinetic energy it removes."""
-        M, Mi, f0, v0, law = self.mass_matrix, self.inverse_mass, self.f0, self.v0, self.law
-        if law not in POTENTIAL_LAWS:
-            raise InputError("friction_law", law, f"must be one of {sorted(POTENTIAL_LAWS)} for the implicit friction")
-        Bt = B.T.tocsr()
-        G = (B @ Mi @ Bt).tocsr()                         # slip-space inverse mass (m x m)
-        I = sp.identity(B.shape[0], format="csr")
-        s_star, lus = B @ v_star, 0
-        v = np.array(v_star if v_start is None else v_start, float)
-        s = B @ v
-
-        def objective(v_, s_):
-            dv_ = v_ - v_star
-            return 0.5 * dv_ @ (M @ dv_) + h * c @ friction_potential(np.abs(s_), f0, v0, law)
-
-        def step(slopes, g):
-            """``-(M + h B^T D B)^-1 g`` in the slips' space (Woodbury): ``M^-1`` is block diagonal, the slips few."""
-            y = Mi @ g
-            w = spla.splu((I + h * G.multiply(slopes[:, None])).tocsc()).solve(slopes * (B @ y))
-            dv = h * (Mi @ (Bt @ w)) - y
-            return dv, B @ dv
-
-        while lus < max_lu:
-            gain = friction_gain(np.abs(s), f0, v0, law)
-            g = M @ (v - v_star) + h * (Bt @ (c * gain * s))
-            dv, ds = step(c * friction_slope(np.abs(s), f0, v0, law), g)
-            lus += 1
-            done = np.max(np.abs(ds), initial=0.0) <= tol * v0
-            if not done and objective(v + dv, s + ds) > objective(v, s) + 1e-4 * (g @ dv):
-                dv, ds = step(c * gain, g)
-                lus += 1
-            v, s = v + dv, s + ds
-            if done or np.max(np.abs(ds), initial=0.0) <= tol * v0:
-                break
-        else:
-            raise NumericalError(f"the implicit friction step (h = {h:g} s) did not converge in {max_lu} LUs",
-                                 component="ChainA5.friction_step")
-        r = c * friction_gain(np.abs(s), f0, v0, law) * s
-        return v, float(h * r @ (0.5 * (s + s_star))), lus
+        ``M (v - v_star) = h F(v)``, ``F = -B^T (c psi(|Bv|) Bv)`` (:meth:`friction_slips`), by
+        :func:`~cvtfem.elements.chain.implicit_friction.friction_step` from ``v_start`` (default ``v_star``) to
+        ``tol v_0``.  Returns ``(v, W, LUs)`` with the work the step dissipates ``W = -h F(v) . (v + v_star) / 2`` (J):
+        the kinetic energy it removes."""
+        fs = FrictionSet(B, c, 1, self.f0, self.v0, self.law)
+        return friction_step(self.mass_matrix, self.inverse_mass, [fs], v_star, h, v_start, tol=tol, max_lu=max_lu)
 
     def forces(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
         """``Q = -dPi/dq - dPhi/dv + Q_friction`` in one pass (:func:`halves_kernel.forces` with ``use_numba``)."""

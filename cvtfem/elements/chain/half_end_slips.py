@@ -1,0 +1,68 @@
+"""The pin-sheave friction of variant (e) (H2 at the pin-half ends) as a linear slip map at frozen positions.
+
+With the positions frozen, the slip of every H2 contact is linear in the velocities, ``s_k = G_k v`` (3 rows per
+contact: the relative velocity at the contact point projected on its tangent plane, m/s), its normal force ``N_k``
+(N) is fixed, and the friction forces are ``Q = -G^T (N psi(|s|) s)`` per contact (the friction power ``F . s`` the
+contact kernel books): the friction of :func:`~cvtfem.elements.chain.half_end_contact_kernel.forces` exactly.
+:func:`slip_map` reads ``G`` from the contact kernel itself (no copy of its geometry): one call of
+:func:`~cvtfem.elements.chain.sheave_contact_refined_kernel.refined_local_kernel` on the contacts in touch, each
+repeated with zero velocities (its normal force, friction off) and with each velocity input set to 1 (the slip is
+linear in them: that slip is ``G``'s column).  Arguments as :func:`half_end_contact_kernel.forces`'.  Units SI.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from cvtfem.elements.chain.half_end_contact import N_POS, _spread
+from cvtfem.elements.chain.half_end_contact_kernel import N_IN, N_OUT, _candidates
+from cvtfem.elements.chain.sheave_contact_refined_kernel import refined_local_kernel
+from cvtfem.elements.jit import njit
+
+__all__ = ["slip_map"]
+
+#: Velocity inputs of a pair (its 8 coordinate rates and the shaft speed), the columns of its local slip map.
+N_VEL = N_IN - N_POS
+
+
+@njit(cache=True)
+def slip_map(y, cols, coef, shaft, centres, r2, meridians, face_radius, slope_factor, c, par, law, n2,
+             N, r_out, c_out, v_out):
+    """The contacts in touch at the positions of ``y = [q, v, constants]``: their normal forces into ``N`` and the
+    entries of ``G`` (3 rows per contact, columns the velocities ``v`` (n2,); duplicates to be summed) into
+    ``r_out``, ``c_out``, ``v_out``.  Returns ``(contacts, entries, first pair with its half end on the shaft axis or
+    -1)``; ``N`` needs ``cols.shape[0]`` places, the entries ``3 cols.shape[0] * N_VEL * cols.shape[2]``."""
+    P = cols.shape[0]
+    X, sh, pair = np.empty((P, N_IN)), np.empty(P, np.int64), np.empty(P, np.int64)
+    m = _candidates(y, cols, coef, shaft, centres, r2, X, sh, pair)
+    rows = N_VEL + 1
+    Xb, shb = np.zeros((m * rows, N_IN)), np.empty(m * rows, np.int64)
+    for t in range(m):
+        for r in range(rows):
+            b = t * rows + r
+            Xb[b, :N_POS] = X[t, :N_POS]
+            if r > 0:
+                Xb[b, N_POS + r - 1] = 1.0
+            shb[b] = sh[t]
+    Xk, Yk = np.empty((m * rows, 2 * (N_POS + 2) + 1)), np.empty((m * rows, N_OUT + 2))
+    slip, fr = np.empty((m * rows, 3)), np.empty((m * rows, 3))
+    _spread(Xb, Xk, N_POS + 2)
+    bad = refined_local_kernel(Xk, shb, centres, meridians, face_radius, True, slope_factor, c, 0.0, par[1], law,
+                               par[2], Yk, slip, fr)
+    k = n = 0
+    for t in range(m):
+        normal = -0.5 * Yk[t * rows, 6]           # the kernel's 2 (s N + F_3) at side s = -1, friction off
+        if not normal > 0.0:
+            continue
+        N[k] = normal
+        i = pair[t]
+        for r in range(1, rows):
+            j = N_POS + r - 1
+            for a in range(cols.shape[2]):
+                col, w = cols[i, j, a], coef[i, j, a]
+                if w == 0.0 or col < n2 or col >= 2 * n2:
+                    continue                      # a constant (the fixed sheave's rate, zero)
+                for d in range(3):
+                    r_out[n], c_out[n], v_out[n] = 3 * k + d, col - n2, w * slip[t * rows + r, d]
+                    n += 1
+        k += 1
+    return k, n, (pair[bad // rows] if bad >= 0 else -1)
