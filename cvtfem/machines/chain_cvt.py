@@ -762,7 +762,7 @@ class ChainCVT(ModelBase):
                         r_outer: float, J, m_sheave, f0: float, v0: float, law: str = "linear-saturated",
                         regime: Regime, F_appl, control: StabilisationParams | None = None,
                         damping_ratio: float = 0.05, b_joint: float = 0.0, face_radius: float = 0.02,
-                        E: float = 2.1e11, poisson: float = 0.3, r_hertz: float | None = None,
+                        face_inclination: float = 0.0, E: float = 2.1e11, poisson: float = 0.3, r_hertz: float | None = None,
                         contact: str = "hertz") -> "ChainCVT":
         """Build the model from plain parameters (SI units).
 
@@ -772,13 +772,13 @@ class ChainCVT(ModelBase):
         the loop parameters (None: open loop, ``M2 = -b20 w2``); ``contact`` ``"hertz"`` (H1), ``"hertz-refined"``
         (H2, :class:`~cvtfem.machines.chain_cvt_refined.RefinedChainCVT`) or, for S1 and only for it, ``"rigid"``
         (:class:`~cvtfem.machines.chain_s1_cvt.ChainS1CVT`).  The Hertz stiffness is held
-        constant (digest §4.3) for a pin end crowned with ``face_radius`` at the contact radius
-        ``r_hertz`` (default: the mean radius of ratio 1, ``(l - 2 L) / (2 pi)``).
+        constant (digest §4.3) for a pin end crowned with ``face_radius`` (m), inclined by ``face_inclination``
+        (rad, H2 only) at the contact radius ``r_hertz`` (default: the mean radius of ratio 1, ``(l - 2 L) / (2 pi)``).
         """
         family = cls._family_for(model, geom, damping_from_ratio(geom, damping_ratio, b_joint), E)
         face = Sheave(face.profile, face.gamma, face.R, face.y, geom.l / 2)
         r_h = (geom.length - 2 * centre_distance) / (2 * np.pi) if r_hertz is None else r_hertz
-        c = hertz_constant(face, r_h, face_radius, E, poisson)
+        c = hertz_constant(face, r_h, face_radius, E, poisson, face_inclination)
         centres = np.array([[centre_distance, 0.0], [0.0, 0.0]])
         if (contact == "rigid") != (model == "chain-S1"):
             raise InputError("cvt.effects.contact", contact, "must be 'rigid' for chain-S1 (its pins have no axial "
@@ -790,7 +790,8 @@ class ChainCVT(ModelBase):
                                                        v0, law, half_length=geom.l / 2)
         elif contact == "hertz-refined" and cls is ChainCVT:
             from cvtfem.machines.chain_cvt_refined import RefinedChainCVT, refined_contact
-            cls, pair = RefinedChainCVT, refined_contact(family, centres, face, c, r_outer, f0, v0, law, face_radius)
+            cls, pair = RefinedChainCVT, refined_contact(family, centres, face, c, r_outer, f0, v0, law, face_radius,
+                                                           face_inclination)
         elif contact == "hertz":
             pair = cls._contact_for(SheaveContact(centres, (face, face), np.array([c, c]), r_outer, f0, v0, law))
         else:
@@ -837,7 +838,8 @@ def from_scene(scene, geom, F_appl, model: str = "chain-S2", **overrides) -> Cha
               f0=cvt.friction.f0, v0=cvt.friction.v0, law=cvt.friction.law,
               regime=Regime(rg.kind, rg.input_speed, rg.torque, rg.ratio, rg.end_value, rg.ramp_time),
               F_appl=F_appl, control=loop if cvt.effects.stabilisation else None,
-              damping_ratio=cvt.chain.damping_ratio, E=cvt.young_modulus)
+              damping_ratio=cvt.chain.damping_ratio, E=cvt.young_modulus, face_radius=cvt.chain.face_radius,
+              face_inclination=cvt.chain.face_inclination)
     kw.update(overrides)
     if kw["model"] in FAMILIES:
         return ChainCVT.from_parameters(geom, **kw)

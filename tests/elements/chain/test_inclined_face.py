@@ -1,0 +1,175 @@
+"""The inclined pin end face in H2 (session 12, issue 14): the face ``z = tan(theta) xi_o + |xi|^2 / (2 R_f)`` over
+the pin section, its normal tilted by ``theta`` outward in the pin's radial plane (digest §5.4, linear coefficient
+``beta``), turning with the pin spin.  Checked: ``theta = 0`` is the session-11 kernel bit for bit; the compiled kernel
+equals its numpy twin; on a cone with ``theta`` = the flank angle an untilted pin parallel to the axis touches on its
+axis (``x_* = 0``, H1's forces); the closed form equals the independent H2 primitives (``pin_coefficients`` with
+``beta``) for untilted pins and differs by ``O(|gamma| tan(theta))`` with end slopes (the dropped cross terms); the
+frictionless forces are minus the gradient of the Hertz potential (now also on the neighbours: the face turns with
+the pin); the friction power is the work rate of the friction forces."""
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from cvtfem.elements.chain.geometry import reference_geometry
+from cvtfem.elements.chain.sheave_contact import SheaveContact
+from cvtfem.elements.chain.symmetric import END_SLOPE_FACTOR
+from cvtfem.elements.contact.hertz import hertz_potential
+from cvtfem.elements.contact.refined import pin_coefficients, refined_contact, sheave_coefficients
+from cvtfem.elements.chain.sheave_contact_refined import face_derivatives
+from cvtfem.errors import InputError
+from cvtfem.machines.chain_cvt import from_scene
+from cvtfem.scene.loader import load_scene
+from tests.machines.test_chain_refined import CONE, F_APPL, S, _random_inputs, _unit_chord_normal
+
+FIXTURE = Path(__file__).parents[2] / "data" / "refined_kernel_theta0.npz"
+THETA = np.radians(10.0)                        # the flank angle of CONE
+
+
+@pytest.fixture(scope="module")
+def contacts():
+    scene = load_scene("band-6+2n")
+    out = {}
+    for model in ("chain-S2", "chain-S3"):
+        con = from_scene(scene, reference_geometry(), F_APPL, model=model, contact="hertz-refined").contact
+        out[model, "torus"], out[model, "cone"] = con, replace(con, faces=(CONE, CONE))
+    return out
+
+
+@pytest.mark.parametrize("model", ["chain-S2", "chain-S3"])
+@pytest.mark.parametrize("face", ["torus", "cone"])
+def test_zero_inclination_is_the_session_11_kernel_bit_for_bit(contacts, model, face):
+    """Inputs and outputs stored from the kernel before the inclination (git 9af04cd, 40 contacts)."""
+    data = np.load(FIXTURE)
+    key = f"{model}_{face}"
+    con = contacts[model, face]
+    assert con.face_inclination == 0.0
+    Y = con.local(data[key + "_X"], data[key + "_shafts"])
+    assert np.array_equal(Y, data[key + "_Y"]) and np.abs(Y).max() > 0
+
+
+@pytest.mark.parametrize("model", ["chain-S2", "chain-S3"])
+@pytest.mark.parametrize("face", ["torus", "cone"])
+def test_compiled_kernel_equals_its_numpy_twin(contacts, model, face):
+    con = replace(contacts[model, face], face_inclination=THETA)
+    X, shafts = _random_inputs(con, seed=21)
+    Y, Yref = con.local(X, shafts), con.local(X, shafts, reference=True)
+    np.testing.assert_allclose(Y, Yref, rtol=1e-12, atol=1e-12 * np.abs(Yref).max())
+
+
+def _rolling_pins(con, m=60, seed=0):
+    """Frictionless inputs of pins ``p-1, p, p+1`` one pitch apart on circles about their shaft, counter-clockwise
+    (the chain's sense), untilted (slopes 0), at rest, penetrations 1-30 um of the contact's own closed form."""
+    rng = np.random.default_rng(seed)
+    shafts = rng.integers(0, 2, m)
+    r = rng.uniform(0.035, 0.085, m)
+    th = rng.uniform(0, 2 * np.pi, m)
+    pts = [con.centres[shafts] + r[:, None] * np.column_stack([np.cos(th + j * 0.009 / r), np.sin(th + j * 0.009 / r)])
+           for j in (-1, 0, 1)]
+    z = rng.normal(0, 1e-4, (m, 1))
+    P = np.column_stack([*pts, np.zeros((m, 1))] + ([np.zeros((m, 2))] if con.slopes else []) + [z])
+    X = np.column_stack([P, np.zeros_like(P), np.zeros(m)])
+    d0 = con.local(X, shafts, details=True)[1]["delta"]
+    X[:, 6] += rng.uniform(1e-6, 3e-5, m) - d0
+    return X, shafts
+
+
+@pytest.mark.parametrize("model", ["chain-S2", "chain-S3"])
+def test_face_inclined_at_the_flank_angle_touches_a_cone_on_the_pin_axis(contacts, model):
+    """Cone of flank angle gamma, face inclined at gamma, pin parallel to the shaft axis: the two surfaces' slopes
+    agree at the axis end, so ``x_* = 0`` exactly, no extra approach, and the frictionless forces are H1's at the
+    axis end (no bending or twist moment).  At ``theta = 0`` the point is ``R_f tan(gamma)`` = 3.5 mm inside."""
+    con = replace(contacts[model, "cone"], face_inclination=THETA, f0=0.0)
+    X, shafts = _rolling_pins(con)
+    Y, d = con.local(X, shafts, details=True)
+    assert np.abs(d["offset"]).max() < 1e-17
+    np.testing.assert_allclose(con.extra_approach(0, np.array([0.05])), 0.0, atol=1e-20)
+    h1 = SheaveContact(con.centres, con.faces, con.c, con.r_outer, 0.0, con.v0, con.law)
+    X1 = np.column_stack([X[:, 2:4], X[:, 6], X[:, con.n_pos - 1], np.zeros((len(X), 4)), X[:, -1]])
+    Y1, d1 = h1.local(X1, shafts, details=True)
+    np.testing.assert_allclose(d["delta"], d1["delta"], rtol=0, atol=1e-17)
+    scale = np.abs(Y1).max()
+    np.testing.assert_allclose(Y[:, 2:4], Y1[:, 0:2], rtol=0, atol=1e-12 * scale)
+    np.testing.assert_allclose(Y[:, 6], Y1[:, 2], rtol=0, atol=1e-12 * scale)
+    assert np.abs(Y[:, [0, 1, 4, 5]]).max() < 1e-12 * scale                  # no twist
+    if con.slopes:
+        assert np.abs(Y[:, 7:9]).max() < 1e-12 * scale                       # no bending moment
+    x0 = replace(con, face_inclination=0.0).local(X, shafts, details=True)[1]["offset"]
+    np.testing.assert_allclose(np.linalg.norm(x0, axis=1), 0.02 * np.tan(THETA), rtol=1e-12)
+
+
+@pytest.mark.parametrize("face", ["torus", "cone"])
+def test_closed_form_equals_the_h2_primitives_with_beta(contacts, face):
+    """Penetration, contact point and normal against ``pin_coefficients`` with the face slope ``beta = (0, T)`` in
+    the pin frame ``(tau_p, n_perp)``: equal to round-off for untilted pins (S2), within ``O(|gamma| T)`` with end
+    slopes (S3: the kernel drops the primitives' cross terms ``gamma . beta`` of the tilted face)."""
+    for model, tol in (("chain-S2", 1e-15), ("chain-S3", None)):
+        con = replace(contacts[model, face], face_inclination=THETA)
+        X, shafts = _random_inputs(con, seed=22)
+        _, d = con.local(X, shafts, details=True)
+        m = len(X)
+        slope = END_SLOPE_FACTOR * X[:, 7:9] if con.slopes else np.zeros((m, 2))
+        n_perp = _unit_chord_normal(X)
+        tau = np.column_stack([n_perp[:, 1], -n_perp[:, 0]])
+        R_c = np.column_stack([con.centres[shafts], X[:, con.n_pos - 1]])
+        prof = lambda r: face_derivatives(con.faces[0], r)[:3]  # noqa: E731
+        sh = sheave_coefficients(X[:, 2:4], R_c, np.zeros((m, 2)), prof, S)
+        beta = np.column_stack([np.zeros(m), np.full(m, np.tan(THETA))])
+        pin = pin_coefficients(X[:, 6], slope, tau, np.zeros(m), beta,
+                               np.broadcast_to(np.eye(2) / con.face_radius, (m, 2, 2)), S)
+        ref = refined_contact(X[:, 2:4], *sh, *pin, S)
+        if tol is not None:
+            np.testing.assert_allclose(d["delta"], ref.delta, rtol=0, atol=tol)
+            np.testing.assert_allclose(d["offset"], ref.offset, rtol=0, atol=tol)
+            np.testing.assert_allclose(d["point"], ref.point, rtol=0, atol=tol)
+            np.testing.assert_allclose(d["normal"], ref.normal, rtol=0, atol=1e-14)
+        else:   # |gamma| up to ~3e-3 here: x_* within |gamma| T |x_*| + R_f |gamma| T ~ 1e-5 m
+            g = np.abs(slope).max()
+            assert g > 1e-3
+            assert np.abs(d["offset"] - ref.offset).max() < 2 * con.face_radius * g * np.tan(THETA)
+            assert np.abs(d["delta"] - ref.delta).max() < 2 * g * np.tan(THETA) * np.abs(ref.offset).max()
+
+
+@pytest.mark.parametrize("model, face", [("chain-S3", "torus"), ("chain-S3", "cone"), ("chain-S2", "torus")])
+def test_forces_are_minus_the_gradient_of_the_hertz_potential(contacts, model, face):
+    """Frictionless generalized forces on every position input (the neighbours too: the face turns with the pin
+    spin) = minus the central-difference gradient of 2 x 2/5 c Delta^{5/2}, 1e-6 relative; nonzero twist."""
+    con = replace(contacts[model, face], f0=0.0, face_inclination=THETA)
+    X, shafts = _random_inputs(con, seed=23)
+    Y = con.local(X, shafts)
+    c = con.c[shafts]
+
+    def U(Xm):
+        return 2 * hertz_potential(con.local(Xm, shafts, details=True)[1]["delta"], c)
+    on = con.local(X, shafts, details=True)[1]["delta"] > 0
+    assert 100 < on.sum() < len(X)
+    for j in range(con.n_pos):
+        h = 1e-9
+        Xp, Xm = X.copy(), X.copy()
+        Xp[:, j] += h
+        Xm[:, j] -= h
+        grad = (U(Xp) - U(Xm)) / (2 * h)
+        np.testing.assert_allclose(Y[:, j], -grad, rtol=1e-6, atol=1e-6 * np.abs(Y[:, j]).max() + 1e-9)
+    assert np.abs(Y[:, [0, 1, 4, 5]]).max() > 1e-4 * np.abs(Y[:, 2:4]).max()     # twist from the turning face
+    assert np.all(Y[:, con.n_pos] == 0)
+
+
+@pytest.mark.parametrize("model", ["chain-S3", "chain-S2"])
+def test_friction_power_is_the_work_rate_of_the_friction_forces(contacts, model):
+    con = replace(contacts[model, "torus"], face_inclination=THETA)
+    X, shafts = _random_inputs(con, seed=24)
+    Y, d = con.local(X, shafts, details=True)
+    Qfr = Y - replace(con, f0=0.0).local(X, shafts)
+    n = con.n_pos
+    power = (Qfr[:, :n] * X[:, n:2 * n]).sum(1) + Qfr[:, n] * X[:, -1]
+    np.testing.assert_allclose(Y[:, -1], power, rtol=1e-10, atol=1e-10 * np.abs(power).max())
+    np.testing.assert_allclose(Y[:, -1], 2 * (d["F_fr"] * d["slip"]).sum(1), rtol=1e-12, atol=1e-300)
+    assert np.all(Y[:, -1] <= 0) and Y[:, -1].min() < -1.0
+
+
+def test_bad_inclination_is_refused(contacts):
+    con = contacts["chain-S3", "torus"]
+    for bad in (-0.1, np.pi / 4, np.nan):
+        with pytest.raises(InputError, match="face_inclination"):
+            replace(con, face_inclination=bad)
