@@ -41,6 +41,7 @@ from cvtfem.elements.chain import sheave_contact_kernel as SK
 from cvtfem.elements.chain.end_contact import EndContact
 from cvtfem.elements.chain.placement import place_on_path
 from cvtfem.elements.chain.sheave_contact import SheaveContact, hertz_constant
+from cvtfem.elements.chain.sheave_contact_refined import RefinedSheaveContact
 from cvtfem.elements.chain.symmetric import ChainS1, ChainS2, ChainS3, damping_from_ratio
 from cvtfem.errors import InputError, NumericalError
 from cvtfem.machines.chain import pin_coordinate_label
@@ -127,6 +128,10 @@ class ChainCVT(ModelBase):
                        "lies inside the free pin end).", 2 * n),
             OutputSpec("contact.radius", "m", "Contact radius per pin end and shaft (0 off contact).", 2 * n),
             OutputSpec("contact.slip_speed", "m/s", "Slip speed of the pin end on the sheave (0 off contact).", 2 * n),
+            *((OutputSpec("contact.face_offset", "m", "Distance |x_*| of the refined (H2) contact point from the "
+                          "pin-axis end per pin end and shaft (0 off contact); the pin's end face reaches width_n / 2 "
+                          "from the axis (`cvtfem history`: the share of contacts beyond it).", 2 * n),)
+              if self.refined_contact else ()),
             OutputSpec("contact.friction_force", "N",
                        "Friction force on one pin end, x1 x2 x3 per pin and shaft.", 6 * n),
             OutputSpec("contact.friction_power", "W", "Friction power of both sheaves of each shaft (<= 0).", 2),
@@ -550,16 +555,24 @@ class ChainCVT(ModelBase):
         out.update(self._more_outputs(x))
         return {s.name: out[s.name] for s in self.output_specs}
 
+    @property
+    def refined_contact(self) -> bool:
+        """The contact is H2 (its details hold the contact point's ``offset`` from the pin-axis end)."""
+        return isinstance(self.contact, RefinedSheaveContact) or getattr(self.contact, "refined", False)
+
     @staticmethod
     def _contact_series(per, c) -> dict[str, np.ndarray]:
         """The per-end contact outputs from the contact details ``c``, spread over ends and shafts by ``per``:
-        normal force (N), penetration, contact radius (m), slip speed (m/s), friction force (N); radius and slip
-        are 0 off contact."""
+        normal force (N), penetration, contact radius (m), slip speed (m/s), friction force (N), H2's face offset
+        (m); radius, slip and offset are 0 off contact."""
         on = c["delta"] > 0
-        return {"contact.normal_force": per(c["N"]), "contact.penetration": per(c["delta"]),
-                "contact.radius": per(np.where(on, c["radius"], 0.0)),
-                "contact.slip_speed": per(np.where(on, np.linalg.norm(c["slip"], axis=1), 0.0)),
-                "contact.friction_force": per(c["F_fr"], 3)}
+        out = {"contact.normal_force": per(c["N"]), "contact.penetration": per(c["delta"]),
+               "contact.radius": per(np.where(on, c["radius"], 0.0)),
+               "contact.slip_speed": per(np.where(on, np.linalg.norm(c["slip"], axis=1), 0.0)),
+               "contact.friction_force": per(c["F_fr"], 3)}
+        if "offset" in c:
+            out["contact.face_offset"] = per(np.where(on, np.linalg.norm(c["offset"], axis=1), 0.0))
+        return out
 
     def _more_outputs(self, x) -> dict[str, Any]:
         """Outputs a subclass adds to :attr:`output_specs` (none here)."""

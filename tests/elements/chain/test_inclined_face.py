@@ -173,3 +173,81 @@ def test_bad_inclination_is_refused(contacts):
     for bad in (-0.1, np.pi / 4, np.nan):
         with pytest.raises(InputError, match="face_inclination"):
             replace(con, face_inclination=bad)
+
+
+def test_face_offset_output_is_the_contact_points_distance_from_the_axis():
+    """``contact.face_offset`` of an H2 chain = |x_*| of its contacts in contact (0 off contact); H1 has none."""
+    from cvtfem.machines.chain_cvt import from_scene as chain_from_scene
+
+    scene = load_scene("band-6+2n")
+    F = np.array([30000.0, 35000.0])
+    h1 = chain_from_scene(scene, reference_geometry(), F, model="chain-A1", contact="hertz")
+    assert "contact.face_offset" not in {s.name for s in h1.output_specs}
+    model = chain_from_scene(scene, reference_geometry(), F, model="chain-A1", contact="hertz-refined",
+                             face_inclination=THETA)
+    nc, _, iz, _ = model._idx
+    pl, u3, z = model.wedge_guess(2.4, 35000.0)
+    x = np.zeros(model.size)
+    x[:nc] = model._placed(pl, u3)
+    x[iz] = z
+    out = model.outputs(0.0, x)
+    ends, shafts, _, (_, d) = model._contacts(x[:model.n2], x[model.n2:2 * model.n2], details=True)
+    on = d["delta"] > 0
+    expect = np.zeros(2 * model.n_ends)
+    expect[2 * ends[on] + shafts[on]] = np.linalg.norm(d["offset"][on], axis=1)
+    assert on.sum() > 40
+    np.testing.assert_array_equal(out["contact.face_offset"], expect)
+
+
+def _made_up_run(path, offsets, normal):
+    """A results file of the variant-a scene with the history's series and the given ``contact.face_offset`` and
+    ``contact.normal_force`` rows (rows, 2 n)."""
+    from cvtfem.io.results import ResultsWriter
+    from cvtfem.outputs import OutputSpec
+
+    scene = load_scene("variant-a")
+    n2 = offsets.shape[1]
+    specs = [OutputSpec(name, "", "", size) for name, size in (
+        ("driving.speed", 1), ("driven.speed", 1), ("ratio", 1), ("work", 4), ("energy", 1),
+        ("driving.clamping_force", 1), ("driven.clamping_force", 1), ("contact.face_offset", n2),
+        ("contact.normal_force", n2))]
+    with ResultsWriter(path, scene.to_toml(), "run", specs) as w:
+        for j, (x, N) in enumerate(zip(offsets, normal)):
+            t = 1e-4 * j
+            w.append(t, {"driving.speed": 366.0, "driven.speed": 152.0, "ratio": 2.4,
+                         "work": [100 * t, 97 * t, 3 * t, 0.0], "energy": 1.0, "driving.clamping_force": 4e4,
+                         "driven.clamping_force": 3.5e4, "contact.face_offset": x, "contact.normal_force": N})
+    return path
+
+
+def test_history_reports_the_share_of_contacts_off_the_pin_face(tmp_path, capsys):
+    """Ends in contact on the driving shaft with 1 in 10 beyond the face half-height ``width_n / 2`` (the scene's
+    pin: ``pin_area / sqrt(12 pin_I_min / pin_area) / 2`` = 3.02 mm) and none on the driven: 10 % and 0 %, a
+    warning (more than 5 %); an end off contact with a large offset does not count."""
+    from cvtfem.cli import main
+    from cvtfem.io.results import read_results
+    from cvtfem.post.history import off_face
+
+    ch = load_scene("variant-a").cvt.chain
+    h = 0.5 * ch.pin_area / np.sqrt(12 * ch.pin_I_min / ch.pin_area)
+    rows, n = 5, 84
+    x = np.zeros((rows, n, 2))
+    N = np.zeros((rows, n, 2))
+    N[:, :20, 0], N[:, 40:70, 1] = 3000.0, 900.0
+    x[:, :20, 0] = 0.5 * h
+    x[:, :2, 0] = 1.01 * h                                      # 2 of 20 driving contacts off the face
+    x[:, 40:70, 1] = 0.9 * h
+    x[:, 80, 1] = 5 * h                                         # off contact: not counted
+    path = _made_up_run(tmp_path / "run.h5", x.reshape(rows, -1), N.reshape(rows, -1))
+    face = off_face(read_results(path))
+    np.testing.assert_allclose(face["half_height"], h, rtol=1e-12)
+    np.testing.assert_allclose(face["fraction"], [0.1, 0.0], rtol=1e-12)
+    np.testing.assert_allclose(face["mean"], [(18 * 0.5 + 2 * 1.01) / 20 * h, 0.9 * h], rtol=1e-12)
+    assert main(["history", str(path)]) == 0
+    printed = capsys.readouterr().out
+    assert "driving 10.0%, driven 0.0%" in printed and "warning: 10% of the contacts" in printed
+    x[:, :2, 0] = 0.99 * h
+    path = _made_up_run(tmp_path / "run2.h5", x.reshape(rows, -1), N.reshape(rows, -1))
+    assert main(["history", str(path)]) == 0
+    printed = capsys.readouterr().out
+    assert "driving 0.0%, driven 0.0%" in printed and "warning" not in printed
