@@ -8,6 +8,7 @@ movable sheave's axial coordinate), controller states (low-order digest section 
 from __future__ import annotations
 
 import importlib.util
+import math
 from typing import Any
 
 from cvtfem.control.stabilisation import LOOP_OUTPUTS, Stabilisation
@@ -390,7 +391,10 @@ def _contact_note(scene: Scene) -> str:
         "both pin ends"
     faces = ", the faces opening under the pin forces," if scene.sheave is not None and \
         scene.sheave.flexibility != "rigid" else ""
-    return f"{'refined (H2)' if refined else 'Hertz (H1)'} contact{faces} at {where} with"
+    ch = scene.cvt.chain
+    pin_face = f" (pin end faces crowned {ch.face_radius * 1e3:g} mm" + (
+        f", inclined {math.degrees(ch.face_inclination):.3g} deg)" if refined else ")")
+    return f"{'refined (H2)' if refined else 'Hertz (H1)'} contact{pin_face}{faces} at {where} with"
 
 
 def _plate_state_note(scene: Scene, model) -> str:

@@ -1,23 +1,30 @@
 """Refined pin–sheave contact H2 of a symmetric chain (S2, S3) on the rigid sheave pairs of two shafts.
 
 The variant of :class:`~cvtfem.elements.chain.sheave_contact.SheaveContact` (H1) with the refined biconvex
-kinematics of the contact digest §5 (1.330)–(1.352): the pin end face is crowned, ``z = |xi|^2 / (2 R_f)``
-about the pin-axis end in the pin frame (radius ``face_radius`` in both directions), the sheave face is the
+kinematics of the contact digest §5 (1.330)–(1.352): the pin end face is crowned and inclined,
+``z = beta . xi + |xi|^2 / (2 R_f)`` about the pin-axis end in the pin frame (radius ``face_radius`` in both
+directions, ``beta = tan(theta)`` towards the pin's outward radial side ``-n_perp``: the face normal tilted by
+``face_inclination`` ``theta`` towards the sheave flank, turning with the pin spin), the sheave face is the
 untilted face ``x3 = z_k + s(r)`` of model 1.  Both are quadratics about the in-plane pin point (1.331) and
 the contact point, penetration (along ``k``) and normal are the closed form of §5.3
 (:func:`~cvtfem.elements.contact.refined.refined_contact`, which the tests hold equal).  For this face and an
 untilted sheave the closed form reads, in the frame of :mod:`cvtfem.elements.contact.refined` (sheave side
 ``s = -1``: its material on the ``+k`` side of the ``x3 > 0`` pin end)
 
-    ``Delta = s (z_k - u3) + f(r) + ((f' + s gamma_e)^2 / m_e + gamma_n^2 / m_n) / 2``,
-    ``m_e = 1/R_f - f''``, ``m_n = 1/R_f - f'/r``,
+    ``Delta = s (z_k - u3) + f(r) + ((f' + s gamma_e - q_e)^2 / m_e + (s gamma_n - q_n)^2 / m_n) / 2``,
+    ``m_e = 1/R_f - f''``, ``m_n = 1/R_f - f'/r``, ``q = tan(theta) n_perp``,
 
 with ``f(r) = -s(r)`` the face profile, ``r`` the radius of the pin end, ``gamma = END_SLOPE_FACTOR u'_p``
 the world end slope of the pin axis (S3; zero for S2, where H2 is H1 shifted by ``x_*`` and
-``f'^2/(2 m_e)``) and ``gamma_e``, ``gamma_n`` its radial and circumferential parts.
+``(f' - q_e)^2/(2 m_e)``), ``gamma_e``, ``gamma_n`` its radial and circumferential parts and ``q`` the face slope
+(the chain runs counter-clockwise, so ``n_perp = k x tau_p`` points inward on an arc: ``q_e = -tan(theta)``; a face
+at the flank angle of a cone meets an untilted pin's face on its axis, ``x_* = 0``).  The face slope enters as the
+digest's ``b = beta_phi - gamma``: its first-order cross terms with the end slope (``gamma . beta``, relative
+``|gamma| tan(theta)``, ~1e-3 at end slopes of a few mrad) are dropped, so the face stays isotropic (``B = E / R_f``) and the closed form scalar.
 
 Forces.  The normal generalized forces are the exact gradient of the potential ``2/5 c Delta^{5/2}`` of this
-closed form in the chain and sheave coordinates (pin end, end slope, ``z_k``): conservative to round-off.
+closed form in the chain and sheave coordinates (pin end, end slope, ``z_k``, and through the inclined face's turn
+``dDelta/dphi = tan(theta) x_* . tau_p`` the neighbours' positions): conservative to round-off.
 The source's (1.351) applies ``N (k - g_*)`` at ``R_*``, which differs from the gradient by terms of third
 order in the offset ``|x_*|`` (the cubic terms the quadratic surfaces drop; docs/chain.md).  Friction, the
 regularised law on the slip of the material points at ``R_*`` (§5.6), acts through the kinematics (1.350):
