@@ -20,8 +20,8 @@ def run(args: argparse.Namespace) -> int:
     import numpy as np
 
     from cvtfem.io.results import read_results
-    from cvtfem.post.history import (OFF_FACE_WARNING, energy_residual, history, nonfinite_series, off_face,
-                                      plot_history, write_history_csv)
+    from cvtfem.analysis.chain_results import OFF_FACE_WARNING, off_face
+    from cvtfem.post.history import energy_residual, history, nonfinite_series, plot_history, write_history_csv
 
     results = read_results(args.results)
     t = results.time

@@ -51,31 +51,6 @@ def mean_slip(series) -> np.ndarray | None:
         return np.where(on.any(axis=1), (slip * on).sum(axis=1) / on.sum(axis=1), np.nan)
 
 
-#: Share of the refined contacts whose point lies off the pin's end face above which `cvtfem history` warns.
-OFF_FACE_WARNING = 0.05
-
-
-def off_face(results) -> dict[str, np.ndarray] | None:
-    """Where a refined (H2) run's contact points lie on the pin's end face (``contact.face_offset``), per shaft
-    (driving, driven) over all stored rows: ``fraction`` of the contacts (pin ends with ``N > 0``) whose point lies
-    farther than the face half-height ``width_n / 2`` from the pin axis, ``mean`` and ``max`` offset (m), and
-    ``half_height`` (m, of the stored scene's pin section); None for a run without the series."""
-    import tomllib
-
-    from cvtfem.machines.cvt import pin_section
-    from cvtfem.scene.loader import scene_from_dict
-
-    s = results.series
-    if "contact.face_offset" not in s:
-        return None
-    x = np.asarray(s["contact.face_offset"]).reshape(len(results.time), -1, 2)
-    on = np.asarray(s["contact.normal_force"]).reshape(x.shape) > 0
-    h = 0.5 * pin_section(scene_from_dict(tomllib.loads(results.scene_toml), str(results.path))).width_n
-    n_on = np.maximum(on.sum(axis=(0, 1)), 1)
-    return {"fraction": ((x > h) & on).sum(axis=(0, 1)) / n_on, "mean": (x * on).sum(axis=(0, 1)) / n_on,
-            "max": np.where(on, x, 0.0).max(axis=(0, 1)), "half_height": h}
-
-
 def history(results, window: float) -> dict[str, np.ndarray]:
     """Columns of the regime history: time (s), speeds (rpm), ratio, steady and corrected efficiency over
     ``window`` s, slip per shaft (m/s, if stored) and clamping forces (N)."""

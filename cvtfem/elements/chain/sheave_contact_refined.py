@@ -20,7 +20,8 @@ the world end slope of the pin axis (S3; zero for S2, where H2 is H1 shifted by 
 (the chain runs counter-clockwise, so ``n_perp = k x tau_p`` points inward on an arc: ``q_e = -tan(theta)``; a face
 at the flank angle of a cone meets an untilted pin's face on its axis, ``x_* = 0``).  The face slope enters as the
 digest's ``b = beta_phi - gamma``: its first-order cross terms with the end slope (``gamma . beta``, relative
-``|gamma| tan(theta)``, ~1e-3 at end slopes of a few mrad) are dropped, so the face stays isotropic (``B = E / R_f``) and the closed form scalar.
+``|gamma| tan(theta)``, ~1e-3 at end slopes of a few mrad) are dropped, so the face stays isotropic
+(``B = E / R_f``) and the closed form scalar.
 
 Forces.  The normal generalized forces are the exact gradient of the potential ``2/5 c Delta^{5/2}`` of this
 closed form in the chain and sheave coordinates (pin end, end slope, ``z_k``, and through the inclined face's turn

@@ -226,7 +226,7 @@ def test_history_reports_the_share_of_contacts_off_the_pin_face(tmp_path, capsys
     warning (more than 5 %); an end off contact with a large offset does not count."""
     from cvtfem.cli import main
     from cvtfem.io.results import read_results
-    from cvtfem.post.history import off_face
+    from cvtfem.analysis.chain_results import off_face
 
     ch = load_scene("variant-a").cvt.chain
     h = 0.5 * ch.pin_area / np.sqrt(12 * ch.pin_I_min / ch.pin_area)
