@@ -251,3 +251,18 @@ def test_history_reports_the_share_of_contacts_off_the_pin_face(tmp_path, capsys
     assert main(["history", str(path)]) == 0
     printed = capsys.readouterr().out
     assert "driving 0.0%, driven 0.0%" in printed and "warning" not in printed
+
+
+def test_hertz_constant_of_the_inclined_face_lies_between_those_of_its_two_radii():
+    """The inclined graph face has the radii ``R_f / cos(theta)`` (circumferential) and ``R_f / cos^3(theta)``
+    (radial): its Hertz constant lies between those of spheres with either radius; theta = 0 is the sphere's."""
+    from cvtfem.elements.band.geometry import Sheave
+    from cvtfem.elements.chain.sheave_contact import hertz_constant
+
+    g = load_scene("variant-a").cvt.geometry
+    for face in (CONE, Sheave(g.sheave_profile, g.flank_angle, g.torus_radius, g.torus_offset)):
+        c = hertz_constant(face, 0.06, 0.02, 2.1e11, 0.3, THETA)
+        low = hertz_constant(face, 0.06, 0.02 / np.cos(THETA), 2.1e11, 0.3)
+        high = hertz_constant(face, 0.06, 0.02 / np.cos(THETA) ** 3, 2.1e11, 0.3)
+        assert low < c < high and high / low < 1.03
+        assert hertz_constant(face, 0.06, 0.02, 2.1e11, 0.3, 0.0) == hertz_constant(face, 0.06, 0.02, 2.1e11, 0.3)
