@@ -266,3 +266,16 @@ def test_hertz_constant_of_the_inclined_face_lies_between_those_of_its_two_radii
         high = hertz_constant(face, 0.06, 0.02 / np.cos(THETA) ** 3, 2.1e11, 0.3)
         assert low < c < high and high / low < 1.03
         assert hertz_constant(face, 0.06, 0.02, 2.1e11, 0.3, 0.0) == hertz_constant(face, 0.06, 0.02, 2.1e11, 0.3)
+
+
+def test_run_summary_reports_the_share_of_contacts_off_the_face():
+    """chain-S3 with H2 from its quasi-static start: with the symmetric face (theta = 0) every driven contact point
+    lies ``R_f tan(gamma) / (1 - R_f f'')`` ~ 3.8 mm inside the pin axis, beyond the 3.02 mm face half-height; with
+    the face inclined at the flank angle none does."""
+    from cvtfem.analysis.run import run_scene
+
+    base = load_scene("chain-S3-refined")
+    flat = run_scene(base, until=1e-5, results=None, show_progress=False)
+    assert flat.off_face_fraction[1] == 1.0 and 0.0 <= flat.off_face_fraction[0] < 0.5
+    tilted = base.replace({"cvt": {"chain": {"face_inclination": base.cvt.geometry.flank_angle}}})
+    assert run_scene(tilted, until=1e-5, results=None, show_progress=False).off_face_fraction == [0.0, 0.0]
