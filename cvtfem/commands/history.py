@@ -1,6 +1,6 @@
 """``cvtfem history RESULTS [--window S] [--png OUT] [--csv OUT]``: regime history of a CVT run (speeds, ratio,
-efficiency steady and kinetic-energy corrected, slip, clamping forces), the run's energy balance and any non-finite
-series."""
+efficiency steady and kinetic-energy corrected, slip, clamping forces), the run's energy balance, where a refined
+contact's points lie on the pin end face (a warning when more than 5 % lie off it) and any non-finite series."""
 from __future__ import annotations
 
 import argparse
@@ -20,6 +20,7 @@ def run(args: argparse.Namespace) -> int:
     import numpy as np
 
     from cvtfem.io.results import read_results
+    from cvtfem.analysis.chain_results import OFF_FACE_WARNING, off_face
     from cvtfem.post.history import energy_residual, history, nonfinite_series, plot_history, write_history_csv
 
     results = read_results(args.results)
@@ -37,6 +38,16 @@ def run(args: argparse.Namespace) -> int:
         print("no input work in the last window: efficiency undefined (NaN)")
     print(f"energy balance over the run: residual {energy_residual(results)[-1]:.2e} of the input work "
           f"(input + clamping work = output + dissipated work + change of stored energy)")
+    face = off_face(results)
+    if face is not None:
+        f, h = face["fraction"], face["half_height"]
+        print(f"contact points off the pin end face (farther than width_n / 2 = {h * 1e3:.3g} mm from the pin axis), "
+              f"all rows: driving {f[0]:.1%}, driven {f[1]:.1%}; offset |x_*| mean {face['mean'][0] * 1e3:.3g} / "
+              f"{face['mean'][1] * 1e3:.3g} mm, max {face['max'][0] * 1e3:.3g} / {face['max'][1] * 1e3:.3g} mm")
+        if f.max() > OFF_FACE_WARNING:
+            print(f"warning: {f.max():.0%} of the contacts on a shaft lie off the pin end face (more than "
+                  f"{OFF_FACE_WARNING:.0%}): the face model (cvt.chain.face_radius, face_inclination) puts the "
+                  "contact point beyond the pin; see docs/transmission.md, 'Session 12: the inclined pin face'")
     bad = nonfinite_series(results)
     print("non-finite values: " + (", ".join(bad) if bad else "none"))
     if args.csv:

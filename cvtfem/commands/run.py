@@ -76,6 +76,13 @@ def run(args: argparse.Namespace) -> int:
     eff = (f"efficiency {s.efficiency:.4f} (kinetic-energy corrected {s.efficiency_kinetic:.4f})"
            if s.efficiency is not None else f"efficiency {s.efficiency_note}")
     print(f"  {eff}, clamping {s.clamping_force_N[0] / 1e3:.2f} / {s.clamping_force_N[1] / 1e3:.2f} kN")
+    if s.off_face_fraction is not None:
+        from cvtfem.analysis.chain_results import OFF_FACE_WARNING
+
+        off = s.off_face_fraction
+        print(f"  contact points off the pin end face at the end: driving {off[0]:.0%}, driven {off[1]:.0%}"
+              + (f" (warning: more than {OFF_FACE_WARNING:.0%}; see `cvtfem history`)" if max(off) > OFF_FACE_WARNING
+                 else ""))
     if s.results:
         print(f"  results: {s.results}")
     if args.summary_json:

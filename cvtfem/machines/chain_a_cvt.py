@@ -395,7 +395,8 @@ class ChainACVT(ChainCVT):
         h1 = model.contact.pair
         fam = model.family
         h2 = RefinedSheaveContact(h1.centres, h1.faces, h1.c, h1.r_outer, h1.f0, h1.v0, face_radius,
-                                  (np.arange(fam.n) - 1) % fam.n, fam.ip1, slopes=True, law=h1.law, eps=h1.eps)
+                                  (np.arange(fam.n) - 1) % fam.n, fam.ip1, slopes=True, law=h1.law, eps=h1.eps,
+                                  face_inclination=kw.get("face_inclination", 0.0))
         return replace(model, contact=EndContact(h2))._settled()
 
     def _settled(self) -> "ChainACVT":

@@ -41,6 +41,7 @@ from cvtfem.elements.chain import sheave_contact_kernel as SK
 from cvtfem.elements.chain.end_contact import EndContact
 from cvtfem.elements.chain.placement import place_on_path
 from cvtfem.elements.chain.sheave_contact import SheaveContact, hertz_constant
+from cvtfem.elements.chain.sheave_contact_refined import RefinedSheaveContact
 from cvtfem.elements.chain.symmetric import ChainS1, ChainS2, ChainS3, damping_from_ratio
 from cvtfem.errors import InputError, NumericalError
 from cvtfem.machines.chain import pin_coordinate_label
@@ -127,6 +128,10 @@ class ChainCVT(ModelBase):
                        "lies inside the free pin end).", 2 * n),
             OutputSpec("contact.radius", "m", "Contact radius per pin end and shaft (0 off contact).", 2 * n),
             OutputSpec("contact.slip_speed", "m/s", "Slip speed of the pin end on the sheave (0 off contact).", 2 * n),
+            *((OutputSpec("contact.face_offset", "m", "Distance |x_*| of the refined (H2) contact point from the "
+                          "pin-axis end per pin end and shaft (0 off contact); the pin's end face reaches width_n / 2 "
+                          "from the axis (`cvtfem history`: the share of contacts beyond it).", 2 * n),)
+              if self.refined_contact else ()),
             OutputSpec("contact.friction_force", "N",
                        "Friction force on one pin end, x1 x2 x3 per pin and shaft.", 6 * n),
             OutputSpec("contact.friction_power", "W", "Friction power of both sheaves of each shaft (<= 0).", 2),
@@ -550,16 +555,24 @@ class ChainCVT(ModelBase):
         out.update(self._more_outputs(x))
         return {s.name: out[s.name] for s in self.output_specs}
 
+    @property
+    def refined_contact(self) -> bool:
+        """The contact is H2 (its details hold the contact point's ``offset`` from the pin-axis end)."""
+        return isinstance(self.contact, RefinedSheaveContact) or getattr(self.contact, "refined", False)
+
     @staticmethod
     def _contact_series(per, c) -> dict[str, np.ndarray]:
         """The per-end contact outputs from the contact details ``c``, spread over ends and shafts by ``per``:
-        normal force (N), penetration, contact radius (m), slip speed (m/s), friction force (N); radius and slip
-        are 0 off contact."""
+        normal force (N), penetration, contact radius (m), slip speed (m/s), friction force (N), H2's face offset
+        (m); radius, slip and offset are 0 off contact."""
         on = c["delta"] > 0
-        return {"contact.normal_force": per(c["N"]), "contact.penetration": per(c["delta"]),
-                "contact.radius": per(np.where(on, c["radius"], 0.0)),
-                "contact.slip_speed": per(np.where(on, np.linalg.norm(c["slip"], axis=1), 0.0)),
-                "contact.friction_force": per(c["F_fr"], 3)}
+        out = {"contact.normal_force": per(c["N"]), "contact.penetration": per(c["delta"]),
+               "contact.radius": per(np.where(on, c["radius"], 0.0)),
+               "contact.slip_speed": per(np.where(on, np.linalg.norm(c["slip"], axis=1), 0.0)),
+               "contact.friction_force": per(c["F_fr"], 3)}
+        if "offset" in c:
+            out["contact.face_offset"] = per(np.where(on, np.linalg.norm(c["offset"], axis=1), 0.0))
+        return out
 
     def _more_outputs(self, x) -> dict[str, Any]:
         """Outputs a subclass adds to :attr:`output_specs` (none here)."""
@@ -762,7 +775,7 @@ class ChainCVT(ModelBase):
                         r_outer: float, J, m_sheave, f0: float, v0: float, law: str = "linear-saturated",
                         regime: Regime, F_appl, control: StabilisationParams | None = None,
                         damping_ratio: float = 0.05, b_joint: float = 0.0, face_radius: float = 0.02,
-                        E: float = 2.1e11, poisson: float = 0.3, r_hertz: float | None = None,
+                        face_inclination: float = 0.0, E: float = 2.1e11, poisson: float = 0.3, r_hertz: float | None = None,
                         contact: str = "hertz") -> "ChainCVT":
         """Build the model from plain parameters (SI units).
 
@@ -772,13 +785,13 @@ class ChainCVT(ModelBase):
         the loop parameters (None: open loop, ``M2 = -b20 w2``); ``contact`` ``"hertz"`` (H1), ``"hertz-refined"``
         (H2, :class:`~cvtfem.machines.chain_cvt_refined.RefinedChainCVT`) or, for S1 and only for it, ``"rigid"``
         (:class:`~cvtfem.machines.chain_s1_cvt.ChainS1CVT`).  The Hertz stiffness is held
-        constant (digest §4.3) for a pin end crowned with ``face_radius`` at the contact radius
-        ``r_hertz`` (default: the mean radius of ratio 1, ``(l - 2 L) / (2 pi)``).
+        constant (digest §4.3) for a pin end crowned with ``face_radius`` (m), inclined by ``face_inclination``
+        (rad, H2 only) at the contact radius ``r_hertz`` (default: the mean radius of ratio 1, ``(l - 2 L) / (2 pi)``).
         """
         family = cls._family_for(model, geom, damping_from_ratio(geom, damping_ratio, b_joint), E)
         face = Sheave(face.profile, face.gamma, face.R, face.y, geom.l / 2)
         r_h = (geom.length - 2 * centre_distance) / (2 * np.pi) if r_hertz is None else r_hertz
-        c = hertz_constant(face, r_h, face_radius, E, poisson)
+        c = hertz_constant(face, r_h, face_radius, E, poisson, face_inclination)
         centres = np.array([[centre_distance, 0.0], [0.0, 0.0]])
         if (contact == "rigid") != (model == "chain-S1"):
             raise InputError("cvt.effects.contact", contact, "must be 'rigid' for chain-S1 (its pins have no axial "
@@ -790,7 +803,8 @@ class ChainCVT(ModelBase):
                                                        v0, law, half_length=geom.l / 2)
         elif contact == "hertz-refined" and cls is ChainCVT:
             from cvtfem.machines.chain_cvt_refined import RefinedChainCVT, refined_contact
-            cls, pair = RefinedChainCVT, refined_contact(family, centres, face, c, r_outer, f0, v0, law, face_radius)
+            cls, pair = RefinedChainCVT, refined_contact(family, centres, face, c, r_outer, f0, v0, law, face_radius,
+                                                           face_inclination)
         elif contact == "hertz":
             pair = cls._contact_for(SheaveContact(centres, (face, face), np.array([c, c]), r_outer, f0, v0, law))
         else:
@@ -837,7 +851,8 @@ def from_scene(scene, geom, F_appl, model: str = "chain-S2", **overrides) -> Cha
               f0=cvt.friction.f0, v0=cvt.friction.v0, law=cvt.friction.law,
               regime=Regime(rg.kind, rg.input_speed, rg.torque, rg.ratio, rg.end_value, rg.ramp_time),
               F_appl=F_appl, control=loop if cvt.effects.stabilisation else None,
-              damping_ratio=cvt.chain.damping_ratio, E=cvt.young_modulus)
+              damping_ratio=cvt.chain.damping_ratio, E=cvt.young_modulus, face_radius=cvt.chain.face_radius,
+              face_inclination=cvt.chain.face_inclination)
     kw.update(overrides)
     if kw["model"] in FAMILIES:
         return ChainCVT.from_parameters(geom, **kw)

@@ -14,11 +14,14 @@ from cvtfem.elements.chain.sheave_contact_refined import RefinedSheaveContact
 from cvtfem.machines.chain_cvt import ChainCVT
 
 
-def refined_contact(family, centres, face, c, r_outer, f0, v0, law, face_radius) -> RefinedSheaveContact:
+def refined_contact(family, centres, face, c, r_outer, f0, v0, law, face_radius,
+                    face_inclination=0.0) -> RefinedSheaveContact:
     """The H2 contact of ``family`` (S2 or S3) with the sheave ``face`` on both shafts at ``centres`` (2, 2) m,
-    Hertz stiffness ``c`` (N/m^1.5), pin end faces crowned with ``face_radius`` (m)."""
+    Hertz stiffness ``c`` (N/m^1.5), pin end faces crowned with ``face_radius`` (m), inclined by
+    ``face_inclination`` (rad)."""
     return RefinedSheaveContact(centres, (face, face), np.array([c, c]), r_outer, f0, v0, face_radius,
-                                family.im1, family.ip1, slopes=family.ndof == 5, law=law)
+                                family.im1, family.ip1, slopes=family.ndof == 5, law=law,
+                                face_inclination=face_inclination)
 
 
 class RefinedChainCVT(ChainCVT):

@@ -8,6 +8,7 @@ movable sheave's axial coordinate), controller states (low-order digest section 
 from __future__ import annotations
 
 import importlib.util
+import math
 from typing import Any
 
 from cvtfem.control.stabilisation import LOOP_OUTPUTS, Stabilisation
@@ -130,6 +131,23 @@ def band_params(scene: Scene, **overrides: Any):
     return BandParams(**values)
 
 
+def pin_section(scene):
+    """The pins' :class:`~cvtfem.elements.chain.geometry.PinSection`: the rectangle with the scene's ``pin_area`` and
+    smallest second moment ``pin_I_min`` (side along the chain ``sqrt(12 I / F)``, ``width_n`` across it)."""
+    import numpy as np
+
+    from cvtfem.elements.chain.geometry import PinSection
+
+    ch = scene.cvt.chain
+    width_tau = float(np.sqrt(12.0 * ch.pin_I_min / ch.pin_area))
+    section = PinSection(width_tau, ch.pin_area / width_tau, scene.cvt.young_modulus)
+    if section.width_n < width_tau:
+        raise InputError("cvt.chain.pin_I_min", ch.pin_I_min,
+                         f"must be at most pin_area^2 / 12 = {ch.pin_area ** 2 / 12:.4g} m^4 (the square section) "
+                         "for a rectangular pin of that area")
+    return section
+
+
 def chain_geometry(scene: Scene):
     """:class:`~cvtfem.elements.chain.geometry.ChainGeometry` of a CVT scene's ``[cvt.chain]``.
 
@@ -140,18 +158,12 @@ def chain_geometry(scene: Scene):
     """
     import numpy as np
 
-    from cvtfem.elements.chain.geometry import PinSection
     from cvtfem.elements.chain.geometry import chain_geometry as build
     from cvtfem.elements.link_pattern import link_lengths
 
     ch = scene.cvt.chain
     pitch = link_lengths(ch.n_pins, ch.pitch_short, ch.pitch_long, ch.long_fraction, np.random.default_rng(scene.seed))
-    width_tau = float(np.sqrt(12.0 * ch.pin_I_min / ch.pin_area))
-    section = PinSection(width_tau, ch.pin_area / width_tau, scene.cvt.young_modulus)
-    if section.width_n < width_tau:
-        raise InputError("cvt.chain.pin_I_min", ch.pin_I_min,
-                         f"must be at most pin_area^2 / 12 = {ch.pin_area ** 2 / 12:.4g} m^4 (the square section) "
-                         "for a rectangular pin of that area")
+    section = pin_section(scene)
     return build(ch.n_pins, ch.pin_length, pitch, ch.plates_per_link, ch.link_stiffness, ch.mass, section,
                  period=ch.lacing_period, c_pin=ch.pin_axial_stiffness)
 
@@ -379,7 +391,10 @@ def _contact_note(scene: Scene) -> str:
         "both pin ends"
     faces = ", the faces opening under the pin forces," if scene.sheave is not None and \
         scene.sheave.flexibility != "rigid" else ""
-    return f"{'refined (H2)' if refined else 'Hertz (H1)'} contact{faces} at {where} with"
+    ch = scene.cvt.chain
+    pin_face = f" (pin end faces crowned {ch.face_radius * 1e3:g} mm" + (
+        f", inclined {math.degrees(ch.face_inclination):.3g} deg)" if refined else ")")
+    return f"{'refined (H2)' if refined else 'Hertz (H1)'} contact{pin_face}{faces} at {where} with"
 
 
 def _plate_state_note(scene: Scene, model) -> str:

@@ -191,7 +191,7 @@ def _refuse_unread(validated: Mapping[str, Any], data: Mapping[str, Any]) -> Non
     if validated.get("cvt") is None or data.get("preset") in (None, ""):
         return
     model = validated["cvt"]["model"]
-    unread = unread_keys(model)
+    unread = unread_keys(validated["cvt"])
     if not unread:
         return
     presets = resolve_presets({"preset": data["preset"]})

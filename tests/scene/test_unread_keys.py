@@ -37,3 +37,20 @@ def test_cvtfem_run_refuses_it_in_one_line(tmp_path, cli):
     assert res.returncode == 2 and "Traceback" not in res.stderr
     line = res.stderr.strip()
     assert len(line.splitlines()) == 1 and "`cvt.driven.radial_stiffness`" in line and "chain-S2" in line, line
+
+
+def test_the_pin_face_keys_are_refused_where_they_are_not_read():
+    """The face inclination is the refined contact's (H2) only; the crown radius sets every Hertz contact's constant;
+    a band model reads neither (session 12)."""
+    with pytest.raises(InputError, match=r"`cvt.chain.face_inclination` is not read by `chain-S2`.*got 0.1"):
+        scene_from_dict({"preset": "chain-S2", "cvt": {"chain": {"face_inclination": 0.1}}})
+    with pytest.raises(InputError, match=r"`cvt.chain.face_radius` is not read by `band-6\+2n`.*got 0.01"):
+        scene_from_dict({"preset": "band-6+2n", "cvt": {"chain": {"face_radius": 0.01}}})
+    with pytest.raises(InputError, match=r"`cvt.chain.face_inclination` is not read by `band-4dof`"):
+        scene_from_dict({"preset": "band-4dof", "cvt": {"chain": {"face_inclination": 0.1}}})
+    h1 = scene_from_dict({"preset": "chain-S2", "cvt": {"chain": {"face_radius": 0.01}}})
+    assert h1.cvt.chain.face_radius == 0.01                               # H1's Hertz constant
+    a = scene_from_dict({"preset": "variant-a", "cvt": {"chain": {"face_inclination": 0.1, "face_radius": 0.01}}})
+    assert (a.cvt.chain.face_inclination, a.cvt.chain.face_radius) == (0.1, 0.01)
+    with pytest.raises(InputError, match="face_inclination"):
+        scene_from_dict({"preset": "variant-a", "cvt": {"chain": {"face_inclination": 0.8}}})   # beyond pi/4

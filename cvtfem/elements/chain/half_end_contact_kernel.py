@@ -28,13 +28,13 @@ STEPS = np.array([1e-9] * N_POS + [1e-6] * N_POS + [1e-5])
 
 def pack(contact, scale: float) -> tuple:
     """Kernel constants of a :class:`HalfEndContact` whose outputs are scaled by ``scale`` (0.5 inside
-    :class:`EndContact`): ``(centres (2, 2), r_outer^2, meridians (2, 4), face radius, end-slope factor, c (2,),
+    :class:`EndContact`): ``(centres (2, 2), r_outer^2, meridians (2, 4), face (R_f, tan theta), end-slope factor, c (2,),
     (f0, v0, eps, scale), law code)``."""
     h2 = contact.pair
     if not h2.slopes:
         raise ValueError("half_end_contact_kernel.pack: the H2 kernel of a half end has slopes")
     return (np.ascontiguousarray(h2.centres, float), float(h2.r_outer) ** 2, np.ascontiguousarray(h2._meridians, float),
-            float(h2.face_radius), float(END_SLOPE_FACTOR), np.ascontiguousarray(h2.c, float),
+            h2.face, float(END_SLOPE_FACTOR), np.ascontiguousarray(h2.c, float),
             np.array([h2.f0, h2.v0, h2.eps, scale]), LAW_CODES[h2.law])
 
 
@@ -53,7 +53,7 @@ def _candidates(y, cols, coef, shaft, centres, r2, X, sh, pair):
 
 
 @njit(cache=True)
-def _local(X, sh, centres, meridians, face_radius, slope_factor, c, par, law, Y):
+def _local(X, sh, centres, meridians, face, slope_factor, c, par, law, Y):
     """Outputs ``Y`` (m, 10) of the contacts with inputs ``X`` (m, 17) on shafts ``sh``: ``HalfEndContact.local``
     times ``par[3]``, the refined kernel called once for all of them.  Returns the kernel's flag (>= 0: a half end
     on the shaft axis)."""
@@ -61,7 +61,7 @@ def _local(X, sh, centres, meridians, face_radius, slope_factor, c, par, law, Y)
     Xk, Yk = np.empty((m, 2 * (N_POS + 2) + 1)), np.empty((m, N_OUT + 2))
     slip, fr = np.empty((m, 3)), np.empty((m, 3))
     _spread(X, Xk, N_POS + 2)
-    bad = refined_local_kernel(Xk, sh, centres, meridians, face_radius, True, slope_factor, c, par[0], par[1], law,
+    bad = refined_local_kernel(Xk, sh, centres, meridians, face, True, slope_factor, c, par[0], par[1], law,
                                par[2], Yk, slip, fr)
     _gather(Yk, Y)
     for i in range(m):
@@ -71,19 +71,19 @@ def _local(X, sh, centres, meridians, face_radius, slope_factor, c, par, law, Y)
 
 
 @njit(cache=True)
-def forces(y, cols, coef, shaft, rows, rw, centres, r2, meridians, face_radius, slope_factor, c, par, law, Q):
+def forces(y, cols, coef, shaft, rows, rw, centres, r2, meridians, face, slope_factor, c, par, law, Q):
     """Add the contact forces to ``Q`` (n2,); returns ``(friction power (W, <= 0), first pair with its half end on the
     shaft axis or -1)``."""
     P = cols.shape[0]
     X, sh, pair = np.empty((P, N_IN)), np.empty(P, np.int64), np.empty(P, np.int64)
     m = _candidates(y, cols, coef, shaft, centres, r2, X, sh, pair)
     Y = np.empty((m, N_OUT))
-    bad = _local(X[:m], sh[:m], centres, meridians, face_radius, slope_factor, c, par, law, Y)
+    bad = _local(X[:m], sh[:m], centres, meridians, face, slope_factor, c, par, law, Y)
     return scatter_forces(pair[:m], Y, rows, rw, Q), (pair[bad] if bad >= 0 else -1)
 
 
 @njit(cache=True)
-def local_jacobians(y, cols, coef, shaft, rows, rw, centres, r2, meridians, face_radius, slope_factor, c, par, law,
+def local_jacobians(y, cols, coef, shaft, rows, rw, centres, r2, meridians, face, slope_factor, c, par, law,
                     steps):
     """``(pair (m,), Jl (m, 10, 17))``: the candidates in contact and their local Jacobians by central differences
     with ``steps`` (``HalfEndContact.local_jacobian``: one perturbed input column for all of them at once).  A
@@ -94,7 +94,7 @@ def local_jacobians(y, cols, coef, shaft, rows, rw, centres, r2, meridians, face
     X, sh, pair = np.empty((P, N_IN)), np.empty(P, np.int64), np.empty(P, np.int64)
     m = _candidates(y, cols, coef, shaft, centres, r2, X, sh, pair)
     Y0 = np.empty((m, N_OUT))
-    _local(X[:m], sh[:m], centres, meridians, face_radius, slope_factor, c, par, law, Y0)
+    _local(X[:m], sh[:m], centres, meridians, face, slope_factor, c, par, law, Y0)
     k = 0
     for t in range(m):                                            # the candidates in contact, in their order
         if np.any(Y0[t] != 0.0):
@@ -106,9 +106,9 @@ def local_jacobians(y, cols, coef, shaft, rows, rw, centres, r2, meridians, face
     Jl = np.empty((m, N_OUT, N_IN))
     for j in range(N_IN):
         Xs[:, j] = X0[:, j] + steps[j]
-        _local(Xs, sh, centres, meridians, face_radius, slope_factor, c, par, law, Yp)
+        _local(Xs, sh, centres, meridians, face, slope_factor, c, par, law, Yp)
         Xs[:, j] = X0[:, j] - steps[j]
-        _local(Xs, sh, centres, meridians, face_radius, slope_factor, c, par, law, Ym)
+        _local(Xs, sh, centres, meridians, face, slope_factor, c, par, law, Ym)
         Xs[:, j] = X0[:, j]
         for t in range(m):
             for o in range(N_OUT):
@@ -117,12 +117,12 @@ def local_jacobians(y, cols, coef, shaft, rows, rw, centres, r2, meridians, face
 
 
 @njit(cache=True)
-def jacobian(y, cols, coef, shaft, rows, rw, centres, r2, meridians, face_radius, slope_factor, c, par, law, steps,
+def jacobian(y, cols, coef, shaft, rows, rw, centres, r2, meridians, face, slope_factor, c, par, law, steps,
              n_state, r_out, c_out, v_out, dD):
     """Entries of ``dQ/dy`` of :func:`forces` (over ``y[:n_state]``) into ``r_out``, ``c_out``, ``v_out`` (their count
     returned) and ``-d(friction power)/dy`` added to ``dD``: the local Jacobians of :func:`local_jacobians` (10, 17)
     mapped on both sides ``R^T (dY/dX) P``."""
-    pair, Jl = local_jacobians(y, cols, coef, shaft, rows, rw, centres, r2, meridians, face_radius, slope_factor, c,
+    pair, Jl = local_jacobians(y, cols, coef, shaft, rows, rw, centres, r2, meridians, face, slope_factor, c,
                                par, law, steps)
     return scatter_jacobian(pair, Jl, cols, coef, rows, rw, n_state, dD, r_out, c_out, v_out)
 

@@ -57,7 +57,7 @@ def pack_refined(pair, sides, sheave_x3, face_ref, end_slots, half_end: bool, sc
     return (np.ascontiguousarray(pair.centres, float), float(pair.r_outer) ** 2,
             _frame(sides, sheave_x3, face_ref), np.asarray(end_slots, np.int64)[:2],
             REFINED_HALF_END if half_end else REFINED, np.ascontiguousarray(pair._meridians, float),
-            float(pair.face_radius), float(END_SLOPE_FACTOR), np.ascontiguousarray(pair.c, float),
+            pair.face, float(END_SLOPE_FACTOR), np.ascontiguousarray(pair.c, float),
             np.array([pair.f0, pair.v0, pair.eps, scale]), LAW_CODES[pair.law], np.zeros((2, 3)), False, 1.0)
 
 
@@ -68,7 +68,7 @@ def pack_point(pair, sides, sheave_x3, face_ref, scale: float, share: float, axi
     from the pair's mid-plane (symmetric chain); the rest as :func:`pack_refined`'s."""
     centres, r2, prof, c, par, law = _pack_point_kernel(pair, scale)
     return (centres, r2, _frame(sides, sheave_x3, face_ref), np.array([0, 1], np.int64), POINT, np.zeros((2, 4)),
-            1.0, 1.0, c, par, law, prof, bool(axial_relative), float(share))
+            np.array([1.0, 0.0]), 1.0, c, par, law, prof, bool(axial_relative), float(share))
 
 
 def _frame_pattern() -> tuple[np.ndarray, np.ndarray]:
@@ -182,7 +182,7 @@ def _gather_back(Y, half_end, Y10):
 
 
 @njit(cache=True)
-def _refined_outputs(Z, sh, sv, centres, frame, kind, meridians, face_radius, slope_factor, c, par, law, R, dK):
+def _refined_outputs(Z, sh, sv, centres, frame, kind, meridians, face, slope_factor, c, par, law, R, dK):
     """:func:`mapped_outputs` of H2 contacts (``ElasticChainACVT.mapped_local``)."""
     m, n_p = Z.shape[0], (Z.shape[1] - 1) // 2
     half_end = kind == REFINED_HALF_END
@@ -206,12 +206,12 @@ def _refined_outputs(Z, sh, sv, centres, frame, kind, meridians, face_radius, sl
     if half_end:
         Xk = np.empty((m, 2 * N_KERNEL + 1))
         _half_spread(kin, Xk, N_KERNEL)
-        bad = refined_local_kernel(Xk, sh, centres, meridians, face_radius, True, slope_factor, c, par[0], par[1],
+        bad = refined_local_kernel(Xk, sh, centres, meridians, face, True, slope_factor, c, par[0], par[1],
                                    law, par[2], Yk, slip, fr)
         Y = np.empty((m, n_c + 2))
         _half_gather(Yk, Y)
     else:
-        bad = refined_local_kernel(kin, sh, centres, meridians, face_radius, True, slope_factor, c, par[0], par[1],
+        bad = refined_local_kernel(kin, sh, centres, meridians, face, True, slope_factor, c, par[0], par[1],
                                    law, par[2], Yk, slip, fr)
         Y = Yk
     Y10, F = np.empty(N_KERNEL), np.empty(N_FRAME)
@@ -270,7 +270,7 @@ def _point_outputs(Z, sh, sv, centres, frame, c, par, law, prof, axial_relative,
 
 
 @njit(cache=True)
-def mapped_outputs(Z, sh, sv, centres, frame, kind, meridians, face_radius, slope_factor, c, par, law, prof,
+def mapped_outputs(Z, sh, sv, centres, frame, kind, meridians, face, slope_factor, c, par, law, prof,
                    axial_relative, share, R, dK):
     """Outputs ``R`` (m, n_p + 2) of the mapped contacts with inputs ``Z`` (m, 2 n_p + 1) on shafts ``sh``, sheaves
     ``sv``: the generalized forces on the ``n_p`` mapped positions, on the spin, the friction power (W), as
@@ -278,7 +278,7 @@ def mapped_outputs(Z, sh, sv, centres, frame, kind, meridians, face_radius, slop
     with its end on the shaft axis (H2), or -1."""
     if kind == POINT:
         return _point_outputs(Z, sh, sv, centres, frame, c, par, law, prof, axial_relative, share, R)
-    return _refined_outputs(Z, sh, sv, centres, frame, kind, meridians, face_radius, slope_factor, c, par, law, R, dK)
+    return _refined_outputs(Z, sh, sv, centres, frame, kind, meridians, face, slope_factor, c, par, law, R, dK)
 
 
 @njit(cache=True)
@@ -307,7 +307,7 @@ def _candidates(y, cols, coef, shaft, centres, r2, ends, Zall, sh, pair):
 
 
 @njit(cache=True)
-def forces(y, cols, coef, shaft, sheave, rows, rw, centres, r2, frame, ends, kind, meridians, face_radius,
+def forces(y, cols, coef, shaft, sheave, rows, rw, centres, r2, frame, ends, kind, meridians, face,
            slope_factor, c, par, law, prof, axial_relative, share, Q):
     """Add the mapped contacts' generalized forces to ``Q`` (n2,); returns ``(friction power (W, <= 0), first pair
     with its end on the shaft axis or -1)``."""
@@ -317,13 +317,13 @@ def forces(y, cols, coef, shaft, sheave, rows, rw, centres, r2, frame, ends, kin
     sv = sheave[pair[:m]]
     n_out = rows.shape[1] + 1
     R, dK = np.empty((m, n_out)), np.empty((m, N_PATTERN))
-    bad = mapped_outputs(Zall[:m], sh[:m], sv, centres, frame, kind, meridians, face_radius, slope_factor, c,
+    bad = mapped_outputs(Zall[:m], sh[:m], sv, centres, frame, kind, meridians, face, slope_factor, c,
                          par, law, prof, axial_relative, share, R, dK)
     return scatter_forces(pair[:m], R, rows, rw, Q), (pair[bad] if bad >= 0 else -1)
 
 
 @njit(cache=True)
-def jacobian(y, cols, coef, shaft, sheave, rows, rw, centres, r2, frame, ends, kind, meridians, face_radius,
+def jacobian(y, cols, coef, shaft, sheave, rows, rw, centres, r2, frame, ends, kind, meridians, face,
              slope_factor, c, par, law, prof, axial_relative, share, steps, n_state, r_out, c_out, v_out, dD):
     """Entries of ``dQ/dy`` of :func:`forces` (over ``y[:n_state]``) into ``r_out``, ``c_out``, ``v_out`` (their count
     returned) and ``-d(friction power)/dy`` added to ``dD``: the mapped contacts' local Jacobians by central
@@ -342,11 +342,11 @@ def jacobian(y, cols, coef, shaft, sheave, rows, rw, centres, r2, frame, ends, k
     for j in range(n_in):
         for t in range(m):
             Zs[t, j] = Z0[t, j] + steps[j]
-        b1 = mapped_outputs(Zs, sh, sv, centres, frame, kind, meridians, face_radius, slope_factor, c, par,
+        b1 = mapped_outputs(Zs, sh, sv, centres, frame, kind, meridians, face, slope_factor, c, par,
                             law, prof, axial_relative, share, Rp, dK)
         for t in range(m):
             Zs[t, j] = Z0[t, j] - steps[j]
-        b2 = mapped_outputs(Zs, sh, sv, centres, frame, kind, meridians, face_radius, slope_factor, c, par,
+        b2 = mapped_outputs(Zs, sh, sv, centres, frame, kind, meridians, face, slope_factor, c, par,
                             law, prof, axial_relative, share, Rm, dK)
         for t in range(m):
             Zs[t, j] = Z0[t, j]

@@ -46,13 +46,16 @@ def face_profile(face: Sheave):
     return profile
 
 
-def hertz_constant(face: Sheave, r: float, face_radius: float, E: float, nu: float) -> float:
+def hertz_constant(face: Sheave, r: float, face_radius: float, E: float, nu: float, inclination: float = 0.0) -> float:
     """Hertz stiffness ``c`` (N/m^1.5) of a pin end crowned with ``face_radius`` (m, both directions) on the
-    face at radius ``r`` (m), steel on steel (``E`` Pa, ``nu``), held constant (digest §4.3)."""
+    face at radius ``r`` (m), steel on steel (``E`` Pa, ``nu``), held constant (digest §4.3).  A face inclined by
+    ``inclination`` (rad; the graph ``z = tan(theta) xi_o + |xi|^2 / (2 R_f)`` of the H2 kernel) has the true
+    curvatures ``cos^3(theta) / R_f`` (radial, with the sheave's meridian) and ``cos(theta) / R_f``."""
     g = float(np.arctan(face.tan_gamma(r)))
     fp, fpp = -np.tan(g), float(face.d2z0(r))
     k_mer, k_circ = sheave_curvatures(r, fp, fpp)
-    pin = np.diag([1 / face_radius, 1 / face_radius])[None]
+    ci = np.cos(inclination)
+    pin = np.diag([ci / face_radius, ci ** 3 / face_radius])[None]
     sheave = np.diag([float(k_circ), float(k_mer)])[None]
     sum_k, omega = relative_curvature(pin, sheave)
     return float(hertz_stiffness(sum_k, omega, compliance(E, nu, E, nu))[0])

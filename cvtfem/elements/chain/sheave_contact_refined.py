@@ -1,23 +1,31 @@
 """Refined pin–sheave contact H2 of a symmetric chain (S2, S3) on the rigid sheave pairs of two shafts.
 
 The variant of :class:`~cvtfem.elements.chain.sheave_contact.SheaveContact` (H1) with the refined biconvex
-kinematics of the contact digest §5 (1.330)–(1.352): the pin end face is crowned, ``z = |xi|^2 / (2 R_f)``
-about the pin-axis end in the pin frame (radius ``face_radius`` in both directions), the sheave face is the
+kinematics of the contact digest §5 (1.330)–(1.352): the pin end face is crowned and inclined,
+``z = beta . xi + |xi|^2 / (2 R_f)`` about the pin-axis end in the pin frame (radius ``face_radius`` in both
+directions, ``beta = tan(theta)`` towards the pin's outward radial side ``-n_perp``: the face normal tilted by
+``face_inclination`` ``theta`` towards the sheave flank, turning with the pin spin), the sheave face is the
 untilted face ``x3 = z_k + s(r)`` of model 1.  Both are quadratics about the in-plane pin point (1.331) and
 the contact point, penetration (along ``k``) and normal are the closed form of §5.3
 (:func:`~cvtfem.elements.contact.refined.refined_contact`, which the tests hold equal).  For this face and an
 untilted sheave the closed form reads, in the frame of :mod:`cvtfem.elements.contact.refined` (sheave side
 ``s = -1``: its material on the ``+k`` side of the ``x3 > 0`` pin end)
 
-    ``Delta = s (z_k - u3) + f(r) + ((f' + s gamma_e)^2 / m_e + gamma_n^2 / m_n) / 2``,
-    ``m_e = 1/R_f - f''``, ``m_n = 1/R_f - f'/r``,
+    ``Delta = s (z_k - u3) + f(r) + ((f' + s gamma_e - q_e)^2 / m_e + (s gamma_n - q_n)^2 / m_n) / 2``,
+    ``m_e = 1/R_f - f''``, ``m_n = 1/R_f - f'/r``, ``q = tan(theta) n_perp``,
 
 with ``f(r) = -s(r)`` the face profile, ``r`` the radius of the pin end, ``gamma = END_SLOPE_FACTOR u'_p``
 the world end slope of the pin axis (S3; zero for S2, where H2 is H1 shifted by ``x_*`` and
-``f'^2/(2 m_e)``) and ``gamma_e``, ``gamma_n`` its radial and circumferential parts.
+``(f' - q_e)^2/(2 m_e)``), ``gamma_e``, ``gamma_n`` its radial and circumferential parts and ``q`` the face slope
+(the chain runs counter-clockwise, so ``n_perp = k x tau_p`` points inward on an arc: ``q_e = -tan(theta)``; a face
+at the flank angle of a cone meets an untilted pin's face on its axis, ``x_* = 0``).  The face slope enters as the
+digest's ``b = beta_phi - gamma``: its first-order cross terms with the end slope (``gamma . beta``, relative
+``|gamma| tan(theta)``, ~1e-3 at end slopes of a few mrad) are dropped, so the face stays isotropic
+(``B = E / R_f``) and the closed form scalar.
 
 Forces.  The normal generalized forces are the exact gradient of the potential ``2/5 c Delta^{5/2}`` of this
-closed form in the chain and sheave coordinates (pin end, end slope, ``z_k``): conservative to round-off.
+closed form in the chain and sheave coordinates (pin end, end slope, ``z_k``, and through the inclined face's turn
+``dDelta/dphi = tan(theta) x_* . tau_p`` the neighbours' positions): conservative to round-off.
 The source's (1.351) applies ``N (k - g_*)`` at ``R_*``, which differs from the gradient by terms of third
 order in the offset ``|x_*|`` (the cubic terms the quadratic surfaces drop; docs/chain.md).  Friction, the
 regularised law on the slip of the material points at ``R_*`` (§5.6), acts through the kinematics (1.350):
@@ -85,7 +93,12 @@ class RefinedSheaveContact:
     ``c``, ``r_outer``, ``f0``, ``v0``, ``law``, ``eps``), plus:
 
     face_radius : float, m
-        Crown radius ``R_f`` of the pin end faces (both directions).
+        Crown radius ``R_f`` of the pin end faces (both directions): the face is the graph
+        ``z = tan(theta) xi_o + |xi|^2 / (2 R_f)`` over the pin section (``xi_o`` the outward radial coordinate).
+    face_inclination : float, rad
+        Angle ``theta`` of the face normal at the pin-axis end from the pin axis, tilted outward in the pin's
+        radial plane (towards the sheave flank); 0: the symmetric crowned face (digest §5.4 [A]).  The chain
+        runs counter-clockwise (the models' frame), so the outward direction is ``-n_perp = -k x tau_p``.
     im1, ip1 : (n,) int
         Previous and next pin of each pin (the chain's cyclic neighbours).
     slopes : bool
@@ -104,16 +117,27 @@ class RefinedSheaveContact:
     slopes: bool = False
     law: str = "linear-saturated"
     eps: float = 0.1
+    face_inclination: float = 0.0
 
     def __post_init__(self):
         if not self.r_outer > 0 or not self.v0 > 0 or self.f0 < 0:
             raise InputError("RefinedSheaveContact", (self.r_outer, self.f0, self.v0), "r_outer > 0, f0 >= 0, v0 > 0")
         if not self.face_radius > 0:
             raise InputError("face_radius", self.face_radius, "must be > 0 (crown radius of the pin end face, m)")
+        if not 0.0 <= self.face_inclination < np.pi / 4:
+            raise InputError("face_inclination", self.face_inclination, "must be in [0, pi/4) rad (angle of the pin "
+                             "end face's normal from the pin axis, tilted towards the sheave flank)")
         object.__setattr__(self, "centres", np.asarray(self.centres, float).reshape(2, 2))
         object.__setattr__(self, "c", np.broadcast_to(np.asarray(self.c, float), (2,)).copy())
         _check(self.law, self.eps)
         object.__setattr__(self, "_meridians", np.stack([face_meridian(f).params for f in self.faces]))
+
+    @property
+    def face(self) -> np.ndarray:
+        """The kernels' face constants ``(R_f (m), T)``: ``beta_phi = T n_perp`` in the mirrored frame, ``T =
+        tan(theta)`` (outward ``-n_perp`` on a counter-clockwise chain, the face sloping like the sheave's
+        ``f' < 0``)."""
+        return np.array([float(self.face_radius), float(np.tan(self.face_inclination))])
 
     # ----- layout --------------------------------------------------------------------------------
     @property
@@ -140,9 +164,11 @@ class RefinedSheaveContact:
         return np.column_stack(cols + [iz[shafts], iphi[shafts]])
 
     def extra_approach(self, k: int, r):
-        """Penetration beyond H1's of an untilted pin end at radius ``r`` (m) on shaft ``k``: ``f'^2 / (2 m_e)`` (m)."""
+        """Penetration beyond H1's of an untilted pin end at radius ``r`` (m) on shaft ``k`` whose face turns with
+        the arc: ``(f' + tan(theta))^2 / (2 m_e)`` (m)."""
         _, fp, fpp, _ = face_derivatives(self.faces[k], np.asarray(r, float))
-        return fp * fp / (2.0 * (1.0 / self.face_radius - fpp))
+        P = fp + np.tan(self.face_inclination)
+        return P * P / (2.0 * (1.0 / self.face_radius - fpp))
 
     def candidates(self, u):
         """Broad phase: ``(pin, shaft)`` index arrays of the pin ends ``u`` (n, 2) within the outer radius."""
@@ -188,29 +214,6 @@ class RefinedSheaveContact:
             raise NumericalError("H2 contact: a pin end on the shaft axis", component="contact.refined")
         e = d / r[:, None]
         nu = _kx(e)
-        f, fp, fpp, f3 = self._profile(shafts, r)
-        Rf = self.face_radius
-        me, mn = 1.0 / Rf - fpp, 1.0 / Rf - fp / r     # B - A > 0: the sheave faces have f'' <= 0, f' < 0
-        ge, gn = _dot(g, e), _dot(g, nu)
-        P = fp + s * ge
-        xe, xn = P / me, s * gn / mn                                  # x_* = M^-1 (a_vec - b_vec)
-        delta = s * (z - u3) + f + 0.5 * (P * xe + s * gn * xn)
-        # exact gradient of Delta: in-plane pin position d, slope g; u3 -> -s, z -> +s
-        dd = (e * (fp + xe * fpp + 0.5 * xe ** 2 * f3 + 0.5 * xn ** 2 * (fpp / r - fp / r ** 2))[:, None]
-              + nu * (s * (xe * gn - xn * ge) / r)[:, None])
-        x = xe[:, None] * e + xn[:, None] * nu                        # offset x_* (in-plane, world)
-        dg = s * x
-        N, _ = hertz_force(delta, self.c[shafts])
-        # contact point R_* and the refined normal (§5.3), world frame
-        Ax = (fpp * xe)[:, None] * e + (fp / r * xn)[:, None] * nu
-        gstar = fp[:, None] * e + Ax                                   # common slope g_* (mirrored frame)
-        z_pul = s * z + f + _dot(fp[:, None] * e, x) + 0.5 * _dot(x, Ax)
-        z_pin = s * u3 - s * _dot(g, x) + 0.5 * _dot(x, x) / Rf
-        point3 = 0.5 * s * (z_pul + z_pin)
-        grad = np.column_stack([gstar, np.full(m, -s)])
-        normal = -grad / np.linalg.norm(grad, axis=1, keepdims=True)
-        rho = np.column_stack([x, point3 - u3])
-        arm = np.column_stack([d + x, point3 - z])
         # pin spin: bisector of the unit chords, omega_p and the twist map (1.349)/(1.116)
         cp, cn = up_ - um, un - up_
         lp, ln = np.sqrt(_dot(cp, cp)), np.sqrt(_dot(cn, cn))
@@ -222,6 +225,31 @@ class RefinedSheaveContact:
         tp = (nperp - _dot(nperp, ep)[:, None] * ep) / (nx * lp)[:, None]
         tn = (nperp - _dot(nperp, en)[:, None] * en) / (nx * ln)[:, None]
         om_p = _dot(tp, vp - vm) + _dot(tn, vn - vp)
+        f, fp, fpp, f3 = self._profile(shafts, r)
+        Rf, T = self.face
+        q = T * nperp                                                  # face slope beta_phi (mirrored frame)
+        me, mn = 1.0 / Rf - fpp, 1.0 / Rf - fp / r     # B - A > 0: the sheave faces have f'' <= 0, f' < 0
+        ge, gn = _dot(g, e), _dot(g, nu)
+        qe, qn = _dot(q, e), _dot(q, nu)
+        P, Pn = fp + s * ge - qe, s * gn - qn
+        xe, xn = P / me, Pn / mn                                      # x_* = M^-1 (a_vec - b_vec)
+        delta = s * (z - u3) + f + 0.5 * (P * xe + Pn * xn)
+        # exact gradient of Delta: in-plane pin position d, slope g; u3 -> -s, z -> +s; pin spin T x_* . tau_p
+        dd = (e * (fp + xe * fpp + 0.5 * xe ** 2 * f3 + 0.5 * xn ** 2 * (fpp / r - fp / r ** 2))[:, None]
+              + nu * ((xe * Pn - xn * (s * ge - qe)) / r)[:, None])
+        x = xe[:, None] * e + xn[:, None] * nu                        # offset x_* (in-plane, world)
+        dg = s * x
+        N, _ = hertz_force(delta, self.c[shafts])
+        # contact point R_* and the refined normal (§5.3), world frame
+        Ax = (fpp * xe)[:, None] * e + (fp / r * xn)[:, None] * nu
+        gstar = fp[:, None] * e + Ax                                   # common slope g_* (mirrored frame)
+        z_pul = s * z + f + _dot(fp[:, None] * e, x) + 0.5 * _dot(x, Ax)
+        z_pin = s * u3 - s * _dot(g, x) + _dot(q, x) + 0.5 * _dot(x, x) / Rf
+        point3 = 0.5 * s * (z_pul + z_pin)
+        grad = np.column_stack([gstar, np.full(m, -s)])
+        normal = -grad / np.linalg.norm(grad, axis=1, keepdims=True)
+        rho = np.column_stack([x, point3 - u3])
+        arm = np.column_stack([d + x, point3 - z])
         k = np.array([0.0, 0.0, 1.0])
         g3 = np.column_stack([g, np.zeros(m)])
         gd3 = np.column_stack([gd, np.zeros(m)])
@@ -232,7 +260,7 @@ class RefinedSheaveContact:
         slip = v_rel - _dot(normal, v_rel)[:, None] * normal
         F_fr, _ = friction_force(slip, N, self.f0, self.v0, self.law, self.eps)
         # generalized forces of one end, then x2
-        Q_phi = _dot(F_fr, lever)                                      # on the pin spin
+        Q_phi = _dot(F_fr, lever) - N * T * _dot(x, xb) / nx           # on the pin spin: friction, turning face
         Q_slope = -N[:, None] * dg + np.cross(np.cross(rho, F_fr), k)[:, :2]
         F_pin = np.column_stack([-N[:, None] * dd + F_fr[:, :2], s * N + F_fr[:, 2]])
         Q_rear = -Q_phi[:, None] * tp
@@ -256,7 +284,7 @@ class RefinedSheaveContact:
         m = len(X)
         Y, slip, fr = np.empty((m, self.n_out)), np.empty((m, 3)), np.empty((m, 3))
         bad = refined_local_kernel(np.ascontiguousarray(X, float), np.ascontiguousarray(shafts, np.int64),
-                                   self.centres, self._meridians, float(self.face_radius), bool(self.slopes),
+                                   self.centres, self._meridians, self.face, bool(self.slopes),
                                    END_SLOPE_FACTOR, self.c, float(self.f0), float(self.v0), LAW_CODES[self.law],
                                    float(self.eps), Y, slip, fr)
         if bad >= 0:

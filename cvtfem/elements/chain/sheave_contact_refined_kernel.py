@@ -22,15 +22,16 @@ def _third(params, r):
 
 
 @njit(cache=True)
-def refined_local_kernel(X, shafts, centres, meridians, face_radius, slopes, slope_factor, c, f0, v0, law, eps,
+def refined_local_kernel(X, shafts, centres, meridians, face, slopes, slope_factor, c, f0, v0, law, eps,
                          Y, slip, friction):
     """Local outputs ``Y`` (m, n_out) of H2 chain contacts with inputs ``X`` (m, n_in) (layout of
     :class:`RefinedSheaveContact`); ``meridians`` (2, 4) the shafts' face profiles ``f = -s(r)`` as
-    :attr:`Meridian.params`; ``slip``, ``friction`` (m, 3) scratch.  Returns the index of the first contact
-    with its pin end on the shaft axis, or -1."""
+    :attr:`Meridian.params`; ``face`` the pin end face ``(R_f (m), tan(theta))`` (:attr:`RefinedSheaveContact.face`);
+    ``slip``, ``friction`` (m, 3) scratch.  Returns the index of the first contact with its pin end on the shaft
+    axis, or -1."""
     s = -1.0
     npos = 10 if slopes else 8
-    Rf = face_radius
+    Rf, T = face[0], face[1]
     bad = -1
     for i in range(X.shape[0]):
         k = shafts[i]
@@ -50,30 +51,7 @@ def refined_local_kernel(X, shafts, centres, meridians, face_radius, slopes, slo
             r = 1.0
         e0, e1 = d0 / r, d1 / r
         n0, n1 = -e1, e0
-        f, fp, fpp = evaluate(meridians[k], r)
-        f3 = _third(meridians[k], r)
-        me, mn = 1.0 / Rf - fpp, 1.0 / Rf - fp / r
-        ge, gn = g0 * e0 + g1 * e1, g0 * n0 + g1 * n1
-        P = fp + s * ge
-        xe, xn = P / me, s * gn / mn
-        delta = s * (z - u3) + f + 0.5 * (P * xe + s * gn * xn)
-        ce = fp + xe * fpp + 0.5 * xe * xe * f3 + 0.5 * xn * xn * (fpp / r - fp / (r * r))
-        cn = s * (xe * gn - xn * ge) / r
-        dd0, dd1 = e0 * ce + n0 * cn, e1 * ce + n1 * cn
-        x0, x1 = xe * e0 + xn * n0, xe * e1 + xn * n1
-        dd = max(delta, 0.0)
-        N = c[k] * dd * np.sqrt(dd)
-        # contact point and normal
-        Ax0, Ax1 = fpp * xe * e0 + fp / r * xn * n0, fpp * xe * e1 + fp / r * xn * n1
-        gs0, gs1 = fp * e0 + Ax0, fp * e1 + Ax1
-        z_pul = s * z + f + fp * (e0 * x0 + e1 * x1) + 0.5 * (x0 * Ax0 + x1 * Ax1)
-        z_pin = s * u3 - s * (g0 * x0 + g1 * x1) + 0.5 * (x0 * x0 + x1 * x1) / Rf
-        p3 = 0.5 * s * (z_pul + z_pin)
-        gl = np.sqrt(gs0 * gs0 + gs1 * gs1 + 1.0)
-        nr0, nr1, nr2 = -gs0 / gl, -gs1 / gl, s / gl
-        rho0, rho1, rho2 = x0, x1, p3 - u3
-        a0, a1, a2 = d0 + x0, d1 + x1, p3 - z
-        # pin spin from the unit chords
+        # pin spin from the unit chords: normal k x tau_p of the bisector, twist map (1.349)
         cp0, cp1, cn0, cn1 = up0 - um0, up1 - um1, un0 - up0, un1 - up1
         lp, ln = np.sqrt(cp0 * cp0 + cp1 * cp1), np.sqrt(cn0 * cn0 + cn1 * cn1)
         ep0, ep1, en0, en1 = cp0 / lp, cp1 / lp, cn0 / ln, cn1 / ln
@@ -83,6 +61,31 @@ def refined_local_kernel(X, shafts, centres, meridians, face_radius, slopes, slo
         sp, sn = np0 * ep0 + np1 * ep1, np0 * en0 + np1 * en1
         tp0, tp1 = (np0 - sp * ep0) / (nx * lp), (np1 - sp * ep1) / (nx * lp)
         tn0, tn1 = (np0 - sn * en0) / (nx * ln), (np1 - sn * en1) / (nx * ln)
+        q0, q1 = T * np0, T * np1                                # face slope beta_phi = T n_perp (mirrored frame)
+        f, fp, fpp = evaluate(meridians[k], r)
+        f3 = _third(meridians[k], r)
+        me, mn = 1.0 / Rf - fpp, 1.0 / Rf - fp / r
+        ge, gn = g0 * e0 + g1 * e1, g0 * n0 + g1 * n1
+        qe, qn = q0 * e0 + q1 * e1, q0 * n0 + q1 * n1
+        P, Pn = fp + s * ge - qe, s * gn - qn
+        xe, xn = P / me, Pn / mn
+        delta = s * (z - u3) + f + 0.5 * (P * xe + Pn * xn)
+        ce = fp + xe * fpp + 0.5 * xe * xe * f3 + 0.5 * xn * xn * (fpp / r - fp / (r * r))
+        cn = (xe * Pn - xn * (s * ge - qe)) / r
+        dd0, dd1 = e0 * ce + n0 * cn, e1 * ce + n1 * cn
+        x0, x1 = xe * e0 + xn * n0, xe * e1 + xn * n1
+        dd = max(delta, 0.0)
+        N = c[k] * dd * np.sqrt(dd)
+        # contact point and normal
+        Ax0, Ax1 = fpp * xe * e0 + fp / r * xn * n0, fpp * xe * e1 + fp / r * xn * n1
+        gs0, gs1 = fp * e0 + Ax0, fp * e1 + Ax1
+        z_pul = s * z + f + fp * (e0 * x0 + e1 * x1) + 0.5 * (x0 * Ax0 + x1 * Ax1)
+        z_pin = s * u3 - s * (g0 * x0 + g1 * x1) + (q0 * x0 + q1 * x1) + 0.5 * (x0 * x0 + x1 * x1) / Rf
+        p3 = 0.5 * s * (z_pul + z_pin)
+        gl = np.sqrt(gs0 * gs0 + gs1 * gs1 + 1.0)
+        nr0, nr1, nr2 = -gs0 / gl, -gs1 / gl, s / gl
+        rho0, rho1, rho2 = x0, x1, p3 - u3
+        a0, a1, a2 = d0 + x0, d1 + x1, p3 - z
         om = tp0 * (vp0 - vm0) + tp1 * (vp1 - vm1) + tn0 * (vn0 - vp0) + tn1 * (vn1 - vp1)
         l0, l1, l2 = _cross(g0, g1, 1.0, rho0, rho1, rho2)
         kg0, kg1, kg2 = _cross(0.0, 0.0, 1.0, gd0, gd1, 0.0)
@@ -92,7 +95,8 @@ def refined_local_kernel(X, shafts, centres, meridians, face_radius, slopes, slo
         w2 = u3d + t2 + om * l2 - zd
         _slip_and_friction(i, w0, w1, w2, nr0, nr1, nr2, N, f0, v0, law, eps, slip, friction)
         F0, F1, F2 = friction[i, 0], friction[i, 1], friction[i, 2]
-        Qphi = F0 * l0 + F1 * l1 + F2 * l2
+        # spin force: friction's work on (k + gamma) x rho and the turning face's -N dDelta/dphi = -N T x_* . tau_p
+        Qphi = F0 * l0 + F1 * l1 + F2 * l2 - N * T * (x0 * xb0 + x1 * xb1) / nx
         m0, m1, _ = _cross(rho0, rho1, rho2, F0, F1, F2)
         rear0, rear1 = -Qphi * tp0, -Qphi * tp1
         front0, front1 = Qphi * tn0, Qphi * tn1

@@ -56,6 +56,13 @@ CHAIN = Table("chain", "The chain (pins, plates, links) and its band abstraction
     Key("half_width", "float", "Half-width w of the band (pin end to chain mid-plane).", "m", gt=0.0),
     Key("damping_ratio", "float", "Modal damping ratio nu of the chain's elastic elements (beta = 2 nu / k).",
         "-", ge=0.0, lt=1.0),
+    Key("face_radius", "float", "Crown radius R_f of the pin end faces, both directions (the face z = tan(theta) "
+        "xi_out + |xi|^2 / (2 R_f) over the pin section): sets the Hertz constant and, with the refined contact, "
+        "the contact point.", "m", 0.02, gt=0.0, le=1.0),
+    Key("face_inclination", "float", "Angle theta of the pin end face's normal (at the pin axis) from the pin axis, "
+        "tilted outward towards the sheave flank; refined contact only. 0: crowned symmetrically about the axis; "
+        "`geometry.flank_angle`: parallel to a conical flank (the contact point on the pin axis).", "rad", 0.0,
+        ge=0.0, lt=math.pi / 4),
 ), checks=(lambda t, p: _check_chain(t, p),))
 
 
@@ -166,9 +173,29 @@ CHAIN_UNREAD = {
 }
 
 
-def unread_keys(model: str) -> dict[str, str]:
-    """Dotted keys the CVT model ``model`` does not read, each with what it describes (see :data:`CHAIN_UNREAD`)."""
-    return CHAIN_UNREAD if model.startswith("chain") else {}
+#: The pin end face: read by the discrete chains' Hertz contacts (``face_radius``: the Hertz constant of H1 and H2;
+#: ``face_inclination``: H2's contact point and Hertz constant), by no band model.
+FACE_KEYS = {
+    "cvt.chain.face_radius": "the crown radius of the pin end faces of a discrete chain's Hertz contact (a band "
+                             "model has no pins; the rigid contact of chain-S1 no Hertz constant)",
+    "cvt.chain.face_inclination": "the inclination of the pin end faces, read by the refined contact "
+                                  "(`effects.contact = 'hertz-refined'`) only: the other contacts act at the pin-axis "
+                                  "end",
+}
+
+
+def unread_keys(cvt: Mapping[str, Any]) -> dict[str, str]:
+    """Dotted keys the validated CVT table ``cvt`` (its model and contact) does not read, each with what it
+    describes (see :data:`CHAIN_UNREAD`, :data:`FACE_KEYS`)."""
+    model = cvt["model"]
+    if not model.startswith("chain"):
+        return dict(FACE_KEYS)
+    unread = dict(CHAIN_UNREAD)
+    if cvt["effects"]["contact"] != "hertz-refined":
+        unread["cvt.chain.face_inclination"] = FACE_KEYS["cvt.chain.face_inclination"]
+    if model == "chain-S1":
+        unread["cvt.chain.face_radius"] = FACE_KEYS["cvt.chain.face_radius"]
+    return unread
 
 
 def _check_ordered(table: Mapping[str, Any], path: str, low: str, high: str) -> None:

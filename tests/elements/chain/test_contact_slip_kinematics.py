@@ -6,6 +6,8 @@ with the pin's spin from its link chords and its end slope turning along); a she
 slips by ``dw`` times the radius of the *contact point*; a pin whose rear link does not turn (the entry pin, its
 rear link still on the span) spins at half the sheave's rate and its contact point slides circumferentially by
 ``w |x_*| / 2``; a pin sinking radially slides by the tangential part of its radial speed."""
+from dataclasses import replace
+
 import numpy as np
 import pytest
 
@@ -141,14 +143,32 @@ def test_h1_pin_rolling_with_its_sheave_has_zero_slip_and_a_faster_sheave_slips_
     assert np.allclose(np.linalg.norm(d["slip"], axis=1), 0.7 * r, rtol=1e-12)
 
 
+@pytest.mark.parametrize("face", ["cone", "torus"])
+@pytest.mark.parametrize("slopes", [False, True])
+def test_h2_pin_rolling_with_its_sheave_has_zero_slip_with_an_inclined_face(face, slopes):
+    """The face inclined at the flank angle (session 12) turns with the pin: no slip either, the contact point near
+    the axis (cone: on it up to the end slope's shift, ``|x_*| <= |gamma| / m_e``)."""
+    con = replace(_h2(face, slopes), face_inclination=FACES[face].gamma)
+    X, sh, w = _rolling(con, seed=6)
+    _, d = con.local(X, sh, details=True)
+    x = np.linalg.norm(d["offset"], axis=1)
+    assert x.max() < {("cone", False): 1e-15, ("cone", True): 0.3e-3}.get((face, slopes), 2e-3)
+    assert np.allclose(d["spin_rate"], w, rtol=1e-12)
+    assert np.abs(d["slip"]).max() < 1e-12 * np.abs(w).max() * 0.1
+
+
 @pytest.fixture(scope="module")
 def a1_models():
     scene = load_scene("band-6+2n")
     F = np.array([30000.0, 35000.0])
-    return {c: from_scene(scene, reference_geometry(), F, model="chain-A1", contact=c) for c in ("hertz", "hertz-refined")}
+    models = {c: from_scene(scene, reference_geometry(), F, model="chain-A1", contact=c)
+              for c in ("hertz", "hertz-refined")}
+    models["inclined"] = from_scene(scene, reference_geometry(), F, model="chain-A1", contact="hertz-refined",
+                                    face_inclination=scene.cvt.geometry.flank_angle)
+    return models
 
 
-@pytest.mark.parametrize("contact", ["hertz", "hertz-refined"])
+@pytest.mark.parametrize("contact", ["hertz", "hertz-refined", "inclined"])
 def test_a1_pins_turning_with_their_sheaves_do_not_slip(a1_models, contact):
     """The whole-pin chain A1 placed on its path, every pin of an arc (position, tilt and slopes, random) turning
     rigidly with its sheave: the contacts of pins whose two neighbours are on the same arc have zero slip, through
@@ -175,6 +195,15 @@ def test_a1_pins_turning_with_their_sheaves_do_not_slip(a1_models, contact):
     speed_slip = np.linalg.norm(d["slip"], axis=1)
     assert inner.sum() > 40
     assert speed_slip[inner].max() < 1e-12 * speed
-    if contact == "hertz-refined":
+    if contact != "hertz":
         edge = (pl.piece[p] == shafts) & ~inner
-        assert speed_slip[edge].max() > 0.05                   # the entry and exit pins turn slower than the sheave
+        assert speed_slip[edge].max() > 0.05 * (1 if contact == "hertz-refined" else 0.1)   # entry, exit: slower
+    if contact == "inclined":   # both mirrored ends, both shafts: the face parallel to the flank near the pin axis
+        x = np.linalg.norm(d["offset"], axis=1)[inner & (d["delta"] > 0)]
+        x0 = np.linalg.norm(_contacts_details(a1_models["hertz-refined"], q, v)["offset"], axis=1)[inner & (d["delta"] > 0)]
+        assert x.max() < 0.25 * x0.min() and x0.min() > 2.5e-3
+
+
+def _contacts_details(model, q, v):
+    """The contact details of ``model`` at ``(q, v)``."""
+    return model._contacts(q, v, details=True)[3][1]
