@@ -118,13 +118,28 @@ class PinForceProblem(Problem):
         return {"energy_residual": float(residual / dW[0]), "dissipated": float(dW[2])}
 
 
+#: Packages whose code decides a run's result: the model (its start state and the references) ...
+MODEL_CODE = ("elements", "assembly", "machines", "control", "problems", "scene")
+#: ... and, for the rows of test 2, also the integrators.
+RUN_CODE = MODEL_CODE + ("integrate",)
+
+
+def code_stamp(dirs: tuple[str, ...]) -> str:
+    """A short digest (hex) of the cvtfem sources under ``dirs``: what a cached result was computed with."""
+    from cvtfem.elements.jit import sources_digest
+
+    return sources_digest(str(Path(__file__).resolve().parents[1]), dirs).hex()[:16]
+
+
 class StudyCache:
     """Runs of one study kept in a directory, so that a long study can be resumed or split over processes: the
     reference runs' outputs (``reference-METHOD-RTOL.npy``, every component at every sample) and the rows of test 2
     (``runs.json``, wall and CPU times as measured when they ran).  ``key`` names the study (scene, window, samples,
-    start); a directory holding another study's runs is refused."""
+    start); a directory holding another study's runs is refused.  Every result carries the :func:`code_stamp` of the
+    sources it was computed with; one computed with other code (or with no stamp) is run again, not reused."""
 
     def __init__(self, path, key: str):
+        self.model_code, self.run_code = code_stamp(MODEL_CODE), code_stamp(RUN_CODE)
         self.path = Path(path)
         self.path.mkdir(parents=True, exist_ok=True)
         stamp = self.path / "key.txt"
@@ -152,7 +167,20 @@ class StudyCache:
         while wait and not self._file(method, rtol, "npy").exists() and self.running(method, rtol):
             time.sleep(10)
         f = self._file(method, rtol, "npy")
-        return np.load(f) if f.exists() else None
+        return np.load(f) if f.exists() and self._current(self._file(method, rtol, "code")) else None
+
+    def _current(self, stamp: Path) -> bool:
+        """Whether the result stamped in ``stamp`` was computed with today's model code."""
+        return stamp.exists() and stamp.read_text(encoding="utf-8") == self.model_code
+
+    def stale_rows(self) -> list[str]:
+        """Keys of the kept rows of test 2 computed with other code than today's (or before rows were stamped)."""
+        return [key for key, row in self.rows.items() if row.get("code") != self.run_code]
+
+    def row(self, key: str) -> dict | None:
+        """The kept row ``key`` if it was computed with today's code, else ``None``."""
+        row = self.rows.get(key)
+        return row if row is not None and row.get("code") == self.run_code else None
 
     def running(self, method: str, rtol: float) -> bool:
         """True while a process computes this reference run (its mark is removed when the run is kept)."""
@@ -167,11 +195,12 @@ class StudyCache:
     def keep_reference(self, method: str, rtol: float, p) -> None:
         np.save(self._file(method, rtol, "tmp.npy"), np.asarray(p))      # complete before it appears
         self._file(method, rtol, "tmp.npy").replace(self._file(method, rtol, "npy"))
+        self._file(method, rtol, "code").write_text(self.model_code, encoding="utf-8")
 
     def start(self):
         """The kept start state ``(x0, description)`` of the study's runs, or ``None``."""
         f = self.path / "start.npy"
-        if not f.exists():
+        if not f.exists() or not self._current(self.path / "start.code"):
             return None
         return np.load(f), (self.path / "start.txt").read_text(encoding="utf-8")
 
@@ -180,12 +209,14 @@ class StudyCache:
         (self.path / "start.txt").write_text(kind, encoding="utf-8")
         np.save(self.path / "start.tmp.npy", np.asarray(x0, float))
         (self.path / "start.tmp.npy").replace(self.path / "start.npy")
+        (self.path / "start.code").write_text(self.model_code, encoding="utf-8")
 
     def keep_row(self, key: str, row: dict) -> None:
         """Keep a row of test 2 (re-reading the file first: another process may have added rows)."""
         runs = self.path / "runs.json"
         self.rows = json.loads(runs.read_text(encoding="utf-8")) if runs.exists() else {}
         self.rows[key] = {k: (float(v) if isinstance(v, (np.floating, float)) else v) for k, v in row.items()}
+        self.rows[key]["code"] = self.run_code
         runs.write_text(json.dumps(self.rows, indent=0), encoding="utf-8")
 
 
@@ -371,7 +402,8 @@ def measure(problem: PinForceProblem, fixed, steps, adaptive, rtols, repeats: in
     (``atol = 1e-3 rtol``): rows of :func:`~cvtfem.integrate.study.work_precision` (error = ``E``, wall time =
     median of ``repeats``, RHS calls, Jacobians, LU factorisations) with a ``setting`` label and ``cpu``, the CPU
     time per run (s, with the error's evaluation); a method run both ways is labelled ``"NAME adaptive"`` in its
-    adaptive runs.  ``cache``: rows found there are not run again, rows run are kept there."""
+    adaptive runs.  ``cache``: rows found there (computed with today's code) are not run again, rows run are kept
+    there."""
     from cvtfem.integrate.study import work_precision
 
     both = {label for label, _, _ in fixed} & {label for label, _, _ in adaptive}
@@ -384,8 +416,8 @@ def measure(problem: PinForceProblem, fixed, steps, adaptive, rtols, repeats: in
     for label, method, opts in runs:
         setting = f"h={opts['h']:g}" if "h" in opts else f"rtol={opts['rtol']:g}"
         key = f"{label} {method} {setting}"
-        if cache is not None and key in cache.rows:
-            rows.append(cache.rows[key])
+        if cache is not None and cache.row(key) is not None:
+            rows.append(cache.row(key))
             continue
         if not warm:                     # the process's one-off costs out of the first timed run
             problem.warm_up()

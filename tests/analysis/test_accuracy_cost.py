@@ -326,3 +326,23 @@ def test_the_study_cache_keeps_runs_and_refuses_another_study(study, tmp_path):
     assert np.array_equal(cache.reference("Radau", 1e-6), p)
     with pytest.raises(InputError, match="--cache"):
         ac.StudyCache(tmp_path, "chain-S2 window 0:1e-4")
+
+
+def test_the_study_cache_runs_again_what_other_code_computed(study, tmp_path, monkeypatch):
+    """Results kept by other code (another stamp of the model or integrator sources) are not reused: the row runs
+    again, the reference and the start state read as absent and are computed anew; a stamp follows the sources."""
+    _, problem, _ = study
+    cache = ac.StudyCache(tmp_path, "chain-S2 window 0:5e-5")
+    first = ac.measure(problem, [parse_method("rk4")], [1e-6], [], [], repeats=1, cache=cache)
+    cache.keep_start(problem.y0, "quasi-static")
+    cache.keep_reference("Radau", 1e-6, np.ones((2, 2)))
+    assert cache.stale_rows() == [] and cache.start() is not None and cache.reference("Radau", 1e-6) is not None
+    stamps = {"model": ac.code_stamp(ac.MODEL_CODE), "run": ac.code_stamp(ac.RUN_CODE)}
+    assert stamps["model"] != stamps["run"] and stamps["run"] == ac.code_stamp(ac.RUN_CODE)
+    monkeypatch.setattr(ac, "code_stamp", lambda dirs: "edited-" + dirs[-1])
+    edited = ac.StudyCache(tmp_path, "chain-S2 window 0:5e-5")
+    assert edited.stale_rows() == list(edited.rows) and len(edited.rows) == 1
+    assert edited.start() is None and edited.reference("Radau", 1e-6) is None
+    again = ac.measure(problem, [parse_method("rk4")], [1e-6], [], [], repeats=1, cache=edited)
+    assert again[0]["time"] != first[0]["time"] and again[0]["error"] == first[0]["error"]
+    assert edited.stale_rows() == []
