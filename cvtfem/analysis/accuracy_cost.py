@@ -126,7 +126,7 @@ RUN_CODE = MODEL_CODE + ("integrate",)
 
 def code_stamp(dirs: tuple[str, ...]) -> str:
     """A short digest (hex) of the cvtfem sources under ``dirs``: what a cached result was computed with."""
-    from cvtfem.elements.jit import sources_digest
+    from cvtfem.io.sources import sources_digest
 
     return sources_digest(str(Path(__file__).resolve().parents[1]), dirs).hex()[:16]
 

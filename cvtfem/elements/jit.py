@@ -11,9 +11,9 @@ recompiles every kernel of the package once. Kernels of other packages keep numb
 """
 from __future__ import annotations
 
-import functools
-import hashlib
 from pathlib import Path
+
+from cvtfem.io.sources import sources_digest
 
 try:
     from numba import njit
@@ -30,17 +30,6 @@ __all__ = ["njit", "HAVE_NUMBA", "install_locators", "sources_digest"]
 #: constants they import).
 KERNEL_DIRS = ("elements", "assembly", "machines")
 
-
-@functools.lru_cache(maxsize=None)
-def sources_digest(root: str, dirs: tuple[str, ...]) -> bytes:
-    """SHA-256 over the relative paths and contents of every ``.py`` file under ``root/dir`` for ``dirs``."""
-    h = hashlib.sha256()
-    base = Path(root)
-    for d in dirs:
-        for path in sorted((base / d).rglob("*.py")):
-            h.update(str(path.relative_to(base)).encode())
-            h.update(path.read_bytes())
-    return h.digest()
 
 
 def install_locators(root: str | Path, dirs: tuple[str, ...]) -> None:

@@ -112,12 +112,16 @@ def continuation(net: TorsionalNetwork, omega_start: float, omega_stop: float, N
     clock = time.perf_counter()
     sign = 1.0 if omega_stop > omega_start else -1.0
     goals = np.unique(np.append(np.asarray(targets, float), omega_stop))
+    p = load_harmonics(net, N)
+    if not np.any(p):
+        raise InputError("torsional.load", "no nonzero amplitude", "must excite the network (a load with a nonzero "
+                         "amplitude): without one the periodic response is zero at every frequency, with no branch "
+                         "to follow")
     with single_thread_blas():
         first = solve_periodic(net, omega_start, N, samples=samples, tol=tol, a0=a0, raise_on_failure=True)
         M = first.samples or default_samples(N)
         topo = prepare(net)
         D = net.incidence()
-        p = load_harmonics(net, N)
         scale_p = max(np.linalg.norm(p), 1e-300)
         scale = [max(np.linalg.norm(first.a) / np.sqrt(first.a.size), 1e-300)]  # grows with the response
         W = omega_start

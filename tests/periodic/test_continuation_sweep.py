@@ -138,6 +138,14 @@ def test_continuation_that_cannot_finish_says_where():
         continuation(stop_oscillator(), 0.6, 1.8, N, samples=M, max_steps=5)
 
 
+def test_continuation_without_excitation_is_an_input_error():
+    """No load (or only zero amplitudes): the response is zero everywhere and there is no branch to scale and follow
+    (the fuzzer's `periodic` on engine_gear_train without its loads divided 0 by 0); the key is named."""
+    unloaded = build_network([1.0], [0.05], [0], [-1], [4.0], law=[GAP], k_in=[1.0], h=[0.5], orders=(1,), Q=[[0.0]])
+    with pytest.raises(InputError, match="torsional.load"):
+        continuation(unloaded, 0.6, 1.8, N, samples=M)
+
+
 SCENE = """
 title = "hardening one-sided stop"
 [periodic]
