@@ -18,7 +18,7 @@ import tomli_w
 from cvtfem.errors import InputError
 from cvtfem.scene.node import Node, thaw
 from cvtfem.scene.schema import SCENE, scene_kind
-from cvtfem.scene.schema.base import validate
+from cvtfem.scene.schema.base import Key, Table, validate
 
 PRESET_PACKAGE = "cvtfem.scene.presets"
 #: Sub-folder of the partial scenes (regimes, chain patterns) combined with a preset.
@@ -197,9 +197,19 @@ def _refuse_unread(validated: Mapping[str, Any], data: Mapping[str, Any]) -> Non
     presets = resolve_presets({"preset": data["preset"]})
     for key, what in unread.items():
         written, given = _lookup(data, key), _lookup(presets, key)
+        if given is None:                      # the presets leave it to the schema's default
+            given = _schema_default(key)
         if written is not None and given is not None and written != given:
             raise InputError(key, written, f"is not read by `{model}`: it is {what}; leave it at its presets' value "
                              f"{given!r} (a changed value would be ignored)")
+
+
+def _schema_default(key: str) -> Any:
+    """The schema's default of the dotted key (None where it has none or the path is not a plain key)."""
+    node = SCENE
+    for part in key.split("."):
+        node = node.child(part) if isinstance(node, Table) else None
+    return None if not isinstance(node, Key) or node.required else node.default
 
 
 def _lookup(doc: Mapping[str, Any], key: str) -> Any:

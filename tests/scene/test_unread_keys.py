@@ -8,7 +8,7 @@ import pytest
 
 from cvtfem.errors import InputError
 from cvtfem.scene.loader import load_scene, scene_from_dict
-from cvtfem.scene.schema.cvt import CHAIN_UNREAD
+from cvtfem.scene.schema.cvt import CHAIN_UNREAD, ELASTIC_SHAFT_KEYS
 
 
 @pytest.mark.parametrize("key", sorted(CHAIN_UNREAD))
@@ -54,3 +54,16 @@ def test_the_pin_face_keys_are_refused_where_they_are_not_read():
     assert (a.cvt.chain.face_inclination, a.cvt.chain.face_radius) == (0.1, 0.01)
     with pytest.raises(InputError, match="face_inclination"):
         scene_from_dict({"preset": "variant-a", "cvt": {"chain": {"face_inclination": 0.8}}})   # beyond pi/4
+
+
+@pytest.mark.parametrize("key", sorted(ELASTIC_SHAFT_KEYS))
+def test_the_elastic_shaft_keys_are_refused_on_rigid_shafts_and_band_models(key):
+    """The beam and bearing keys are read by a discrete chain on elastic shafts only (session 12's audit)."""
+    shaft, name = key.split(".")[1:]
+    value = load_scene("variant-b").data["cvt"][shaft][name] * 2
+    with pytest.raises(InputError, match=rf"`{key}` is not read by `chain-A1`"):
+        scene_from_dict({"preset": "variant-a", "cvt": {shaft: {name: value}}})             # A1 on rigid shafts
+    with pytest.raises(InputError, match=rf"`{key}` is not read by `band-6\+2n\+8`"):
+        scene_from_dict({"preset": "band-6+2n+8", "cvt": {shaft: {name: value}}})
+    elastic = scene_from_dict({"preset": "variant-b", "cvt": {shaft: {name: value}}})      # read there
+    assert elastic.data["cvt"][shaft][name] == value

@@ -184,13 +184,27 @@ FACE_KEYS = {
 }
 
 
+#: The elastic shafts' beam and bearing model (``machines/shaft_structure.py``): read only by a discrete chain with
+#: ``effects.shaft_elasticity`` (the band models' compliant shaft is ``radial_stiffness`` and ``tilt_stiffness``).
+ELASTIC_SHAFT_KEYS = {
+    f"cvt.{shaft}.{key}": f"the elastic shaft's {what}, read only by a discrete chain with "
+                          "`cvt.effects.shaft_elasticity = true` (rigid shafts and band models have no beam model)"
+    for shaft in ("driving", "driven")
+    for key, what in (("shaft_length", "length between the bearings"), ("shaft_diameter", "diameter"),
+                      ("shaft_elements", "beam element count"), ("bearing_stiffness", "bearing stiffness"),
+                      ("bearing_damping", "bearing damping"), ("sheave_offset", "sheave position on the beam"))
+}
+
+
 def unread_keys(cvt: Mapping[str, Any]) -> dict[str, str]:
-    """Dotted keys the validated CVT table ``cvt`` (its model and contact) does not read, each with what it
-    describes (see :data:`CHAIN_UNREAD`, :data:`FACE_KEYS`)."""
+    """Dotted keys the validated CVT table ``cvt`` (its model, contact and shafts) does not read, each with what it
+    describes (see :data:`CHAIN_UNREAD`, :data:`FACE_KEYS`, :data:`ELASTIC_SHAFT_KEYS`)."""
     model = cvt["model"]
     if not model.startswith("chain"):
-        return dict(FACE_KEYS)
+        return {**FACE_KEYS, **ELASTIC_SHAFT_KEYS}
     unread = dict(CHAIN_UNREAD)
+    if not cvt["effects"]["shaft_elasticity"]:
+        unread.update(ELASTIC_SHAFT_KEYS)
     if cvt["effects"]["contact"] != "hertz-refined":
         unread["cvt.chain.face_inclination"] = FACE_KEYS["cvt.chain.face_inclination"]
     if model == "chain-S1":
