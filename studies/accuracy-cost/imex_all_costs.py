@@ -14,17 +14,9 @@ from cvtfem.analysis.accuracy_cost import StudyCache
 from cvtfem.integrate import solve
 from cvtfem.machines.cvt import closed_loop
 from cvtfem.scene.loader import load_scene
+from imex_costs import median_cpu           # this directory: python puts a script's own on the path
 
 SCENE = "studies/accuracy-cost/scenes/variant-e-rigid-chapter2-linear-saturated.toml"
-
-
-def median_cpu(fn, k=200):
-    ts = []
-    for _ in range(k):
-        t = time.process_time()
-        fn()
-        ts.append(time.process_time() - t)
-    return float(np.median(ts))
 
 
 def main(cache="out/studies/w-short-cache", scheme="frozen-mid"):

@@ -23,6 +23,29 @@ def assert_jacobian_columns(model, x, J, cols) -> None:
         assert np.all(err <= 1e-5 * scale + 1e-6), (c, err.max())
 
 
+def assert_forces_are_minus_the_hertz_gradient(con, X, shafts):
+    """A refined contact's frictionless generalized forces on every position input of the contacts ``X`` (more than
+    100 of them touching, not all) equal minus the central-difference gradient of the Hertz potential of both ends,
+    ``2 x 2/5 c Delta^{5/2}``, to 1e-6 relative; returns the forces."""
+    from cvtfem.elements.contact.hertz import hertz_potential
+
+    Y = con.local(X, shafts)
+    c = con.c[shafts]
+
+    def U(Xm):
+        return 2 * hertz_potential(con.local(Xm, shafts, details=True)[1]["delta"], c)
+    on = con.local(X, shafts, details=True)[1]["delta"] > 0
+    assert 100 < on.sum() < len(X)
+    for j in range(con.n_pos):
+        h = 1e-9
+        Xp, Xm = X.copy(), X.copy()
+        Xp[:, j] += h
+        Xm[:, j] -= h
+        grad = (U(Xp) - U(Xm)) / (2 * h)
+        np.testing.assert_allclose(Y[:, j], -grad, rtol=1e-6, atol=1e-6 * np.abs(Y[:, j]).max() + 1e-9)
+    return Y
+
+
 def assert_energy_balance(model, x0, t_end: float) -> None:
     """A Radau run (rtol 1e-6) over ``[0, t_end]`` s: ``E(t) - E(0)`` = input - output + clamping - dissipated
     work to 1e-6 of the input work, with power going in and friction dissipating some."""

@@ -15,12 +15,12 @@ import pytest
 from cvtfem.elements.chain.geometry import reference_geometry
 from cvtfem.elements.chain.sheave_contact import SheaveContact
 from cvtfem.elements.chain.symmetric import END_SLOPE_FACTOR
-from cvtfem.elements.contact.hertz import hertz_potential
 from cvtfem.elements.contact.refined import pin_coefficients, refined_contact, sheave_coefficients
 from cvtfem.elements.chain.sheave_contact_refined import face_derivatives
 from cvtfem.errors import InputError
 from cvtfem.machines.chain_cvt import from_scene
 from cvtfem.scene.loader import load_scene
+from tests.machines.chain_checks import assert_forces_are_minus_the_hertz_gradient
 from tests.machines.test_chain_refined import CONE, F_APPL, S, _random_inputs, _unit_chord_normal
 
 FIXTURE = Path(__file__).parents[2] / "data" / "refined_kernel_theta0.npz"
@@ -137,20 +137,7 @@ def test_forces_are_minus_the_gradient_of_the_hertz_potential(contacts, model, f
     spin) = minus the central-difference gradient of 2 x 2/5 c Delta^{5/2}, 1e-6 relative; nonzero twist."""
     con = replace(contacts[model, face], f0=0.0, face_inclination=THETA)
     X, shafts = _random_inputs(con, seed=23)
-    Y = con.local(X, shafts)
-    c = con.c[shafts]
-
-    def U(Xm):
-        return 2 * hertz_potential(con.local(Xm, shafts, details=True)[1]["delta"], c)
-    on = con.local(X, shafts, details=True)[1]["delta"] > 0
-    assert 100 < on.sum() < len(X)
-    for j in range(con.n_pos):
-        h = 1e-9
-        Xp, Xm = X.copy(), X.copy()
-        Xp[:, j] += h
-        Xm[:, j] -= h
-        grad = (U(Xp) - U(Xm)) / (2 * h)
-        np.testing.assert_allclose(Y[:, j], -grad, rtol=1e-6, atol=1e-6 * np.abs(Y[:, j]).max() + 1e-9)
+    Y = assert_forces_are_minus_the_hertz_gradient(con, X, shafts)
     assert np.abs(Y[:, [0, 1, 4, 5]]).max() > 1e-4 * np.abs(Y[:, 2:4]).max()     # twist from the turning face
     assert np.all(Y[:, con.n_pos] == 0)
 
