@@ -46,6 +46,20 @@ def assert_forces_are_minus_the_hertz_gradient(con, X, shafts):
     return Y
 
 
+def assert_friction_power_is_the_work_rate(con, X, shafts) -> None:
+    """A refined contact's friction power output equals the work rate of its friction forces (the forces less the
+    frictionless ones) on the velocity inputs, 1e-10, and ``2 F_fr . slip`` (both ends), 1e-12; it dissipates."""
+    from dataclasses import replace
+
+    Y, d = con.local(X, shafts, details=True)
+    Qfr = Y - replace(con, f0=0.0).local(X, shafts)
+    n = con.n_pos
+    power = (Qfr[:, :n] * X[:, n:2 * n]).sum(1) + Qfr[:, n] * X[:, -1]
+    np.testing.assert_allclose(Y[:, -1], power, rtol=1e-10, atol=1e-10 * np.abs(power).max())
+    np.testing.assert_allclose(Y[:, -1], 2 * (d["F_fr"] * d["slip"]).sum(1), rtol=1e-12, atol=1e-300)
+    assert np.all(Y[:, -1] <= 0) and Y[:, -1].min() < -1.0
+
+
 def assert_energy_balance(model, x0, t_end: float) -> None:
     """A Radau run (rtol 1e-6) over ``[0, t_end]`` s: ``E(t) - E(0)`` = input - output + clamping - dissipated
     work to 1e-6 of the input work, with power going in and friction dissipating some."""

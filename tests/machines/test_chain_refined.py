@@ -18,7 +18,7 @@ from cvtfem.machines.chain_cvt import from_scene
 from cvtfem.machines.chain_cvt_refined import RefinedChainCVT
 from cvtfem.scene.loader import load_scene
 from tests.machines.chain_checks import (assert_energy_balance, assert_forces_are_minus_the_hertz_gradient,
-                                         assert_jacobian_columns)
+                                         assert_friction_power_is_the_work_rate, assert_jacobian_columns)
 
 RATIO = 2.4
 F_APPL = np.array([30000.0, 35000.0])
@@ -180,13 +180,7 @@ def test_forces_are_minus_the_gradient_of_the_hertz_potential(models, model, fac
 def test_friction_power_is_the_work_rate_of_the_friction_forces(models, model):
     con = models[model].contact
     X, shafts = _random_inputs(con, seed=4)
-    Y, d = con.local(X, shafts, details=True)
-    Qfr = Y - replace(con, f0=0.0).local(X, shafts)
-    n = con.n_pos
-    power = (Qfr[:, :n] * X[:, n:2 * n]).sum(1) + Qfr[:, n] * X[:, -1]
-    np.testing.assert_allclose(Y[:, -1], power, rtol=1e-10, atol=1e-10 * np.abs(power).max())
-    np.testing.assert_allclose(Y[:, -1], 2 * (d["F_fr"] * d["slip"]).sum(1), rtol=1e-12, atol=1e-300)
-    assert np.all(Y[:, -1] <= 0) and Y[:, -1].min() < -1.0
+    assert_friction_power_is_the_work_rate(con, X, shafts)
 
 
 def test_restoring_moment_against_misalignment(models):
