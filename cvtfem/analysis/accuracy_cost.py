@@ -288,8 +288,6 @@ def pin_force_problem(scene, window: tuple[float, float] = (1e-3, 5e-3), sample:
     (``settle``: by the reference method; ``placed``), so both references share the start state.  ``cache``: take
     the reference outputs from there where it holds them, and keep those computed.
     """
-    from cvtfem.integrate import solve
-
     t1, t2 = (float(v) for v in window)
     if not (0 <= t1 < t2 and np.isfinite(t2)):
         raise InputError("--window", window, "must be two simulated times 0 <= t1 < t2, s")

@@ -515,7 +515,7 @@ class ChainHalvesCVT(ChainACVT):
             return None
         P = sp.csr_matrix(self.jac_sparsity, dtype=bool, copy=True)
         P.sort_indices()
-        n2, nz, N = self.n2, self.control.size, self.size
+        n2, nz = self.n2, self.control.size
         nc, iphi, _, _ = self._idx
         fp = self.family.jac_sparsity
         mi_ptr, mi_idx, _ = self._chain_inverse_mass

@@ -56,7 +56,7 @@ from cvtfem.elements.chain.asymmetric import (_M_PAR, _M_PERP, ChainA1, _cross, 
                                               shape_slopes)
 from cvtfem.elements.chain.implicit_friction import FrictionSet, friction_step
 from cvtfem.elements.contact.friction import LAWS, friction_gain
-from cvtfem.errors import InputError, NumericalError
+from cvtfem.errors import InputError
 from cvtfem.outputs import OutputSpec
 
 #: Gauss stations and weights of the half-half and half-plate contacts along the pin (sum of weights 2).

@@ -15,7 +15,6 @@ from cvtfem.elements.band.geometry import Sheave
 from cvtfem.elements.chain.geometry import reference_geometry
 from cvtfem.elements.chain.sheave_contact import SheaveContact
 from cvtfem.elements.chain.sheave_contact_refined import RefinedSheaveContact
-from cvtfem.elements.chain.symmetric import END_SLOPE_FACTOR
 from cvtfem.machines.chain_cvt import from_scene
 from cvtfem.scene.loader import load_scene
 
