@@ -183,11 +183,10 @@ def campbell(problem: ModalProblem, speeds: np.ndarray, n_modes: int,
         raise InputError("speeds", speeds.tolist()[:5], "must be one or more increasing speeds")
     modes = [problem.solve(s, n_modes + extra, min_modes=n_modes) for s in speeds]
     idx, match = track(modes, n_modes)
-    rows = np.arange(len(speeds))[:, None]
-    wd = np.array([m.wd for m in modes])[rows, idx]
-    wn = np.array([m.wn for m in modes])[rows, idx]
-    zeta = np.array([m.damping_ratio for m in modes])[rows, idx]
-    whirl = np.array([m.whirl for m in modes])[rows, idx]
+
+    def tracked(attr: str) -> np.ndarray:      # a speed may return more modes than another (min_modes only bounds)
+        return np.array([np.asarray(getattr(m, attr))[i] for m, i in zip(modes, idx)])
+    wd, wn, zeta, whirl = (tracked(a) for a in ("wd", "wn", "damping_ratio", "whirl"))
     trimmed = tuple(Modes(m.speed, m.eigenvalues[:n_modes], m.shapes[:, :n_modes], m.whirl[:n_modes],
                           m.whirl_ratio[:n_modes]) for m in modes)
     jumps = tuple({"mode": int(j), "speed_rad_s": float(speeds[i]), "mac": float(match[i, j])}

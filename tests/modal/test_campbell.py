@@ -92,3 +92,21 @@ def test_tracking_flags_a_lost_mode():
     swapped = Modes(1.0, np.array([1j, 2j]), e[:, [1, 2]], ("forward", "forward"), np.ones(2))
     index, match = track([first, swapped], 2)
     assert index[1].tolist() == [1, 0] and match[1].tolist() == [0.0, 1.0] and MAC_JUMP == 0.5
+
+
+def test_speeds_returning_different_mode_counts_are_tracked():
+    """A speed may return more converged modes than another (``min_modes`` only bounds from below): the tracked
+    arrays take each speed's own modes (the slow fuzzer's friswell_5_9_1 with a heavy disk and a negative bearing
+    stiffness stacked ragged lists)."""
+    scene = load_scene("friswell_5_9_1").replace({"disk": [{"node": 2, "mass": 32.59, "Id": 0.1781, "Ip": 29807481.0},
+                                                           {"node": 4, "mass": 51.53, "Id": 0.4236, "Ip": 0.8051}],
+                                                  "bearing": [{"node": 0, "kxx": 1e6, "kyy": 1e6},
+                                                              {"node": 6, "kxx": -1e6, "kyy": 1e6}]})
+    m = build_model(scene)
+    problem = ModalProblem(m.M, m.K, m.C, m.G, m.dof_kind)
+    speeds = np.array([0.0, 157.07963267948966, 314.1592653589793])
+    modes = [problem.solve(s, 16, min_modes=12) for s in speeds]
+    assert len({len(m.wd) for m in modes}) > 1                      # the case: counts differ between speeds
+    result = campbell(problem, speeds, 12)
+    assert result.wd.shape == result.wn.shape == result.whirl.shape == (3, 12)
+    assert np.all(result.wn >= 0)
