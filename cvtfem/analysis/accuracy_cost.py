@@ -414,8 +414,9 @@ def measure(problem: PinForceProblem, fixed, steps, adaptive, rtols, repeats: in
     for label, method, opts in runs:
         setting = f"h={opts['h']:g}" if "h" in opts else f"rtol={opts['rtol']:g}"
         key = f"{label} {method} {setting}"
-        if cache is not None and cache.row(key) is not None:
-            rows.append(cache.row(key))
+        kept = cache.row(key) if cache is not None else None
+        if kept is not None:
+            rows.append(kept)
             continue
         if not warm:                     # the process's one-off costs out of the first timed run
             problem.warm_up()

@@ -213,9 +213,10 @@ def run(args: argparse.Namespace) -> int:
         spectrum = spectrum_summary(lam, lam_v0)
         print(f"spectrum at t = {t0:g} s: min Re {lam.real.min():.3g} 1/s ({lam_v0.real.min():.3g} with v0/10), max "
               f"|Im| {np.abs(lam.imag).max():.3g} 1/s ({np.abs(lam_v0.imag).max():.3g}), max Re {lam.real.max():.3g}")
-    if args.from_cache and cache.stale_rows():
-        print(f"WARNING: {len(cache.stale_rows())} of the {len(cache.rows)} rows were measured with other code than "
-              f"today's (run them again without --from-cache): {', '.join(cache.stale_rows())}")
+    stale = cache.stale_rows() if args.from_cache else []
+    if stale:
+        print(f"WARNING: {len(stale)} of the {len(cache.rows)} rows were measured with other code than today's (run "
+              f"them again without --from-cache): {', '.join(stale)}")
     rows = ac.distinct_labels(sorted(cache.rows.values(), key=lambda r: (r["label"], -r.get("h", r.get("rtol", 0.0))))
                               if args.from_cache else
                               ac.measure(problem, fixed, steps, adaptive, rtols, args.repeats, cache))
