@@ -17,7 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
-from cvtfem.analysis.steppers import make_stepper
+from cvtfem.analysis.steppers import check_method_options, make_stepper
 from cvtfem.analysis.summary import EFFICIENCY_WINDOW, RunSummary, summarise
 from cvtfem.blas import single_thread_blas
 from cvtfem.errors import InputError, NumericalError
@@ -199,7 +199,11 @@ class _Run:
         # the start of the efficiency window among the samples
         j = int(np.searchsorted(self.t_out, self.t_out[-1] - EFFICIENCY_WINDOW))
         self.j_window = 0 if j >= len(self.t_out) - 1 else j  # run shorter than one output step past the window
+        from cvtfem.integrate.methods import parse_options
+
         sol = scene.solver
+        self.options = check_method_options(sol.method, parse_options(sol.options, "solver.options",
+                                                                      "scheme=imex-rk4"))
         if sol.on_failure == "retry":  # the fallback runs adaptive: refuse one without error estimate now
             try:
                 make_stepper(sol.fallback, lambda t, y: -y, 0.0, [1.0], 1.0, sol.rtol, sol.atol)
@@ -373,7 +377,8 @@ class _Run:
                                events=self.events, switch=self.switch,
                                jac_sparsity=getattr(loop, "jac_sparsity", None),
                                stall_steps=STALL_STEPS, stall_h=STALL_FRACTION * t_end,
-                               split=getattr(loop, "stiff_split", None))
+                               split=getattr(loop, "stiff_split", None),
+                               options=self.options if method == sol.method else None)
         except BaseException as err:
             if writer is not None:
                 writer.close("failed", str(err))

@@ -81,23 +81,13 @@ def parse_method(spec: str) -> tuple[str, str, dict]:
     import inspect
 
     from cvtfem.integrate.driver import solve
+    from cvtfem.integrate.methods import parse_options
 
     name, *pairs = spec.strip().split(":")
-    opts = {}
-    for pair in pairs:
-        key, sep, val = pair.partition("=")
-        if not sep:
-            raise InputError("--methods", spec, "options must be key=value, e.g. gbs:stages=2")
+    opts = parse_options(pairs, "--methods", "gbs:stages=2")
+    for key in opts:
         if key in inspect.signature(solve).parameters:   # h, rtol, ...: the study sets them
             raise InputError("--methods", spec, f"options must be the method's own, not `{key}` (the study sets it)")
-        for conv in (int, float):
-            try:
-                opts[key] = conv(val)
-                break
-            except ValueError:
-                continue
-        else:
-            opts[key] = {"true": True, "false": False}.get(val.lower(), val)
     return spec.strip(), name, opts
 
 

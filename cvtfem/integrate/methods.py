@@ -18,7 +18,7 @@ from cvtfem.errors import InputError
 from cvtfem.integrate.base import Stepper
 
 __all__ = ["METHODS", "SCIPY_METHODS", "register_method", "unregister_method", "all_options", "check_options",
-           "IgnoredOptionWarning"]
+           "parse_options", "method_options", "IgnoredOptionWarning"]
 
 _NATIVE: dict[str, type] = {}
 _SCIPY: dict[str, type] = {}
@@ -79,6 +79,32 @@ def all_options() -> frozenset[str]:
     for cls in METHODS.values():
         out |= cls.OPTIONS
     return frozenset(out)
+
+
+def parse_options(pairs, where: str, example: str = "stages=2") -> dict:
+    """``["stages=2", "proportional=false", "scheme=imex-rk4"]`` -> ``{"stages": 2, "proportional": False,
+    "scheme": "imex-rk4"}``: numbers become int or float, ``true``/``false`` booleans; ``where`` names the argument or
+    key in the error of a pair without ``=``."""
+    opts = {}
+    for pair in pairs:
+        key, sep, val = pair.partition("=")
+        key, val = key.strip(), val.strip()
+        if not sep or not key:
+            raise InputError(where, pair, f"options must be key=value, e.g. {example}")
+        for conv in (int, float):
+            try:
+                opts[key] = conv(val)
+                break
+            except ValueError:
+                continue
+        else:
+            opts[key] = {"true": True, "false": False}.get(val.lower(), val)
+    return opts
+
+
+def method_options(method: str) -> frozenset[str]:
+    """The options the native method ``method`` accepts (none for scipy's methods: ``cvtfem run`` passes them none)."""
+    return METHODS[method].OPTIONS if method in METHODS else frozenset()
 
 
 def check_options(method: str, accepted: frozenset, options: dict) -> dict:

@@ -21,6 +21,9 @@ EVENT = TableArray("event", "Events of a run: a named scalar output crossing a v
 
 SOLVER = Table("solver", "Time integration settings (used by `cvtfem run`).", (
     Key("method", "str", "Integration method.", "", "Radau", choices=METHODS),
+    Key("options", "str[]", "Options of `solver.method` as key=value, e.g. ['scheme=imex-rk4', 'friction=all'] for "
+        "'strang-friction' (an option the method does not take is refused with the list it takes; scipy's methods "
+        "take none).", "", ()),
     Key("t_end", "float", "Simulated time to reach.", "s", 1.0, gt=0.0),
     Key("h", "float", "Fixed step, or initial step of adaptive methods (0: automatic).", "s", 0.0, ge=0.0),
     Key("rtol", "float", "Relative tolerance of adaptive methods.", "-", 1e-6, gt=0.0, lt=1.0),

@@ -1,0 +1,52 @@
+"""The scene key ``solver.options``: a method's own options reach its stepper through ``cvtfem run``; an option the
+method does not take, a malformed pair or a bad value is an InputError naming the key, before any results file."""
+from __future__ import annotations
+
+import pytest
+
+from cvtfem.analysis.run import run_scene
+from cvtfem.errors import InputError
+from cvtfem.integrate.methods import parse_options
+from cvtfem.scene.loader import load_scene
+
+
+def _gbs(options, tmp_path=None):
+    scene = load_scene("band-4dof", {"solver": {"method": "gbs", "h": 2e-5, "options": options}})
+    return run_scene(scene, until=0.004, show_progress=False,
+                     results=None if tmp_path is None else tmp_path / "r.h5")
+
+
+def test_options_reach_the_method():
+    """GBS extrapolates over 4 stages by default (17 RHS calls a step); with ``stages=2`` it takes 5 a step and its
+    run differs (within its lower order's error), and ``stages=4`` is the default run bit for bit."""
+    default, two, four = _gbs([]), _gbs(["stages=2"]), _gbs(["stages=4"])
+    steps = default.solver["steps"]
+    assert default.solver["nfev"] == 1 + 17 * steps and two.solver["nfev"] == 1 + 5 * steps
+    assert four.solver["nfev"] == default.solver["nfev"] and four.ratio == default.ratio
+    assert two.ratio != default.ratio and two.ratio == pytest.approx(default.ratio, rel=2e-3)
+
+
+@pytest.mark.parametrize("options, value, rule", [
+    (["scheme=imex-rk4"], "scheme=imex-rk4", "must be an option of 'gbs': sequence, stages"),
+    (["stages"], "stages", "options must be key=value"),
+    (["sequence=fibonacci"], "sequence=fibonacci", "sequence"),
+])
+def test_bad_options_are_input_errors_before_any_results(tmp_path, options, value, rule):
+    with pytest.raises(InputError) as err:
+        _gbs(options, tmp_path)
+    assert err.value.where == "solver.options" and err.value.value == value and rule in str(err.value)
+    if err.value.value != "sequence=fibonacci":       # the value is the method's to judge: at its construction
+        assert not (tmp_path / "r.h5").exists()
+
+
+def test_scipy_methods_take_no_options():
+    scene = load_scene("band-4dof", {"solver": {"method": "RK45", "options": ["first_step=1e-6"]}})
+    with pytest.raises(InputError, match="`solver.options` must be an option of 'RK45': it takes none"):
+        run_scene(scene, until=0.001, show_progress=False)
+
+
+def test_parse_options_converts_numbers_and_booleans():
+    assert parse_options(["stages=2", "d=0.5", "proportional=False", "scheme=imex-rk4"], "x") == {
+        "stages": 2, "d": 0.5, "proportional": False, "scheme": "imex-rk4"}
+    with pytest.raises(InputError, match="`x` options must be key=value"):
+        parse_options(["=2"], "x")
