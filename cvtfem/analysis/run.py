@@ -302,8 +302,11 @@ class _Run:
             sparsity = getattr(self.loop, "jac_sparsity", None)
             fields = [("t_end", 1), ("k", 1), ("steps", 1), ("next_checkpoint", 1), ("t_last", 1), ("x_last", n),
                       ("x_window", n), ("wall", 1), ("retry", 1)] + list(loop_fields(n, m))
+            split = getattr(self.loop, "stiff_split", None)
             for method in self.methods():
-                fields += [(f"{method}:{name}", size) for name, size in memory_fields(method, n, n2, sparsity)]
+                options = self.options if method == self.scene.solver.method else None
+                fields += [(f"{method}:{name}", size)
+                           for name, size in memory_fields(method, n, n2, sparsity, options, split)]
             self._layout = Layout(tuple(fields))
         return self._layout
 

@@ -23,7 +23,7 @@ from cvtfem.integrate.events import EVENT_SAMPLES, EventLocator
 from cvtfem.integrate.guards import ErrorMonitor, GrowthGuard
 from cvtfem.integrate.methods import METHODS, SCIPY_METHODS, check_options
 from cvtfem.integrate.stats import COUNTERS, Stats
-from cvtfem.integrate.system import OdeSystem
+from cvtfem.integrate.system import OdeSystem, as_system
 
 __all__ = ["Stepping", "NativeEngine", "Candidate", "make_engine", "initial_step", "state_fields", "GROWTH_LIMIT",
            "ZENO_GAP", "ZENO_GAP_H", "ZENO_COUNT"]
@@ -408,11 +408,14 @@ def state_fields(method: str, n: int, n2: int = 0, n_events: int = 0, jac_sparsi
     return loop_fields(n, n_events) + memory_fields(method, n, n2, jac_sparsity)
 
 
-def memory_fields(method: str, n: int, n2: int = 0, jac_sparsity=None) -> tuple[tuple[str, int], ...]:
-    """The method part of :meth:`Stepping.fields` for ``n`` states, without building a run."""
+def memory_fields(method: str, n: int, n2: int = 0, jac_sparsity=None, options: dict | None = None,
+                  split=None) -> tuple[tuple[str, int], ...]:
+    """The method part of :meth:`Stepping.fields` for ``n`` states, without building a run (``options`` and the
+    model's stiff ``split`` as the run's: ``strang-friction``'s memory is its explicit method's)."""
     if method in SCIPY_METHODS:
         from cvtfem.integrate.scipy_bridge import scipy_fields
 
         return scipy_fields(method, n, jac_sparsity)
-    system = OdeSystem(fun=lambda t, x: x, n=n, n2=n2, jac_sparsity=jac_sparsity)
-    return METHODS[method](system, Stats()).memory_fields() + (("controller", len(CONTROLLER_MEMORY)),)
+    system = as_system(lambda t, x: x, np.zeros(n), n2=n2, jac_sparsity=jac_sparsity, split=split)
+    stepper = METHODS[method](system, Stats(), **(options or {}))
+    return stepper.memory_fields() + (("controller", len(CONTROLLER_MEMORY)),)
