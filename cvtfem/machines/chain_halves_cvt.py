@@ -389,24 +389,27 @@ class ChainHalvesCVT(ChainACVT):
         energy balance closes exactly.  Newton starts from the friction's acceleration of the previous solve (a guess
         only: the solution is unique).  Returns the new state and the Newton iterations (each one sparse LU)."""
         chain, nc, n2 = self.family.chain, self.family.size, self.n2
-        key = x[:nc].tobytes()
-        if self._slips[0] != key:
-            self._slips = (key, *chain.friction_slips(x[:nc]))
+        key, kept = x[:nc].tobytes(), self._friction_kept
+        if kept.get("halves", (None,))[0] != key:
+            kept["halves"] = (key, *chain.friction_slips(x[:nc]))
         v_star = x[n2:n2 + nc]
         accel = self._friction_accel.get("halves")
         guess = None if accel is None else v_star + h * accel
-        v, W, its = chain.friction_step(self._slips[1], self._slips[2], v_star, h, guess)
+        v, W, its = chain.friction_step(*kept["halves"][1:], v_star, h, guess)
         self._friction_accel["halves"] = (v - v_star) / h
         out = np.array(x, float)
         out[n2:n2 + nc] = v
         out[2 * n2 + self.control.size + 2] += W
         return out, its
 
-    _slips: tuple = (None, None, None)
-
     @cached_property
     def _friction_accel(self) -> dict:
         """The friction accelerations of the last solve of each split (Newton's start guess)."""
+        return {}
+
+    @cached_property
+    def _friction_kept(self) -> dict:
+        """The slips of the last positions each split solved at, by split (``(key, ...)``: its stages share them)."""
         return {}
 
     # ----- all friction implicit: the pin-sheave friction of the H2 half ends joins f_I ---------------------------
@@ -479,21 +482,19 @@ class ChainHalvesCVT(ChainACVT):
         """:meth:`friction_solve` of all friction (:meth:`friction_sets`) on all velocities (chain, shafts and sheaves:
         :func:`~cvtfem.elements.chain.implicit_friction.friction_step`, the shafts' and sheaves' as its border)."""
         n2 = self.n2
-        key = x[:n2].tobytes()
-        if self._all_sets[0] != key:
-            self._all_sets = (key, self.friction_sets(x))
+        key, kept = x[:n2].tobytes(), self._friction_kept
+        if kept.get("all", (None,))[0] != key:
+            kept["all"] = (key, self.friction_sets(x))
         v_star = x[n2:2 * n2]
         accel = self._friction_accel.get("all")
         guess = None if accel is None else v_star + h * accel
         M, Mi, border = self._masses
-        v, W, its = friction_step(M, Mi, self._all_sets[1], v_star, h, guess, border=border, tol=self.FRICTION_TOL)
+        v, W, its = friction_step(M, Mi, kept["all"][1], v_star, h, guess, border=border, tol=self.FRICTION_TOL)
         self._friction_accel["all"] = (v - v_star) / h
         out = np.array(x, float)
         out[n2:2 * n2] = v
         out[2 * n2 + self.control.size + 2] += W
         return out, its
-
-    _all_sets: tuple = (None, None)
 
     def friction_hold(self, x, d):
         """The rate at ``x`` of the friction forces ``M d_v`` held constant (``d_v``: ``d``'s velocity rows, m/s^2 and

@@ -33,9 +33,12 @@ from typing import ClassVar
 import numpy as np
 import scipy.sparse as sp
 
+from cvtfem.elements.chain import mapped_contact_kernel as MCK
+from cvtfem.elements.chain import mapped_half_end_slips as MHS
+from cvtfem.elements.contact.friction import POTENTIAL_LAWS
 from cvtfem.errors import NumericalError
 from cvtfem.machines.chain_cvt_elastic import ElasticChainACVT
-from cvtfem.machines.chain_halves_cvt import ChainHalvesCVT
+from cvtfem.machines.chain_halves_cvt import ChainHalvesCVT, HalvesFamily
 from cvtfem.machines.chain_halves_refined_cvt import ChainHalvesRefinedCVT
 from cvtfem.machines.static_balance import lifted_newton
 
@@ -192,6 +195,66 @@ class ElasticChainHalvesRefinedCVT(ElasticChainHalvesCVT, ChainHalvesRefinedCVT)
     refined_end_slots: ClassVar[tuple] = (0, 1, 4)
 
     half_end_frame: ClassVar[bool] = True
+
+    # ----- the friction split off (stiff, solved implicitly), on elastic shafts ---------------------------------------
+    @cached_property
+    def stiff_split(self) -> tuple | None:
+        """:attr:`ChainHalvesCVT.stiff_split` on elastic shafts: ``f_E`` the same model without the halves' internal
+        friction (default) or without any friction (variant ``"all"``), each as a frictionless twin of this model
+        (:attr:`_frictionless`); ``f_I`` solved on the chain's velocities (halves) or on all velocities with the
+        sheaves' structure coordinates as the border (``"all"``: :meth:`sheave_slips` through the sheave frames,
+        :attr:`_masses` with the structure's consistent mass).  None without friction in the halves."""
+        if self.family.chain.f0 == 0.0:
+            return None
+        variants = {"all": (self.rhs_explicit_all, self.friction_solve_all, self.friction_hold)} if (
+            self._sheave_friction) else {}
+        return self.rhs_explicit, self.friction_solve, self.friction_hold, variants
+
+    @cached_property
+    def _frictionless(self) -> dict:
+        """This model without the halves' internal friction (``"halves"``) and without any friction (``"all"``)."""
+        fam, h2 = self.family, self.contact.pair.pair
+        halves = replace(self, family=HalvesFamily(fam.chain.without_friction(), fam.geom))
+        contact = replace(self.contact, pair=replace(self.contact.pair, pair=replace(h2, f0=0.0)))
+        return {"halves": halves, "all": replace(halves, contact=contact)}
+
+    def rhs_explicit(self, t: float, x):
+        """:meth:`rhs` without the halves' internal friction: ``f_E`` of :attr:`stiff_split`."""
+        return self._frictionless["halves"].rhs(t, x)
+
+    def rhs_explicit_all(self, t: float, x):
+        """:meth:`rhs` without any friction: ``f_E`` of the split's variant ``"all"``."""
+        return self._frictionless["all"].rhs(t, x)
+
+    @cached_property
+    def _sheave_friction(self) -> tuple | None:
+        """``(compiled mapped-contact constants, pin-sheave law (f0, v0, name))`` where the pin-sheave friction can
+        join ``f_I`` (the compiled H2 half-end contact, a law with a potential, ``f0 > 0``), else None."""
+        ck, h2 = self._compiled_mapped, self.contact.pair.pair
+        if ck is None or ck[4] != MCK.REFINED_HALF_END or h2.law not in POTENTIAL_LAWS or h2.f0 == 0.0:
+            return None
+        return ck, (float(h2.f0), float(h2.v0), h2.law)
+
+    def sheave_slips(self, x) -> tuple[sp.csr_matrix, np.ndarray]:
+        """``(G, N)`` of :meth:`ChainHalvesCVT.sheave_slips` for the contacts in their sheaves' frames: ``G``'s
+        columns reach the sheaves' translation, tilt and spin rates (:func:`~cvtfem.elements.chain.
+        mapped_half_end_slips.slip_map`)."""
+        n2, table, ck = self.n2, self._mapped_table, self._sheave_friction[0]
+        cols = table[0]
+        P, size = cols.shape[0], 3 * cols.shape[0] * cols.shape[1] * cols.shape[2]
+        N, r, c, d = np.empty(P), np.empty(size, np.int64), np.empty(size, np.int64), np.empty(size)
+        m, k, bad = MHS.slip_map(np.ascontiguousarray(x[:2 * n2]), *table[:4], *ck[:4], *ck[5:11], n2, N, r, c, d)
+        self._raise_on_axis(bad)
+        return sp.csr_matrix((d[:k], (r[:k], c[:k])), shape=(3 * m, n2)), N[:m]
+
+    @cached_property
+    def _masses(self) -> tuple:
+        """``(M, M^-1, border)``: the mass matrix of all velocities (chain, structure), its inverse and the border:
+        the structure coordinates the sheaves' frames read (their translation, tilt, axial position and spin)."""
+        ch, s = self.family.chain, self.structure
+        M = sp.block_diag([ch.mass_matrix, s.M], format="csr")
+        Mi = sp.block_diag([ch.inverse_mass, sp.csr_matrix(self._structure_inverse)], format="csr")
+        return M, Mi, self._idx[0] + np.unique(s.sheave_dofs)
 
     def _refined_frame(self, P, k, j):
         """``(K, dK/dP)``: the half-end contact's inputs (m, 8: end, chord, ``x3``, slope, ``z_ref``) in the frame of
