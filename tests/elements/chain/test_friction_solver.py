@@ -34,7 +34,7 @@ def _random_system(rng, n_contacts=60, n_vel=150):
 
 
 def _chain_system(rng, n_pins=40, dofs=4):
-    """Contacts of a closed chain: each pin's slips read its own dofs and the next pin's (the last pin's the first's)."""
+    """Contacts of a closed chain: the slips of a pin read its dofs and the next pin's (the last pin: the first's)."""
     sizes = np.tile([1, 2], n_pins)
     rows, cols = [], []
     r = 0
