@@ -439,8 +439,9 @@ class ChainHalvesCVT(ChainACVT):
 
     def sheave_slips(self, x) -> tuple[sp.csr_matrix, np.ndarray]:
         """``(G, N)``: the slips of the pin-sheave contacts in touch at the positions of ``x``, ``s = G v`` (2 rows per
-        contact: the tangent-plane slip in an orthonormal basis of the plane, m/s; columns the velocities ``v`` (n2,)), and their normal forces ``N`` (N): the contacts' friction
-        forces are ``-G^T (N psi(|s|) s)`` (:func:`~cvtfem.elements.chain.half_end_slips.slip_map`)."""
+        contact: the tangent-plane slip in an orthonormal basis of the plane, m/s; columns the velocities ``v``
+        (n2,)), and their normal forces ``N`` (N): the contacts' friction forces are ``-G^T (N psi(|s|) s)``
+        (:func:`~cvtfem.elements.chain.half_end_slips.slip_map`)."""
         n2, table = self.n2, self._pair_table
         P, K = table[0].shape[0], table[0].shape[2]
         N, size = np.empty(P), 2 * P * HES.N_VEL * K
