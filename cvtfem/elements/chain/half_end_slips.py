@@ -30,8 +30,9 @@ def slip_map(y, cols, coef, shaft, centres, r2, meridians, face_radius, slope_fa
              N, r_out, c_out, v_out):
     """The contacts in touch at the positions of ``y = [q, v, constants]``: their normal forces into ``N`` and the
     entries of ``G`` (2 rows per contact: the tangent-plane slip in the basis of :func:`_plane`; columns the
-    velocities ``v`` (n2,); duplicates to be summed) into ``r_out``, ``c_out``, ``v_out``.  Returns ``(contacts, entries, first pair with its half end on the shaft axis or
-    -1)``; ``N`` needs ``cols.shape[0]`` places, the entries ``2 cols.shape[0] * N_VEL * cols.shape[2]``."""
+    velocities ``v`` (n2,); duplicates to be summed) into ``r_out``, ``c_out``, ``v_out``.  Returns ``(contacts,
+    entries, first pair with its half end on the shaft axis or -1)``; ``N`` needs ``cols.shape[0]`` places, the
+    entries ``2 cols.shape[0] * N_VEL * cols.shape[2]``."""
     P = cols.shape[0]
     X, sh, pair = np.empty((P, N_IN)), np.empty(P, np.int64), np.empty(P, np.int64)
     m = _candidates(y, cols, coef, shaft, centres, r2, X, sh, pair)
