@@ -1,14 +1,15 @@
 """The pin-sheave friction of variant (e) (H2 at the pin-half ends) as a linear slip map at frozen positions.
 
-With the positions frozen, the slip of every H2 contact is linear in the velocities, ``s_k = G_k v`` (3 rows per
+With the positions frozen, the slip of every H2 contact is linear in the velocities, ``s_k = G_k v`` (2 rows per
 contact: the relative velocity at the contact point projected on its tangent plane, m/s, in an orthonormal basis of
-that plane: two rows), its normal force ``N_k``
-(N) is fixed, and the friction forces are ``Q = -G^T (N psi(|s|) s)`` per contact (the friction power ``F . s`` the
-contact kernel books): the friction of :func:`~cvtfem.elements.chain.half_end_contact_kernel.forces` exactly.
-:func:`slip_map` reads ``G`` from the contact kernel itself (no copy of its geometry): one call of
-:func:`~cvtfem.elements.chain.sheave_contact_refined_kernel.refined_local_kernel` on the contacts in touch, each
-repeated with zero velocities (its normal force, friction off) and with each velocity input set to 1 (the slip is
-linear in them: that slip is ``G``'s column).  Arguments as :func:`half_end_contact_kernel.forces`'.  Units SI.
+that plane), its normal force ``N_k`` (N) is fixed, and the friction forces are ``Q = -G^T (N psi(|s|) s)`` per contact
+(the friction power ``F . s`` the contact kernel books): the friction of
+:func:`~cvtfem.elements.chain.half_end_contact_kernel.forces` exactly.  :func:`slip_map` reads ``G`` from the contact
+kernel itself (no copy of its geometry),
+:func:`~cvtfem.elements.chain.sheave_contact_refined_kernel.refined_local_kernel`: on the candidate contacts with zero
+velocities (their normal forces, friction off), then on those in touch with each velocity input set to 1 in turn (the
+slip is linear in them: that slip is ``G``'s column).
+Arguments as :func:`half_end_contact_kernel.forces`'.  Units SI.
 """
 from __future__ import annotations
 
@@ -36,42 +37,54 @@ def slip_map(y, cols, coef, shaft, centres, r2, meridians, face_radius, slope_fa
     P = cols.shape[0]
     X, sh, pair = np.empty((P, N_IN)), np.empty(P, np.int64), np.empty(P, np.int64)
     m = _candidates(y, cols, coef, shaft, centres, r2, X, sh, pair)
-    rows = N_VEL + 1
-    Xb, shb = np.zeros((m * rows, N_IN)), np.empty(m * rows, np.int64)
-    for t in range(m):
-        for r in range(rows):
-            b = t * rows + r
-            Xb[b, :N_POS] = X[t, :N_POS]
-            if r > 0:
-                Xb[b, N_POS + r - 1] = 1.0
-            shb[b] = sh[t]
-    Xk, Yk = np.empty((m * rows, 2 * (N_POS + 2) + 1)), np.empty((m * rows, N_OUT + 2))
-    slip, fr = np.empty((m * rows, 3)), np.empty((m * rows, 3))
-    _spread(Xb, Xk, N_POS + 2)
-    bad = refined_local_kernel(Xk, shb, centres, meridians, face_radius, True, slope_factor, c, 0.0, par[1], law,
-                               par[2], Yk, slip, fr)
-    k = n = 0
+    Y0, _, bad = _local(X, sh, np.arange(m), -1, centres, meridians, face_radius, slope_factor, c, par, law)
+    if bad >= 0:
+        return 0, 0, pair[bad]
+    touch = np.flatnonzero(-0.5 * Y0[:, 6] > 0.0)   # the kernel's 2 (s N + F_3) at side s = -1, friction off
+    _, slip, bad = _local(X, sh, touch, N_VEL, centres, meridians, face_radius, slope_factor, c, par, law)
+    if bad >= 0:
+        return 0, 0, pair[touch[bad // N_VEL]]
+    n = 0
     basis = np.empty((2, 3))
-    for t in range(m):
-        normal = -0.5 * Yk[t * rows, 6]           # the kernel's 2 (s N + F_3) at side s = -1, friction off
-        if not normal > 0.0:
-            continue
-        N[k] = normal
-        _plane(slip[t * rows + 1:(t + 1) * rows], basis)
+    for k in range(touch.shape[0]):
+        t = touch[k]
+        N[k] = -0.5 * Y0[t, 6]
+        _plane(slip[k * N_VEL:(k + 1) * N_VEL], basis)
         i = pair[t]
-        for r in range(1, rows):
-            j = N_POS + r - 1
+        for r in range(N_VEL):
+            j = N_POS + r
+            e = slip[k * N_VEL + r]
             for a in range(cols.shape[2]):
                 col, w = cols[i, j, a], coef[i, j, a]
                 if w == 0.0 or col < n2 or col >= 2 * n2:
                     continue                      # a constant (the fixed sheave's rate, zero)
                 for d in range(2):
-                    e = slip[t * rows + r]
                     r_out[n], c_out[n] = 2 * k + d, col - n2
                     v_out[n] = w * (basis[d, 0] * e[0] + basis[d, 1] * e[1] + basis[d, 2] * e[2])
                     n += 1
-        k += 1
-    return k, n, (pair[bad // rows] if bad >= 0 else -1)
+    return touch.shape[0], n, -1
+
+
+@njit(cache=True)
+def _local(X, sh, sel, units, centres, meridians, face_radius, slope_factor, c, par, law):
+    """The H2 kernel on the candidates ``sel`` at their positions: with zero velocities, friction off (``units``
+    -1: one row each, its outputs ``Y``), or with each of the ``units`` velocity inputs set to 1 in turn (the slips,
+    ``units`` rows each).  Returns ``(Y, slip, first bad row or -1)``."""
+    rows = max(units, 1)
+    Xb, shb = np.zeros((sel.shape[0] * rows, N_IN)), np.empty(sel.shape[0] * rows, np.int64)
+    for t in range(sel.shape[0]):
+        for r in range(rows):
+            b = t * rows + r
+            Xb[b, :N_POS] = X[sel[t], :N_POS]
+            if units > 0:
+                Xb[b, N_POS + r] = 1.0
+            shb[b] = sh[sel[t]]
+    Xk, Yk = np.empty((Xb.shape[0], 2 * (N_POS + 2) + 1)), np.empty((Xb.shape[0], N_OUT + 2))
+    slip, fr = np.empty((Xb.shape[0], 3)), np.empty((Xb.shape[0], 3))
+    _spread(Xb, Xk, N_POS + 2)
+    bad = refined_local_kernel(Xk, shb, centres, meridians, face_radius, True, slope_factor, c, 0.0, par[1], law,
+                               par[2], Yk, slip, fr)
+    return Yk, slip, bad
 
 
 @njit(cache=True)
