@@ -441,19 +441,20 @@ class ChainHalvesCVT(ChainACVT):
         return Pf
 
     def sheave_slips(self, x) -> tuple[sp.csr_matrix, np.ndarray]:
-        """``(G, N)``: the slips of the pin-sheave contacts in touch at the positions of ``x``, ``s = G v`` (3 rows per
-        contact, m/s; columns the velocities ``v`` (n2,)), and their normal forces ``N`` (N): the contacts' friction
-        forces are ``-G^T (N psi(|s|) s)`` (:func:`~cvtfem.elements.chain.half_end_slips.slip_map`)."""
+        """``(G, N)``: the slips of the pin-sheave contacts in touch at the positions of ``x``, ``s = G v`` (2 rows per
+        contact: the tangent-plane slip in an orthonormal basis of the plane, m/s; columns the velocities ``v``
+        (n2,)), and their normal forces ``N`` (N): the contacts' friction forces are ``-G^T (N psi(|s|) s)``
+        (:func:`~cvtfem.elements.chain.half_end_slips.slip_map`)."""
         n2, table = self.n2, self._pair_table
         P, K = table[0].shape[0], table[0].shape[2]
-        N, size = np.empty(P), 3 * P * HES.N_VEL * K
+        N, size = np.empty(P), 2 * P * HES.N_VEL * K
         r, c, d = np.empty(size, np.int64), np.empty(size, np.int64), np.empty(size)
         m, k, bad = HES.slip_map(np.concatenate([x[:2 * n2], self._constants]), *table[:3], *self._compiled_contact,
                                  n2, N, r, c, d)
         if bad >= 0:
             raise NumericalError(f"H2 contact: a pin-half end on the shaft axis (pair {bad})",
                                  component="contact.refined")
-        return sp.csr_matrix((d[:k], (r[:k], c[:k])), shape=(3 * m, n2)), N[:m]
+        return sp.csr_matrix((d[:k], (r[:k], c[:k])), shape=(2 * m, n2)), N[:m]
 
     def friction_sets(self, x) -> list:
         """The :class:`~cvtfem.elements.chain.implicit_friction.FrictionSet` of all friction at the positions of
@@ -463,7 +464,7 @@ class ChainHalvesCVT(ChainACVT):
         B, c = chain.friction_slips(x[:nc])
         B = sp.csr_matrix((B.data, B.indices, B.indptr), shape=(B.shape[0], n2))
         G, N = self.sheave_slips(x)
-        return [FrictionSet(B, c, 1, chain.f0, chain.v0, chain.law), FrictionSet(G, N, 3, *self._sheave_friction[1])]
+        return [FrictionSet(B, c, 1, chain.f0, chain.v0, chain.law), FrictionSet(G, N, 2, *self._sheave_friction[1])]
 
     @cached_property
     def _masses(self) -> tuple:

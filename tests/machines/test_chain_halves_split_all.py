@@ -39,7 +39,7 @@ def test_slip_map_gives_the_kernels_friction(model):  # noqa: F811
         fs = m.friction_sets(x)[1]
         s = G @ x[n2:2 * n2]
         r = fs.forces(s)
-        assert len(N) > 100 and np.all(N > 0) and G.shape == (3 * len(N), n2)
+        assert len(N) > 100 and np.all(N > 0) and G.shape == (2 * len(N), n2)
         assert np.abs(-(G.T @ r) - (Q - Q0)).max() <= 1e-12 * np.abs(Q).max()
         assert -r @ s == pytest.approx(Pf, rel=1e-12)
 

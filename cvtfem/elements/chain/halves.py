@@ -50,6 +50,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from cvtfem.elements.chain import halves_kernel as HK
+from cvtfem.elements.chain import halves_slips_kernel as HSK
 from cvtfem.elements.chain import plates as P
 from cvtfem.elements.chain import plates_kernel as PK
 from cvtfem.elements.chain.asymmetric import (_M_PAR, _M_PERP, ChainA1, _cross, _dot, _kx, shape_functions,
@@ -659,6 +660,13 @@ class ChainA5:
             add(n * (1 + hf) + p, di[:, 10 * hf + 8], one)
             add(n * (1 + hf) + p, di[:, 20], -one)
             c.append(Tn)
+        if pattern is not None and self.backend == "numba":                # the compiled twin of the loop below
+            roll = np.empty(len(CONTACTS) * len(GAUSS_XI) * 24 * n)
+            N = np.empty((len(CONTACTS), len(GAUSS_XI), n))
+            HSK.rolling_slip_values(u, self._next, self.axis_link, self._cs, *self._slip_constants, roll, N)
+            vals.append(roll)
+            c.append(N.ravel())
+            return self._slips_out(pattern, vals, c, (3 + len(CONTACTS) * len(GAUSS_XI)) * n, groups)
         fr = self._frames(u)
         H = shape_functions(GAUSS_XI, l)                                  # (4, S)
         Ux = np.einsum("is,hinc->hsnc", H, u)
@@ -690,6 +698,11 @@ class ChainA5:
             unique, where = np.unique(key, return_inverse=True)
             indptr = np.searchsorted(unique // self.n2, np.arange(m + 1))
             pattern = self._slip_pattern = (where, unique % self.n2, indptr)
+        return self._slips_out(pattern, vals, c, m, groups)
+
+    def _slips_out(self, pattern, vals, c, m, groups) -> tuple:
+        """:meth:`friction_slips`' rows from the values ``vals`` on the CSR ``pattern``, those with ``c > 0``."""
+        n = self.n_pins
         where, indices, indptr = pattern
         B = sp.csr_matrix((np.bincount(where, np.concatenate(vals), len(indices)), indices, indptr), shape=(m, self.n2))
         c = np.concatenate(c)
@@ -697,6 +710,19 @@ class ChainA5:
         label = np.concatenate([np.zeros(n, int), np.ones(2 * n, int), np.repeat(2 + np.arange(len(CONTACTS)),
                                                                                  len(GAUSS_XI) * n)])
         return (B[keep], c[keep], label[keep]) if groups else (B[keep], c[keep])
+
+    @property
+    def _slip_constants(self) -> tuple:
+        """The constant arguments of :func:`~.halves_slips_kernel.rolling_slip_values` after ``cs``."""
+        if getattr(self, "_slip_consts", None) is None:
+            arcs = [self._arcs[name] for name, *_ in CONTACTS]
+            self._slip_consts = (
+                shape_functions(GAUSS_XI, self.l), self.l / 2 * GAUSS_W,
+                np.array([[A, B, sig] for _, A, B, sig in CONTACTS], float),
+                np.array([[a[0], a[2]] for a in arcs], float), np.array([[a[1], a[3]] for a in arcs], float),
+                np.array([a[4] for a in arcs], float), np.array([a[5] for a in arcs], float),
+                np.array([self._contact_w[name] for name, *_ in CONTACTS], float))
+        return self._slip_consts
 
     def friction_step(self, B: sp.csr_matrix, c: np.ndarray, v_star: np.ndarray, h: float, v_start=None,
                       tol: float = 1e-6, max_lu: int = 100) -> tuple[np.ndarray, float, int]:

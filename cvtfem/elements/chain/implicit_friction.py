@@ -13,8 +13,8 @@ from dataclasses import dataclass
 
 import numpy as np
 import scipy.sparse as sp
-import scipy.sparse.linalg as spla
 
+from cvtfem.elements.chain.friction_solver import SlipCholesky
 from cvtfem.elements.contact.friction import (POTENTIAL_LAWS, friction_gain, friction_potential, friction_slope)
 from cvtfem.errors import InputError, NumericalError
 
@@ -64,65 +64,45 @@ class FrictionSet:
         t = s.reshape(-1, d) / np.where(speed > 0, speed, 1.0)[:, None]
         return gain[:, None, None] * np.eye(d) + (slope - gain)[:, None, None] * t[:, :, None] * t[:, None, :]
 
-
-class _SlipSystem:
-    """``A = I + h D K`` (``K = S M^-1 S^T`` over the inner velocities, ``D`` block diagonal by contact) on a pattern
-    built once per pattern of ``K`` (:func:`_slip_system`): the rows of a contact share the union of their ``K`` rows'
-    columns, and ``A``'s data is one weighted ``bincount`` of ``K``'s per iteration; factored as the CSC of ``A^T``
-    (the CSR arrays as they are)."""
-
-    def __init__(self, K: sp.csr_matrix, sizes: np.ndarray):
-        m = K.shape[0]
-        gid = np.repeat(np.arange(len(sizes)), sizes)                   # each row's contact
-        first = np.concatenate([[0], np.cumsum(sizes)[:-1]])
-        rows = np.repeat(np.arange(m), np.diff(K.indptr))
-        key = np.unique(np.concatenate([gid[rows] * m + K.indices, gid * m + np.arange(m)]))
-        start = np.searchsorted(key // m, np.arange(len(sizes)))       # each contact's first pattern column
-        width = np.diff(np.append(start, len(key)))[gid]                # pattern columns of each row
-        self.indptr = np.concatenate([[0], np.cumsum(width)])
-        self.indices = key[np.repeat(start[gid] - self.indptr[:-1], width) + np.arange(self.indptr[-1])] % m
-        rank = np.searchsorted(key, gid[rows] * m + K.indices) - start[gid[rows]]
-        d = sizes[gid[rows]]                                            # each K entry feeds the d rows of its contact
-        self.entry = np.repeat(np.arange(K.nnz), d)
-        e = self.entry
-        r = first[gid[rows[e]]] + (np.arange(e.size) - np.repeat(np.cumsum(d) - d, d))       # the target row
-        self.tgt = self.indptr[r] + rank[e]
-        boff = np.concatenate([[0], np.cumsum(sizes ** 2)[:-1]])        # blocks flattened by contact
-        g = gid[r]
-        self.block = boff[g] + (r - first[g]) * sizes[g] + (rows[e] - first[g])
-        self.diag = self.indptr[:-1] + np.searchsorted(key, gid * m + np.arange(m)) - start[gid]
-
-    def factor(self, K: sp.csr_matrix, h: float, blocks: np.ndarray):
-        data = np.bincount(self.tgt, h * blocks[self.block] * K.data[self.entry], minlength=self.indptr[-1])
-        data[self.diag] += 1.0
-        m = len(self.indptr) - 1
-        return spla.splu(sp.csc_matrix((data, self.indices, self.indptr), shape=(m, m)))
+    def roots(self, s, tangent: bool) -> np.ndarray:
+        """The symmetric square roots (contacts, dim, dim) of :meth:`slopes` (a convex potential's ``f' >= 0``)."""
+        d, speed = self.dim, self.speeds(s)
+        gain = np.sqrt(self.c * friction_gain(speed, self.f0, self.v0, self.law))
+        if not tangent or d == 1:
+            diag = np.sqrt(self.c * friction_slope(speed, self.f0, self.v0, self.law)) if tangent else gain
+            return diag[:, None, None] * np.eye(d)
+        slope = np.sqrt(self.c * friction_slope(speed, self.f0, self.v0, self.law))
+        t = s.reshape(-1, d) / np.where(speed > 0, speed, 1.0)[:, None]
+        return gain[:, None, None] * np.eye(d) + (slope - gain)[:, None, None] * t[:, :, None] * t[:, None, :]
 
 
 _LAST: dict = {}
 _MASS: dict = {}
 
 
-def _inner_mass(Mi: sp.spmatrix, border) -> tuple[np.ndarray, sp.csr_matrix]:
-    """``(inner, Mi_in)``: the mask of the velocities off the border and ``Mi`` with the border's rows and columns
-    zeroed, kept for the next call with the same ``Mi`` and border."""
+def _inner_mass(Mi: sp.spmatrix, border) -> tuple[np.ndarray, sp.csr_matrix, np.ndarray]:
+    """``(inner, Mi_in, Mi_b)``: the mask of the velocities off the border, ``Mi`` with the border's rows and columns
+    zeroed and the border's block of ``Mi`` (dense), kept for the next call with the same ``Mi`` and border."""
     border = np.zeros(0, int) if border is None else np.asarray(border)
     key = (id(Mi), border.tobytes())
     if key not in _MASS:
         inner = np.ones(Mi.shape[0], bool)
         inner[border] = False
         _MASS.clear()
-        _MASS[key] = (Mi, inner, Mi.multiply(inner[:, None]).multiply(inner[None, :]).tocsr())
+        Mi_in = Mi.multiply(inner[:, None]).multiply(inner[None, :]).tocsr()
+        Mi_in.eliminate_zeros()
+        _MASS[key] = (Mi, inner, Mi_in,
+                      Mi[~inner][:, ~inner].toarray())
     return _MASS[key][1:]
 
 
-def _slip_system(K: sp.csr_matrix, sizes: np.ndarray) -> _SlipSystem:
-    """The :class:`_SlipSystem` of ``K``'s pattern, kept for the next call with the same pattern (successive solves
-    of a run mostly share it: the same contacts in touch)."""
+def _slip_system(K: sp.csr_matrix, sizes: np.ndarray) -> SlipCholesky:
+    """The :class:`~.friction_solver.SlipCholesky` of ``K``'s pattern, kept for the next call with the same pattern
+    (successive solves of a run mostly share it: the same contacts in touch)."""
     key = K.indptr.tobytes() + K.indices.tobytes() + sizes.tobytes()
     if key not in _LAST:
         _LAST.clear()
-        _LAST[key] = _SlipSystem(K, sizes)
+        _LAST[key] = SlipCholesky(K, sizes)
     return _LAST[key]
 
 
@@ -132,7 +112,8 @@ def friction_step(M: sp.spmatrix, Mi: sp.spmatrix, sets: list[FrictionSet], v_st
 
     Newton on the convex function of the module docstring from ``v_start`` (default ``v*``; the minimiser does not
     depend on it), its matrix ``M + h S^T D S`` inverted through the slips' ``I + h D S M^-1 S^T`` (Woodbury: the
-    mass inverse ``Mi`` is block diagonal, the slips fewer than the velocities); the velocities ``border`` (indices:
+    mass inverse ``Mi`` is block diagonal, the slips fewer than the velocities) in its symmetric form ``I + h E K E``
+    (``D = E E``; :class:`~.friction_solver.SlipCholesky`, a compiled sparse LDL^T); the velocities ``border`` (indices:
     the shafts', which couple every contact on them) enter that matrix as a low-rank update (Woodbury again), so its
     LU stays sparse.  Where a Newton step does not lower the function (a saturated law's tangent sends a slip far
     off) the majorise-minimise step (secant slopes ``c psi``; lies above ``Phi`` for laws with falling ``psi``)
@@ -142,11 +123,12 @@ def friction_step(M: sp.spmatrix, Mi: sp.spmatrix, sets: list[FrictionSet], v_st
     round-off whatever that tolerance."""
     S = sp.vstack([f.S for f in sets], format="csr")
     St = S.T.tocsr()
-    inner, Mi_in = _inner_mass(Mi, border)
+    inner, Mi_in, Mi_b = _inner_mass(Mi, border)
+    Mi_csr = Mi.tocsr()
     K = (S @ Mi_in @ St).tocsr()                             # slip-space inverse mass without the border
     K.sort_indices()
-    U = S[:, ~inner].toarray()                               # the border's slip columns (rows x r)
-    Q = U @ Mi[~inner][:, ~inner].toarray()
+    U = np.ascontiguousarray(St[~inner].toarray().T)         # the border's slip columns (rows x r)
+    Q = U @ Mi_b
     bounds = np.cumsum([0] + [f.S.shape[0] for f in sets])
     parts = [slice(a, b) for a, b in zip(bounds[:-1], bounds[1:])]
     system = _slip_system(K, np.concatenate([np.full(len(f.c), f.dim) for f in sets]))
@@ -161,33 +143,28 @@ def friction_step(M: sp.spmatrix, Mi: sp.spmatrix, sets: list[FrictionSet], v_st
         return 0.5 * dv_ @ (M @ dv_) + h * sum(f.potential(s_[p]) for f, p in zip(sets, parts))
 
     def step(tangent, g):
-        """``-(M + h S^T D S)^-1 g``."""
-        blocks = [f.slopes(s[p], tangent) for f, p in zip(sets, parts)]
-
-        def D(x):                                            # the block-diagonal D times x (rows, ...)
-            return np.concatenate([np.einsum("gij,gj...->gi...", b, x[p].reshape(len(b), b.shape[1], *x.shape[1:]))
-                                   .reshape(x[p].shape) for b, p in zip(blocks, parts)])
-
-        lu = system.factor(K, h, np.concatenate([b.ravel() for b in blocks]))
-        y = Mi @ g
-        w = lu.solve(D(S @ y), trans="T")
-        if U.shape[1]:
-            Z = lu.solve(h * D(U), trans="T")                # A = A_c + (h D U) Q^T
-            w -= Z @ np.linalg.solve(np.eye(U.shape[1]) + Q.T @ Z, Q.T @ w)
-        dv = h * (Mi @ (St @ w)) - y
-        return dv, S @ dv
+        """``-(M + h S^T E E S)^-1 g`` by Woodbury: ``-y + h M^-1 S^T E C^-1 E S y``, ``y = M^-1 g``, ``C = I + h E
+        S M^-1 S^T E`` (SPD), its border part a rank-r update (Woodbury again)."""
+        E = np.concatenate([f.roots(s[p], tangent).ravel() for f, p in zip(sets, parts)])
+        return system.direction(K.data, h, E, g, Mi_csr, S, St, U, Q)
 
     def small(ds):
         return all(np.max(np.abs(ds[p]), initial=0.0) <= tol * f.v0 for f, p in zip(sets, parts))
 
+    value = None                                             # the objective at v, once needed
     while lus < max_lu:
         g = M @ (v - v_star) + h * (St @ forces(s))
         dv, ds = step(True, g)
         lus += 1
         done = small(ds)
-        if not done and objective(v + dv, s + ds) > objective(v, s) + 1e-4 * (g @ dv):
-            dv, ds = step(False, g)
-            lus += 1
+        if not done:
+            value = objective(v, s) if value is None else value
+            trial = objective(v + dv, s + ds)
+            if trial > value + 1e-4 * (g @ dv):
+                dv, ds = step(False, g)
+                lus += 1
+                trial = None
+            value = trial
         v, s = v + dv, s + ds
         if done or small(ds):
             break

@@ -38,3 +38,20 @@ def test_friction_step_is_backward_euler_and_books_the_kinetic_energy(law):
         dT = 0.5 * v @ (M @ v) - 0.5 * v1 @ (M @ v1)
         assert W == pytest.approx(dT, rel=1e-9) and W > 0
         assert its <= 80                            # LUs (66 at most: linear-saturated, h = 1e-7 s)
+
+
+@pytest.mark.parametrize("case", CASES)
+def test_compiled_slip_values_equal_the_numpy_reference(case):
+    """The compiled rolling slips (:mod:`~cvtfem.elements.chain.halves_slips_kernel`, used once the CSR pattern is
+    known) equal the numpy method's rows, forces and groups to 1e-12, at two states (the pattern reused)."""
+    kw, v_scale = CASES[case]
+    fast, ref = chain(use_numba=True, **kw), chain(use_numba=False, **kw)
+    q0, _ = state(fast, v_scale)
+    rng = np.random.default_rng(3)
+    fast.friction_slips(q0)                                   # the first call builds the pattern in numpy
+    for q in (q0, q0 + 1e-6 * rng.standard_normal(q0.size)):
+        B, c, g = fast.friction_slips(q, groups=True)
+        B0, c0, g0 = ref.friction_slips(q, groups=True)
+        assert B.shape == B0.shape and np.array_equal(g, g0) and np.any(g >= 2)
+        assert np.abs((B - B0).toarray()).max() <= 1e-12 * np.abs(B0).max()
+        assert np.abs(c - c0).max() <= 1e-12 * np.abs(c0).max()

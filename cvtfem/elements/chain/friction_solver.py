@@ -1,0 +1,254 @@
+"""The symmetric slip matrix ``C = I + h E K E`` of the implicit friction and its sparse LDL^T on a fixed pattern.
+
+``K`` (sparse, symmetric, m x m; m/s per N here: a slip-space inverse mass ``S M^-1 S^T``) and ``E`` (block diagonal
+by contact, symmetric blocks of ``sizes`` rows: the square root of the friction's slope blocks) fix ``C``, symmetric
+positive definite.  :class:`SlipCholesky` does the symbolic work once per pattern of ``K`` (the fill-reducing order,
+the elimination tree, where each product ``E K E`` lands in ``C``'s upper triangle) and each :meth:`SlipCholesky.factor`
+only the numeric LDL^T (compiled, the up-looking algorithm of QDLDL: Stellato et al., the OSQP solver).  Units: those
+of ``K`` times ``h E^2`` cancel (``C`` is dimensionless).
+"""
+from __future__ import annotations
+
+import numpy as np
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+from cvtfem.elements.jit import njit
+from cvtfem.errors import NumericalError
+
+__all__ = ["SlipCholesky"]
+
+
+@njit(cache=True)
+def _etree(Ap, Ai, Lnz, parent, work):
+    """Elimination tree ``parent`` and the column counts ``Lnz`` of ``L`` from the upper triangle (CSC, diagonal
+    included) of a symmetric matrix."""
+    n = Lnz.shape[0]
+    for i in range(n):
+        work[i], Lnz[i], parent[i] = -1, 0, -1
+    for j in range(n):
+        work[j] = j
+        for p in range(Ap[j], Ap[j + 1]):
+            i = Ai[p]
+            while work[i] != j:
+                if parent[i] == -1:
+                    parent[i] = j
+                Lnz[i] += 1
+                work[i] = j
+                i = parent[i]
+
+
+@njit(cache=True)
+def _fill(Cx, tgt, i1, entry, i2, Kx, E, h, diag):
+    """``C``'s upper triangle: ``h E[i1] K[entry] E[i2]`` summed into ``tgt``, plus the identity."""
+    Cx[:] = 0.0
+    for k in range(tgt.shape[0]):
+        Cx[tgt[k]] += h * E[i1[k]] * Kx[entry[k]] * E[i2[k]]
+    for i in range(diag.shape[0]):
+        Cx[diag[i]] += 1.0
+
+
+@njit(cache=True)
+def _ldl(Ap, Ai, Ax, parent, Lp, Li, Lx, D, y, mark, stack, reach, nxt):
+    """``A = L D L^T`` (``L`` unit lower, CSC without its diagonal, on ``Lp`` from :func:`_etree`).  Returns the first
+    column with a pivot ``<= 0`` or -1."""
+    n = D.shape[0]
+    for i in range(n):
+        nxt[i], mark[i], y[i] = Lp[i], False, 0.0
+    for k in range(n):
+        top, D[k] = 0, 0.0
+        for p in range(Ap[k], Ap[k + 1]):
+            i = Ai[p]
+            if i == k:
+                D[k] = Ax[p]
+                continue
+            y[i] = Ax[p]
+            if mark[i]:
+                continue
+            depth = 0
+            while i != -1 and i < k and not mark[i]:                 # the path up the tree to a marked node
+                mark[i] = True
+                stack[depth] = i
+                depth += 1
+                i = parent[i]
+            while depth > 0:
+                depth -= 1
+                reach[top] = stack[depth]
+                top += 1
+        for t in range(top - 1, -1, -1):
+            j = reach[t]
+            yj = y[j]
+            for p in range(Lp[j], nxt[j]):
+                y[Li[p]] -= Lx[p] * yj
+            q = nxt[j]
+            Li[q], Lx[q] = k, yj / D[j]
+            D[k] -= yj * Lx[q]
+            nxt[j] += 1
+            y[j], mark[j] = 0.0, False
+        if not D[k] > 0.0:
+            return k
+    return -1
+
+
+@njit(cache=True)
+def _ldl_solve(Lp, Li, Lx, D, X):
+    """``X <- (L D L^T)^-1 X`` in place, ``X`` (n, columns)."""
+    n, k = X.shape
+    for i in range(n):
+        for p in range(Lp[i], Lp[i + 1]):
+            for c in range(k):
+                X[Li[p], c] -= Lx[p] * X[i, c]
+    for i in range(n):
+        for c in range(k):
+            X[i, c] /= D[i]
+    for i in range(n - 1, -1, -1):
+        for p in range(Lp[i], Lp[i + 1]):
+            for c in range(k):
+                X[i, c] -= Lx[p] * X[Li[p], c]
+
+
+@njit(cache=True)
+def _blocks_times(E, boff, first, sizes, X, out):
+    """``out = E X``, ``E`` block diagonal (blocks flattened row-major from ``boff``), ``X`` (m, columns)."""
+    for g in range(sizes.shape[0]):
+        d, f, o = sizes[g], first[g], boff[g]
+        for a in range(d):
+            for c in range(X.shape[1]):
+                acc = 0.0
+                for b in range(d):
+                    acc += E[o + a * d + b] * X[f + b, c]
+                out[f + a, c] = acc
+
+
+@njit(cache=True)
+def _csr_times(indptr, indices, data, x, out):
+    for r in range(indptr.shape[0] - 1):
+        acc = 0.0
+        for p in range(indptr[r], indptr[r + 1]):
+            acc += data[p] * x[indices[p]]
+        out[r] = acc
+
+
+@njit(cache=True)
+def _direction(sym, Lp, Li, Lx, D, work, Cx, Kx, h, E, g, Mi, S, St, U, Q, dv, ds):
+    """The Newton direction ``dv = -y + h Mi S^T E z`` (``y = Mi g``, ``(C + h EU Mb (EU)^T) z = E S y``, ``Q = U Mb``)
+    and ``ds = S dv`` after the LDL^T of ``C`` (:class:`SlipCholesky`'s arrays ``sym``); raises nothing, returns the
+    first bad pivot or -1."""
+    Ap, Ai, parent, tgt, i1, entry, i2, diag, perm, sizes, first, boff = sym
+    _fill(Cx, tgt, i1, entry, i2, Kx, E, h, diag)
+    bad = _ldl(Ap, Ai, Cx, parent, Lp, Li, Lx, D, *work)
+    if bad >= 0:
+        return bad
+    m, r = U.shape
+    y, sy = np.empty(g.shape[0]), np.empty(m)
+    _csr_times(Mi[0], Mi[1], Mi[2], g, y)
+    _csr_times(S[0], S[1], S[2], y, sy)
+    R = np.empty((m, r + 1))
+    R[:, 0] = sy
+    R[:, 1:] = U
+    ER = np.empty((m, r + 1))
+    _blocks_times(E, boff, first, sizes, R, ER)
+    X = np.empty((m, r + 1))
+    for i in range(m):
+        X[perm[i]] = ER[i]
+    _ldl_solve(Lp, Li, Lx, D, X)
+    z, Z = np.empty(m), np.empty((m, r))
+    for i in range(m):
+        z[i] = X[perm[i], 0]
+        Z[i] = X[perm[i], 1:]
+    if r > 0:
+        EQ = np.empty((m, r))
+        _blocks_times(E, boff, first, sizes, Q, EQ)
+        EQ *= h
+        W = np.eye(r) + EQ.T @ Z
+        z -= Z @ np.linalg.solve(W, EQ.T @ z)
+    Ez = np.empty((m, 1))
+    _blocks_times(E, boff, first, sizes, z.reshape(m, 1), Ez)
+    t, u = np.empty(g.shape[0]), np.empty(g.shape[0])
+    _csr_times(St[0], St[1], St[2], Ez[:, 0], t)
+    _csr_times(Mi[0], Mi[1], Mi[2], t, u)
+    for i in range(g.shape[0]):
+        dv[i] = h * u[i] - y[i]
+    _csr_times(S[0], S[1], S[2], dv, ds)
+    return -1
+
+
+class SlipCholesky:
+    """``C = I + h E K E`` on the pattern of ``K`` (CSR, symmetric pattern, sorted indices) and contacts of ``sizes``
+    rows: the symbolic work in the constructor, :meth:`factor` per new ``(K data, h, E)``, :meth:`solve` after it.
+    ``E`` is flattened by contact, each block row-major (``sizes**2`` values each)."""
+
+    def __init__(self, K: sp.csr_matrix, sizes: np.ndarray):
+        m = K.shape[0]
+        sizes = np.asarray(sizes, np.int64)
+        gid = np.repeat(np.arange(len(sizes)), sizes)
+        first = np.concatenate([[0], np.cumsum(sizes)[:-1]])
+        boff = np.concatenate([[0], np.cumsum(sizes ** 2)[:-1]])
+        rows = np.repeat(np.arange(m), np.diff(K.indptr))
+        cols = K.indices
+        g, f = gid[rows], gid[cols]
+        dg, df = sizes[g], sizes[f]
+        count = dg * df                                                  # each K entry feeds a dg x df block of C
+        entry = np.repeat(np.arange(K.nnz), count)
+        j = np.arange(entry.size) - np.repeat(np.cumsum(count) - count, count)
+        a, b = j // df[entry], j % df[entry]
+        ge, fe = g[entry], f[entry]
+        r, c = first[ge] + a, first[fe] + b                              # C[r, c] += E_g[a, .] K E_f[., b]
+        i1 = boff[ge] + a * dg[entry] + rows[entry] - first[ge]
+        i2 = boff[fe] + (cols[entry] - first[fe]) * df[entry] + b
+        pattern = sp.csc_matrix((np.ones(r.size), (r, c)), shape=(m, m)) + sp.identity(m, format="csc")
+        self.perm = spla.splu(pattern, permc_spec="MMD_AT_PLUS_A").perm_c    # old index -> new
+        pr, pc = self.perm[r], self.perm[c]
+        up = pr <= pc
+        key = np.unique(np.concatenate([pc[up] * m + pr[up], np.arange(m) * (m + 1)]))
+        self.Ap = np.searchsorted(key // m, np.arange(m + 1))
+        self.Ai = key % m
+        self.tgt = np.searchsorted(key, pc[up] * m + pr[up])
+        self.i1, self.entry, self.i2 = i1[up], entry[up], i2[up]
+        self.diag = np.searchsorted(key, np.arange(m) * (m + 1))
+        Lnz, self.parent, work = np.empty(m, np.int64), np.empty(m, np.int64), np.empty(m, np.int64)
+        _etree(self.Ap, self.Ai, Lnz, self.parent, work)
+        self.Lp = np.concatenate([[0], np.cumsum(Lnz)])
+        self.Li, self.Lx = np.empty(self.Lp[-1], np.int64), np.empty(self.Lp[-1])
+        self.D, self.Cx = np.empty(m), np.empty(key.size)
+        self.sizes, self.first, self.boff = sizes, first, boff
+        self._work = (np.empty(m), np.empty(m, np.bool_), np.empty(m, np.int64), np.empty(m, np.int64),
+                      np.empty(m, np.int64))
+
+    def matrix(self, Kx, h: float, E) -> sp.csc_matrix:
+        """``C``'s upper triangle in the solver's order (checks)."""
+        _fill(self.Cx, self.tgt, self.i1, self.entry, self.i2, Kx, E, h, self.diag)
+        m = self.D.size
+        return sp.csc_matrix((self.Cx.copy(), self.Ai, self.Ap), shape=(m, m))
+
+    def factor(self, Kx, h: float, E) -> None:
+        """The LDL^T of ``C`` for ``K``'s data ``Kx`` (the pattern's), step ``h`` and blocks ``E``."""
+        _fill(self.Cx, self.tgt, self.i1, self.entry, self.i2, Kx, E, h, self.diag)
+        y, mark, stack, reach, nxt = self._work
+        bad = _ldl(self.Ap, self.Ai, self.Cx, self.parent, self.Lp, self.Li, self.Lx, self.D, y, mark, stack, reach,
+                   nxt)
+        if bad >= 0:
+            raise NumericalError(f"the slip matrix I + h E K E is not positive definite (pivot {bad})",
+                                 component="friction_solver.SlipCholesky")
+
+    def solve(self, b: np.ndarray) -> np.ndarray:
+        """``C^-1 b`` (``b`` (m,) or (m, k))."""
+        X = np.empty((b.shape[0], b[0].size))
+        X[self.perm] = b.reshape(X.shape)
+        _ldl_solve(self.Lp, self.Li, self.Lx, self.D, X)
+        return X[self.perm].reshape(b.shape)
+
+    def direction(self, Kx, h: float, E, g, Mi: sp.csr_matrix, S: sp.csr_matrix, St: sp.csr_matrix, U, Q):
+        """``(dv, S dv)``: ``dv = -(M + h S^T E E S)^-1 g`` by Woodbury, ``C`` of ``Kx`` (``K = S Mi_in S^T``, ``Mi_in``
+        ``Mi`` without the border) factored here; ``U`` (m, r) the border's slip columns, ``Q = U Mb`` with ``Mb``
+        ``Mi``'s border block (one compiled call: :func:`_direction`)."""
+        sym = (self.Ap, self.Ai, self.parent, self.tgt, self.i1, self.entry, self.i2, self.diag, self.perm, self.sizes,
+               self.first, self.boff)
+        dv, ds = np.empty(g.shape[0]), np.empty(S.shape[0])
+        bad = _direction(sym, self.Lp, self.Li, self.Lx, self.D, self._work, self.Cx, Kx, h, E, g,
+                         (Mi.indptr, Mi.indices, Mi.data), (S.indptr, S.indices, S.data),
+                         (St.indptr, St.indices, St.data), U, Q, dv, ds)
+        if bad >= 0:
+            raise NumericalError(f"the slip matrix I + h E K E is not positive definite (pivot {bad})",
+                                 component="friction_solver.SlipCholesky")
+        return dv, ds
