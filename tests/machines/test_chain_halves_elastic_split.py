@@ -52,7 +52,7 @@ def test_slip_map_gives_the_mapped_kernels_friction(model):
         s = G @ v
         r = fs.forces(s)
         nc = m.family.size
-        assert len(N) > 50 and np.all(N > 0) and G.shape == (3 * len(N), n2)
+        assert len(N) > 50 and np.all(N > 0) and G.shape == (2 * len(N), n2)
         assert np.abs(G[:, nc:]).max() > 0.0
         assert np.abs(-(G.T @ r) - (Q - Q0)).max() <= 1e-12 * np.abs(Q).max()
         assert -r @ s == pytest.approx(Pf, rel=1e-12)

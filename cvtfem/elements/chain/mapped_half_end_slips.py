@@ -4,16 +4,18 @@ The elastic twin of :mod:`~cvtfem.elements.chain.half_end_slips`: every H2 half-
 displaced, tilted sheave (:mod:`~cvtfem.elements.chain.mapped_contact_kernel`), whose kernel rates are ``dK P'``, linear
 in the mapped rates ``P'`` (the half end, its chord, ``x3``, slope, the sheave's translation, tilt, the other sheave's
 axial position) and the spin.  With the positions frozen the slip of a contact in touch is therefore ``s = G v`` (3
-rows: the tangent-plane relative velocity, m/s), read from the kernel itself: one evaluation with the rates zero (its
+components: the tangent-plane relative velocity, m/s), read from the kernel itself: one evaluation with the rates zero (its
 normal force, friction off) and one per mapped rate set to 1 (that slip is ``G``'s column), mapped to the state's
-velocities through the pair table.  The contact's friction forces are ``-G^T (N psi(|s|) s)``, those of
-:func:`mapped_contact_kernel.forces`.  Units SI.
+velocities through the pair table, in the orthonormal basis of the tangent plane of
+:func:`~cvtfem.elements.chain.half_end_slips._plane` (2 rows a contact, as the rigid shafts' map).  The contact's
+friction forces are ``-G^T (N psi(|s|) s)``, those of :func:`mapped_contact_kernel.forces`.  Units SI.
 """
 from __future__ import annotations
 
 import numpy as np
 
 from cvtfem.elements.chain.half_end_contact import _spread as _half_spread
+from cvtfem.elements.chain.half_end_slips import _plane
 from cvtfem.elements.chain.mapped_contact_kernel import (N_FRAME, N_KERNEL, N_PATTERN, PATTERN, _candidates,
                                                          _gather_in, _spread_in, frame_a1)
 from cvtfem.elements.chain.sheave_contact_refined_kernel import refined_local_kernel
@@ -31,10 +33,10 @@ def slip_map(y, cols, coef, shaft, sheave, centres, r2, frame, ends, meridians, 
              n2, N, r_out, c_out, v_out):
     """The H2 half-end contacts in touch at the positions of ``y = [q, v]`` (mapped pair table ``cols``, ``coef``,
     ``shaft``, ``sheave``; the constants of :func:`mapped_contact_kernel.pack_refined` for half ends): their normal
-    forces into ``N`` and the entries of ``G`` (3 rows per contact, columns the velocities ``v`` (n2,); duplicates to
-    be summed) into ``r_out``, ``c_out``, ``v_out``.  Returns ``(contacts, entries, first pair with its half end on the
-    shaft axis or -1)``; ``N`` needs ``cols.shape[0]`` places, the entries ``3 cols.shape[0] cols.shape[1]
-    cols.shape[2]``."""
+    forces into ``N`` and the entries of ``G`` (2 rows per contact: the slip in the basis of its tangent plane;
+    columns the velocities ``v`` (n2,); duplicates to be summed) into ``r_out``, ``c_out``, ``v_out``.  Returns
+    ``(contacts, entries, first pair with its half end on the shaft axis or -1)``; ``N`` needs ``cols.shape[0]``
+    places, the entries ``2 cols.shape[0] cols.shape[1] cols.shape[2]``."""
     n_pairs, n_in, K = cols.shape[0], cols.shape[1], cols.shape[2]
     n_p = (n_in - 1) // 2
     Zall, sh, pair = np.empty((n_pairs, n_in)), np.empty(n_pairs, np.int64), np.empty(n_pairs, np.int64)
@@ -70,20 +72,24 @@ def slip_map(y, cols, coef, shaft, sheave, centres, r2, frame, ends, meridians, 
     bad = refined_local_kernel(Xk, shb, centres, meridians, face, True, slope_factor, c, 0.0, par[1], law, par[2],
                                Yk, slip, fr)
     k_out = n = 0
+    basis = np.empty((2, 3))
     for t in range(m):
         normal = -par[3] * Yk[t * rows, 6]              # the kernel's 2 (s N + F_3) at side s = -1, friction off, scaled
         if not normal > 0.0:
             continue
         N[k_out] = normal
+        _plane(slip[t * rows + 1:(t + 1) * rows], basis)
         i = pair[t]
         for r in range(1, rows):
             j = n_p + r - 1 if r <= n_p else 2 * n_p      # the mapped rate's slot, then the spin's
+            e = slip[t * rows + r]
             for a in range(K):
                 col, w = cols[i, j, a], coef[i, j, a]
                 if w == 0.0 or col < n2 or col >= 2 * n2:
                     continue
-                for d in range(3):
-                    r_out[n], c_out[n], v_out[n] = 3 * k_out + d, col - n2, w * slip[t * rows + r, d]
+                for d in range(2):
+                    r_out[n], c_out[n] = 2 * k_out + d, col - n2
+                    v_out[n] = w * (basis[d, 0] * e[0] + basis[d, 1] * e[1] + basis[d, 2] * e[2])
                     n += 1
         k_out += 1
     return k_out, n, (pair[bad // rows] if bad >= 0 else -1)
