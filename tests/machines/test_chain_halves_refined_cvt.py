@@ -201,8 +201,8 @@ def test_halves_at_the_whole_pin_are_a1_with_twice_the_contact(flat, scene):
     friction power agree too: A1's twist map (1.349) with unit chords, ``(E - e e) n / |e_- + e_+| / L = n_e / (2 L)``
     per chord, is exactly half the twist moment through each chord, the sum of the two halves' (1.352).
     The flat face: an inclined face turns with its body, a half's with its link chord and A1's with the bisector of
-    the pin's two chords (half a pitch angle apart on an arc), so the two contacts differ there (24 and 11 % on the sheaves'
-    axial forces at this state, 10 deg)."""
+    the pin's two chords (half a pitch angle apart on an arc), so the two contacts differ there (24 and 11 % on the
+    sheaves' axial forces at this state, 10 deg)."""
     model, placed = flat
     a1 = from_scene(scene, reference_geometry(), F_APPL, model="chain-A1", contact="hertz-refined",
                     face_inclination=0.0)
