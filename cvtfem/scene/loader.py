@@ -184,8 +184,9 @@ def scene_from_dict(data: Mapping[str, Any], source: str = "<dict>") -> Scene:
 
 def _refuse_unread(validated: Mapping[str, Any], data: Mapping[str, Any]) -> None:
     """A key the scene's CVT model does not read (:func:`~cvtfem.scene.schema.cvt.unread_keys`) that the scene sets
-    to another value than its presets give is an :class:`InputError`, not a value silently ignored; a scene without
-    presets (it must write every key) and a stored resolved scene (the presets' values) pass."""
+    to another value than its presets give or the schema's default is an :class:`InputError`, not a value silently
+    ignored; a scene without presets (it must write every key) and a stored resolved scene (the presets' values, or
+    the schema's default where an older preset held it: ``face_inclination`` 0 before session 13) pass."""
     from cvtfem.scene.schema.cvt import unread_keys
 
     if validated.get("cvt") is None or data.get("preset") in (None, ""):
@@ -196,12 +197,12 @@ def _refuse_unread(validated: Mapping[str, Any], data: Mapping[str, Any]) -> Non
         return
     presets = resolve_presets({"preset": data["preset"]})
     for key, what in unread.items():
-        written, given = _lookup(data, key), _lookup(presets, key)
-        if given is None:                      # the presets leave it to the schema's default
-            given = _schema_default(key)
-        if written is not None and given is not None and written != given:
+        written, given, default = _lookup(data, key), _lookup(presets, key), _schema_default(key)
+        allowed = [v for v in (given, default) if v is not None]
+        if written is not None and allowed and written not in allowed:
+            also = f" or the default {default!r}" if given is not None and default not in (None, given) else ""
             raise InputError(key, written, f"is not read by `{model}`: it is {what}; leave it at its presets' value "
-                             f"{given!r} (a changed value would be ignored)")
+                             f"{allowed[0]!r}{also} (a changed value would be ignored)")
 
 
 def _schema_default(key: str) -> Any:

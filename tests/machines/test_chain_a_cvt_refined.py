@@ -23,12 +23,20 @@ def scene():
 
 @pytest.fixture(scope="module")
 def model(scene):
+    """A1 with H2 and the presets' pin face (inclined at the flank angle)."""
     return from_scene(scene, reference_geometry(), F_APPL, model="chain-A1", contact="hertz-refined")
 
 
 @pytest.fixture(scope="module")
 def static(model, scene):
     return model.static_state(RATIO, scene.cvt.regime.input_speed)
+
+
+@pytest.fixture(scope="module")
+def flat(scene):
+    """A1 with H2 and the flat pin face (theta = 0), with its quasi-static start."""
+    m = from_scene(scene, reference_geometry(), F_APPL, model="chain-A1", contact="hertz-refined", face_inclination=0.0)
+    return m, m.static_state(RATIO, scene.cvt.regime.input_speed)
 
 
 def _perturbed(model, x0, seed=0):
@@ -64,12 +72,15 @@ def test_variant_a_builds_a1_with_h2_at_both_ends():
                                   v0=0.02, regime=m.regime, F_appl=F_APPL)
 
 
-def test_static_start_converges_and_balances_every_sheave(model, static, scene):
+@pytest.mark.parametrize("pin_face", ["flat", "inclined"])
+def test_static_start_converges_and_balances_every_sheave(pin_face, model, static, flat, scene):
     """The H2 start: residual, each movable sheave's axial force = its clamping force, the chain's axial balance,
     the pins on their planned arcs, the contact points x_* inside the pin end; the link tension is A1-with-H1's
     scaled by the wedge's ``tan(gamma)`` at the contact radius over that at the pin radius on the driven arc
-    (``T = F2 tan(gamma2) / theta2*``: on the toroidal face H2's contact point x_* inwards sees a steeper face)."""
-    x0, rep = static
+    (``T = F2 tan(gamma2) / theta2*``: on the toroidal face H2's contact point x_* inwards sees a steeper face).
+    The flat face puts x_* 3.8 mm inside on the driven arc (a 1.3 % steeper wedge), the face inclined at the flank
+    angle 0.4 mm."""
+    model, (x0, rep) = (model, static) if pin_face == "inclined" else flat
     assert rep["residual"] < 1e-8 and rep["max_penetration"] < 5e-5
     at_rest = x0.copy()
     at_rest[model.n2:2 * model.n2] = 0.0          # the solve's state (the running one adds the arc ends' friction)
@@ -85,16 +96,20 @@ def test_static_start_converges_and_balances_every_sheave(model, static, scene):
     for k in (0, 1):
         r = np.linalg.norm(u[0, model.pin_of(ends[on & (shafts == k)])] - model.contact.centres[k], axis=1)
         assert np.abs(r - pl.r[k]).max() < 2e-4
-    assert 2e-3 < np.abs(d["offset"][on]).max() < 4e-3
+    low, high = {"flat": (2e-3, 4e-3), "inclined": (1e-4, 6e-4)}[pin_face]
+    assert low < np.abs(d["offset"][on]).max() < high
     h1 = from_scene(scene, reference_geometry(), F_APPL, model="chain-A1")
     _, rep1 = h1.static_state(RATIO, scene.cvt.regime.input_speed)
     face, driven = model.contact.faces[1], on & (shafts == 1)
     wedge = face.tan_gamma(d["radius"][driven].mean()) / face.tan_gamma(pl.r[1])
-    assert wedge < 0.99                                   # the effect is 1.3 %, the check 0.1 %
+    if pin_face == "flat":
+        assert wedge < 0.99                               # the effect is 1.3 %, the check 0.1 %
+    else:
+        assert 0.998 < wedge < 1.0                        # 0.11 %: x_* near the axis, the tension near H1's
     assert rep["tension"] == pytest.approx(wedge * rep1["tension"], rel=1e-3)
     assert rep["F1"] == pytest.approx(rep1["F1"], rel=3e-2)
-    # the eccentric contact bends the pins: end moments on the arcs, none on the spans
-    assert np.abs(d["moment"][on]).max() > 1.0
+    # the eccentric contact bends the pins: end moments on the arcs, none on the spans (largest: 0.6 N m inclined)
+    assert np.abs(d["moment"][on]).max() > {"flat": 1.0, "inclined": 0.3}[pin_face]
 
 
 def test_contact_forces_are_minus_the_gradient_of_the_hertz_potential(model, static):
@@ -182,8 +197,11 @@ def test_support_forces_are_the_resultant_of_the_contact_forces(model, static, s
 def test_cvtfem_run_variant_a_balances_energy_and_axial_forces(cli, tmp_path):
     """`cvtfem run` of variant (a) at the stationary regime (chain-A1's solver settings) over 0.2 ms from its
     quasi-static start: the work integrals close the energy balance to 1e-5 of the input work, every output is
-    finite, and over the second 0.1 ms the pins' axial forces on each movable sheave balance its clamping force
-    on average to 1 %."""
+    finite, and over the second 0.1 ms each movable sheave obeys ``m_z z'' = F_axial - F_clamp`` (``m_z`` half the
+    pair's mass, ``z''`` by second differences of the stored positions 10 us apart): to 5 % of the largest imbalance
+    at every sample, to 1e-4 of the clamping force on average.  The inclined face starts an axial oscillation of the
+    driving sheave: over this window its mean imbalance is 1.2 % of the clamping force (session 13; the flat face's
+    start was within 1 %), all of it the sheave's inertia."""
     import json
 
     import h5py
@@ -200,8 +218,12 @@ def test_cvtfem_run_variant_a_balances_energy_and_axial_forces(cli, tmp_path):
         for name in s:
             assert np.isfinite(s[name][:]).all(), name
         t, W, E = s["time"][:], s["work"][-1], s["energy"][:]
-        late = t >= 1e-4
-        axial = s["contact.sheave_axial_force"][late].mean(axis=0)
-        F = np.array([s["driving.clamping_force"][late].mean(), s["driven.clamping_force"][late].mean()])
+        z = np.column_stack([s["driving.sheave_position"][:].ravel(), s["driven.sheave_position"][:].ravel()])
+        F = np.column_stack([s["driving.clamping_force"][:].ravel(), s["driven.clamping_force"][:].ravel()])
+        imbalance = (s["contact.sheave_axial_force"][:] - F)[1:-1]
     assert W[0] > 1.0 and abs(W[0] - W[1] - W[2] + W[3] - (E[-1] - E[0])) < 1e-5 * W[0]
-    np.testing.assert_allclose(axial, F, rtol=1e-2)
+    m_z = 0.5 * load_scene("variant-a").cvt.driving.sheave_mass              # both shafts 5 kg
+    late = t[1:-1] >= 1e-4
+    inertia = m_z * (z[2:] - 2 * z[1:-1] + z[:-2]) / np.diff(t)[1:, None] ** 2
+    assert np.abs(imbalance - inertia)[late].max() < 0.05 * np.abs(imbalance[late]).max()
+    np.testing.assert_allclose((imbalance - inertia)[late].mean(axis=0), 0.0, atol=1e-4 * F.mean())

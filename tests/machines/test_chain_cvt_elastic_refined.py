@@ -223,8 +223,12 @@ def test_mapped_forces_are_the_hertz_gradient_and_friction_has_the_kernel_power(
     assert np.abs(Y0[on, 9:14]).max() > 100.0            # the sheave translation and tilt are loaded
     rates = np.column_stack([Z[:, N_POS:2 * N_POS], Z[:, -1]])
     terms = Y[:, :N_POS + 1] * rates
-    np.testing.assert_array_less(np.abs(terms.sum(axis=1) + np.sum(grad * Z[:, N_POS:2 * N_POS], axis=1) - Y[:, -1]),
-                                 1e-5 * np.abs(terms).sum(axis=1) + 1e-9)
+    # the differences' error is ~ (1e-9 m / Delta)^2 of the gradient: no contact within 0.1 um of grazing (the
+    # inclined face's state has one at 13 nm, 2e-5 off)
+    sure = (delta <= 0) | (delta > 1e-7)
+    assert (~sure).sum() <= 2
+    np.testing.assert_array_less(np.abs(terms.sum(axis=1) + np.sum(grad * Z[:, N_POS:2 * N_POS], axis=1)
+                                        - Y[:, -1])[sure], (1e-5 * np.abs(terms).sum(axis=1) + 1e-9)[sure])
     assert Y[:, -1].min() < -1.0
 
 

@@ -26,6 +26,7 @@ def scene():
 
 @pytest.fixture(scope="module")
 def model(scene):
+    """A5 with H2 and the presets' pin face (inclined at the flank angle)."""
     return from_scene(scene, reference_geometry(), F_APPL, model="chain-A5", contact="hertz-refined")
 
 
@@ -33,6 +34,14 @@ def model(scene):
 def placed(model, scene):
     """The placed start (halves rolling on each other on the path of the ratio, sheaves at the wedge estimate)."""
     return model.placed_state(RATIO, scene.cvt.regime.input_speed)
+
+
+@pytest.fixture(scope="module")
+def flat(scene):
+    """A5 with the flat pin face (theta = 0) and its placed start: a face symmetric about the pin axis, the same for
+    a half turning with its own link as for a whole pin turning with the bisector of its two links."""
+    m = from_scene(scene, reference_geometry(), F_APPL, model="chain-A5", contact="hertz-refined", face_inclination=0.0)
+    return m, m.placed_state(RATIO, scene.cvt.regime.input_speed)
 
 
 def _perturbed(model, x0, seed=0):
@@ -145,12 +154,14 @@ def test_friction_power_is_the_work_rate_of_the_friction_forces(model, placed):
     assert Pf0 == 0.0 and Pf < -1.0
     assert Pf == pytest.approx(float((Q - Q0) @ v), rel=1e-10)
 
-def test_twist_acts_on_the_halves_of_one_link_as_1_352(model, placed):
+def test_twist_acts_on_the_halves_of_one_link_as_1_352(flat):
     """The force on the link chord of a half end is (1.352): the twist moment ``F . ((k + gamma) x rho)`` of the
     friction force at ``R_*`` (``rho = R_* - R_pin``, ``gamma`` the end slope) over ``|c|`` along ``n = k x c/|c|``,
-    +on the front half, -on the rear one (spec §5.5, independent halves), per end (EndContact's half of the pair)."""
+    +on the front half, -on the rear one (spec §5.5, independent halves), per end (EndContact's half of the pair).
+    The flat face: an inclined one turning with the half adds the normal force's twist (``dDelta/dphi``)."""
     from cvtfem.elements.chain.symmetric import END_SLOPE_FACTOR
 
+    model, placed = flat
     x = _perturbed(model, placed, seed=2)
     q, v = x[:model.n2], x[model.n2:2 * model.n2]
     _, shafts, _, _, X, (Y, d) = model._contact_set(q, v, details=True)
@@ -182,14 +193,19 @@ def _a1_state_in_halves(a1, a5, x1):
     return x5
 
 
-def test_halves_at_the_whole_pin_are_a1_with_twice_the_contact(model, scene, placed):
+def test_halves_at_the_whole_pin_are_a1_with_twice_the_contact(flat, scene):
     """With both halves of every pin at the same place as A1's pin (zero offset, rigidly tied), each half end is one
     H2 contact at A1's end: frictionless, the half forces summed over the two halves equal A1 + H2 with ``2 c`` on all
     ten pin coordinates and the sheaves, to round-off.  With friction and the chain turning rigidly with one shaft
     (every link chord turns at the shaft's rate, so each half's spin equals A1's bisector spin) all forces and the
     friction power agree too: A1's twist map (1.349) with unit chords, ``(E - e e) n / |e_- + e_+| / L = n_e / (2 L)``
-    per chord, is exactly half the twist moment through each chord, the sum of the two halves' (1.352)."""
-    a1 = from_scene(scene, reference_geometry(), F_APPL, model="chain-A1", contact="hertz-refined")
+    per chord, is exactly half the twist moment through each chord, the sum of the two halves' (1.352).
+    The flat face: an inclined face turns with its body, a half's with its link chord and A1's with the bisector of
+    the pin's two chords (half a pitch angle apart on an arc), so the two contacts differ there (24 and 11 % on the
+    sheaves' axial forces at this state, 10 deg)."""
+    model, placed = flat
+    a1 = from_scene(scene, reference_geometry(), F_APPL, model="chain-A1", contact="hertz-refined",
+                    face_inclination=0.0)
     pair1 = a1.contact.pair
     a1x2 = replace(a1, contact=EndContact(replace(pair1, c=2 * pair1.c)), fixed_z=model.fixed_z)
     fam5 = model.family

@@ -14,17 +14,30 @@ from tests.machines.chain_checks import assert_jacobian_columns
 pytestmark = pytest.mark.slow          # the starts: A1, A3, A4 on rigid shafts, then on the elastic ones (~30-60 s)
 
 
-@pytest.fixture(scope="module")
-def variants():
+def _variants(face: dict) -> dict:
     """``{"d": (model, x0, report), "g": (model, x0)}``: variant (d) from its start on elastic shafts; variant (g) with
     (d)'s face references (both from the wedge estimate and A1's balance) at (d)'s start state, which is no balance of
-    (g) (some of A4's plates bear on a corner there) but a state to evaluate it at."""
-    d = chain_loop(load_scene("variant-d,regime-stationary"))
+    (g) (some of A4's plates bear on a corner there) but a state to evaluate it at; ``face`` the `cvt.chain` keys
+    written over the presets."""
+    d = chain_loop(load_scene("variant-d,regime-stationary").replace({"cvt": {"chain": face}}))
     w1, _, i = d.regime.targets(0.0)
     x0, rep = d.static_state(i, w1)
     d = rep["model"]
-    g = replace(chain_loop(load_scene("variant-g,regime-stationary")), z_ref=d.z_ref, rigid_start=d.rigid_start)
+    g = replace(chain_loop(load_scene("variant-g,regime-stationary").replace({"cvt": {"chain": face}})),
+                z_ref=d.z_ref, rigid_start=d.rigid_start)
     return {"d": (d, x0, rep), "g": (g, x0)}
+
+
+@pytest.fixture(scope="module")
+def variants():
+    """The variants with the presets' pin face (inclined at the flank angle)."""
+    return _variants({})
+
+
+@pytest.fixture(scope="module")
+def flat_variants():
+    """The variants with the flat pin face (theta = 0): the contact points 3-4 mm inside the pin ends."""
+    return _variants({"face_inclination": 0.0})
 
 
 def _running(model, x0, seed: int, pins=np.array([3, 30, 57]), angle: float = 4e-3):
@@ -43,13 +56,15 @@ def _running(model, x0, seed: int, pins=np.array([3, 30, 57]), angle: float = 4e
     return x
 
 
-def test_start_balances_with_corner_contacts_in_the_outer_plates(variants):
+def test_start_balances_with_corner_contacts_in_the_outer_plates(flat_variants):
     """The start on elastic shafts (H2, residual 1e-8 of F2): the movable sheaves take the clamping forces along their
     tilted axes (1e-3). H2's contact points lie inside the pin ends, so the pins bend on the arcs (most on the small
     driving arc) and the outer plates tilt against them: there A4's plates bear on a corner (|m| = 1) or go slack,
     the inner half of the pin keeps line contact (the source, section 1.7: corner contacts occur in the outermost
-    plates). At that state (g)'s clamped plates exceed the bound and the two right-hand sides differ."""
-    (d, x0, rep), (g, _) = variants["d"], variants["g"]
+    plates). At that state (g)'s clamped plates exceed the bound and the two right-hand sides differ.  The flat face
+    (theta = 0): inclined at the flank angle, the contact points lie within 0.5 mm of the axis and no plate of (d)'s
+    start bears on a corner (session 13)."""
+    (d, x0, rep), (g, _) = flat_variants["d"], flat_variants["g"]
     assert isinstance(d, ElasticChainACVT) and d.contact.refined and d.family.chain.model == "A4"
     assert g.family.chain.model == "A3" and g.n2 == d.n2
     assert rep["residual"] < 1e-8

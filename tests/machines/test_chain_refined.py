@@ -32,9 +32,23 @@ def scene():
 
 
 @pytest.fixture(scope="module")
-def models(scene):
-    return {m: from_scene(scene, reference_geometry(), F_APPL, model=m, contact="hertz-refined")
-            for m in ("chain-S2", "chain-S3")}
+def pin_faces(scene):
+    """The refined chains by pin end face: ``flat`` (theta = 0, the face the closed forms below assume) and
+    ``inclined`` (the presets' face, parallel to the nominal flank: theta = ``geometry.flank_angle``)."""
+    return {face: {m: from_scene(scene, reference_geometry(), F_APPL, model=m, contact="hertz-refined", **kw)
+                   for m in ("chain-S2", "chain-S3")}
+            for face, kw in (("flat", {"face_inclination": 0.0}), ("inclined", {}))}
+
+
+@pytest.fixture(scope="module")
+def models(pin_faces):
+    return pin_faces["flat"]
+
+
+def test_the_presets_face_is_inclined_at_the_flank_angle(scene, pin_faces):
+    assert scene.cvt.chain.face_inclination == scene.cvt.geometry.flank_angle > 0
+    assert pin_faces["inclined"]["chain-S3"].contact.face_inclination == scene.cvt.geometry.flank_angle
+    assert pin_faces["flat"]["chain-S3"].contact.face_inclination == 0.0
 
 
 def _contact(models, model, face):
@@ -166,19 +180,21 @@ def test_s2_is_h1_shifted(models, face):
     assert np.all(Y2[:, [0, 1, 4, 5]] == 0)                 # no twist without friction
 
 
+@pytest.mark.parametrize("pin_face", ["flat", "inclined"])
 @pytest.mark.parametrize("model, face", [("chain-S3", "torus"), ("chain-S3", "cone"), ("chain-S2", "torus")])
-def test_forces_are_minus_the_gradient_of_the_hertz_potential(models, model, face):
+def test_forces_are_minus_the_gradient_of_the_hertz_potential(pin_faces, pin_face, model, face):
     """Frictionless generalized forces on every position input (neighbours, pin end, slopes, sheave) and on
     the shaft spin = minus the central-difference gradient of 2 x 2/5 c Delta^{5/2}, 1e-6 relative."""
-    con = replace(_contact(models, model, face), f0=0.0)
+    con = replace(_contact(pin_faces[pin_face], model, face), f0=0.0)
     X, shafts = _random_inputs(con, seed=3)
     Y = assert_forces_are_minus_the_hertz_gradient(con, X, shafts)
     assert np.all(Y[:, con.n_pos] == 0)                     # axisymmetric sheave: no moment on phi
 
 
+@pytest.mark.parametrize("pin_face", ["flat", "inclined"])
 @pytest.mark.parametrize("model", ["chain-S3", "chain-S2"])
-def test_friction_power_is_the_work_rate_of_the_friction_forces(models, model):
-    con = models[model].contact
+def test_friction_power_is_the_work_rate_of_the_friction_forces(pin_faces, pin_face, model):
+    con = pin_faces[pin_face][model].contact
     X, shafts = _random_inputs(con, seed=4)
     assert_friction_power_is_the_work_rate(con, X, shafts)
 
@@ -226,16 +242,30 @@ def test_scene_builds_the_refined_chain(scene):
     assert isinstance(m2, RefinedChainCVT) and not m2.contact.slopes
 
 
+#: Largest contact point offset |x_*| (m) at the quasi-static start: flat face R_f tan(gamma) / (1 - R_f f'') ~ 3.4 mm
+#: (the point inside the face half-height 3.02 mm only for some pins), inclined at the flank angle 0.3-0.4 mm
+#: (docs/transmission.md, session 12: the toroidal flank runs 9.1-11.1 deg against the face's 10 deg).
+OFFSET_BAND = {"flat": (2e-3, 4e-3), "inclined": (1e-4, 6e-4)}
+
+
 @pytest.fixture(scope="module")
-def static_s3(models, scene):
-    return models["chain-S3"].static_state(RATIO, scene.cvt.regime.input_speed)
+def static_s3(pin_faces, scene):
+    """The quasi-static start of chain-S3 with the pin face ``flat`` or ``inclined`` (each solved on first use)."""
+    starts = {}
+
+    def start(pin_face):
+        if pin_face not in starts:
+            starts[pin_face] = pin_faces[pin_face]["chain-S3"].static_state(RATIO, scene.cvt.regime.input_speed)
+        return starts[pin_face]
+    return start
 
 
-def test_static_state_with_refined_contact(models, static_s3):
+@pytest.mark.parametrize("pin_face", ["flat", "inclined"])
+def test_static_state_with_refined_contact(pin_faces, pin_face, static_s3):
     """The quasi-static start with H2: balanced, pins on the planned radii (the driving sheave shifted by the
-    H2 approach), axial forces = clamping forces, contact points x_* inside the pin end face."""
-    m = models["chain-S3"]
-    x0, rep = static_s3
+    H2 approach), axial forces = clamping forces, contact points x_* where the face puts them."""
+    m = pin_faces[pin_face]["chain-S3"]
+    x0, rep = static_s3(pin_face)
     assert rep["residual"] < 1e-8 and rep["max_penetration"] < 5e-5
     o = m.outputs(0.0, x0)
     np.testing.assert_allclose(o["contact.sheave_axial_force"], [rep["F1"], F_APPL[1]], rtol=1e-8)
@@ -247,25 +277,30 @@ def test_static_state_with_refined_contact(models, static_s3):
     for k in (0, 1):
         r = np.linalg.norm(u[pins[on & (shafts == k)]] - m.contact.centres[k], axis=1)
         assert np.abs(r - pl.r[k]).max() < 2e-4          # within 0.2 mm of the planned arc
-    assert np.abs(d["offset"][on]).max() < 4e-3               # |x_*| = R_f tan(gamma) / (1 - R_f f'') ~ 3.4 mm
+    low, high = OFFSET_BAND[pin_face]
+    assert low < np.abs(d["offset"][on]).max() < high
     # the start turns the pins and their slopes with their sheave: no slip at the offset contact points, but the
-    # first and last pin of an arc turn at about half the sheave's rate (one link on the span), so their
-    # contact point, x_* off the axis, slips by about w |x_*| / 2 (0.2 m/s driven, 0.45 m/s driving)
+    # first and last pin of an arc turn slower than the sheave (one link on the span), so their contact point,
+    # x_* off the axis, slips by about w |x_*| / 2 (flat face: 0.47 m/s driving, 0.20 m/s driven; inclined: 0.04 /
+    # 0.02 m/s); the measured factor, 0.85 driving and 0.69 driven, is the same for both faces to 2 %
     n = m.family.n
     slip = o["contact.slip_speed"].reshape(n, 2)
     N = o["contact.normal_force"].reshape(n, 2)
+    offset = o["contact.face_offset"].reshape(n, 2)
     for k in (0, 1):
         on = N[:, k] > 0
         inner = on & on[m.family.im1] & on[m.family.ip1]
         assert np.all(slip[inner, k] < 1e-9) and (on & ~inner).sum() == 2
         w_k = x0[m.n2 + m._idx[1][k]]
-        assert np.all(np.abs(slip[on & ~inner, k] / (w_k * 3.4e-3 / 2) - 1) < 0.25)
+        factor = slip[on & ~inner, k] / (w_k * offset[on & ~inner, k] / 2)
+        assert np.all(np.abs(factor - (0.85, 0.69)[k]) < 0.03)
 
 
-def test_jacobian_of_the_refined_chain_against_differences(models, static_s3):
-    m = models["chain-S3"]
+@pytest.mark.parametrize("pin_face", ["flat", "inclined"])
+def test_jacobian_of_the_refined_chain_against_differences(pin_faces, pin_face, static_s3):
+    m = pin_faces[pin_face]["chain-S3"]
     rng = np.random.default_rng(7)
-    x = static_s3[0].copy()
+    x = static_s3(pin_face)[0].copy()
     nc, n2 = m.family.size, m.n2
     x[:nc] += rng.normal(0.0, 2e-6, nc)
     x[n2:n2 + nc] += rng.normal(0.0, 0.05, nc)
@@ -278,11 +313,12 @@ def test_jacobian_of_the_refined_chain_against_differences(models, static_s3):
     assert_jacobian_columns(m, x, J, cols)
 
 
-def test_energy_balance_over_a_short_run(models, static_s3):
+@pytest.mark.parametrize("pin_face", ["flat", "inclined"])
+def test_energy_balance_over_a_short_run(pin_faces, pin_face, static_s3):
     """20 us of running from the quasi-static start (Radau, rtol 1e-6): E(t) - E(0) = input - output +
     clamping - dissipated work to 1e-6 of the input work."""
-    x0, rep = static_s3
-    m = models["chain-S3"].with_clamping([rep["F1"], F_APPL[1]])
+    x0, rep = static_s3(pin_face)
+    m = pin_faces[pin_face]["chain-S3"].with_clamping([rep["F1"], F_APPL[1]])
     assert_energy_balance(m, x0, 2e-5)
 
 
@@ -309,9 +345,10 @@ def test_run_chain_s3_refined_balances_energy_and_axial_forces(cli, tmp_path):
 
 
 @pytest.mark.parametrize("law", ["tanh", "smooth", "arctan", "linear-saturated", "smoothed"])
+@pytest.mark.parametrize("pin_face", ["flat", "inclined"])
 @pytest.mark.parametrize("model, face", [("chain-S3", "torus"), ("chain-S3", "cone"), ("chain-S2", "torus")])
-def test_kernel_equals_the_numpy_twin(models, model, face, law):
-    con = replace(_contact(models, model, face), law=law)
+def test_kernel_equals_the_numpy_twin(pin_faces, pin_face, model, face, law):
+    con = replace(_contact(pin_faces[pin_face], model, face), law=law)
     X, shafts = _random_inputs(con, seed=8)
     X[:3, con.n_pos:] = 0.0                                      # three contacts without any motion: zero slip
     Yk, Yr = con.local(X, shafts), con.local(X, shafts, reference=True)

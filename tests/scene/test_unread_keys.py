@@ -67,3 +67,34 @@ def test_the_elastic_shaft_keys_are_refused_on_rigid_shafts_and_band_models(key)
         scene_from_dict({"preset": "band-6+2n+8", "cvt": {shaft: {name: value}}})
     elastic = scene_from_dict({"preset": "variant-b", "cvt": {shaft: {name: value}}})      # read there
     assert elastic.data["cvt"][shaft][name] == value
+
+
+@pytest.mark.parametrize("doc", [
+    {"preset": "chain-S2"}, {"preset": "chain-S1"}, {"preset": "variant-zh"}, {"preset": "band-6+2n"},
+    {"preset": "band-6+2n+8"}, {"preset": "band-4dof"},
+    {"preset": "variant-a", "cvt": {"effects": {"contact": "hertz"}}},
+    {"preset": "variant-a", "cvt": {"effects": {"contact": "impact"}}},
+], ids=lambda d: f"{d['preset']}-{d.get('cvt', {}).get('effects', {}).get('contact', 'preset')}")
+def test_the_presets_inclined_face_does_not_refuse_a_model_that_does_not_read_it(doc):
+    """Since session 13 `reference_cvt` inclines the pin face at the flank angle: every scene on it whose model does
+    not read `face_inclination` (H1, impact, rigid contacts, band models) loads, the presets' 10 deg unread."""
+    scene = scene_from_dict(doc)
+    assert scene.cvt.chain.face_inclination == scene.cvt.geometry.flank_angle > 0
+    assert (scene.cvt.model.startswith("band") or scene.cvt.effects.contact != "hertz-refined")
+
+
+def test_a_face_inclination_written_for_a_model_that_does_not_read_it_is_still_refused():
+    """Written by the scene itself and unread: refused, whatever its presets; the presets' value (10 deg) and the
+    schema's neutral default (0, every stored scene before session 13) pass."""
+    for doc, model in (({"preset": "variant-a", "cvt": {"effects": {"contact": "hertz"}}}, "chain-A1"),
+                       ({"preset": "chain-S1"}, "chain-S1"), ({"preset": "band-6+2n+8"}, "band-6\\+2n\\+8")):
+        bad = {**doc, "cvt": {**doc.get("cvt", {}), "chain": {"face_inclination": 0.1}}}
+        with pytest.raises(InputError, match=rf"`cvt.chain.face_inclination` is not read by `{model}`.*presets' "
+                                             r"value 0.1745.* or the default 0.0 .*got 0.1$"):
+            scene_from_dict(bad)
+        for value in (load_scene("variant-a").cvt.geometry.flank_angle, 0.0):
+            ok = {**doc, "cvt": {**doc.get("cvt", {}), "chain": {"face_inclination": value}}}
+            assert scene_from_dict(ok).cvt.chain.face_inclination == value
+    stored = tomllib.loads(load_scene("chain-S2").to_toml())           # a results file's scene before session 13
+    stored["cvt"]["chain"]["face_inclination"] = 0.0
+    assert scene_from_dict(stored).cvt.chain.face_inclination == 0.0

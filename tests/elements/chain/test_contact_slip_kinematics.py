@@ -160,10 +160,11 @@ def test_h2_pin_rolling_with_its_sheave_has_zero_slip_with_an_inclined_face(face
 def a1_models():
     scene = load_scene("band-6+2n")
     F = np.array([30000.0, 35000.0])
-    models = {c: from_scene(scene, reference_geometry(), F, model="chain-A1", contact=c)
-              for c in ("hertz", "hertz-refined")}
-    models["inclined"] = from_scene(scene, reference_geometry(), F, model="chain-A1", contact="hertz-refined",
-                                    face_inclination=scene.cvt.geometry.flank_angle)
+    models = {"hertz": from_scene(scene, reference_geometry(), F, model="chain-A1", contact="hertz")}
+    # H2 with the flat face (theta = 0) and with the presets' face, inclined at the flank angle
+    for c, theta in (("hertz-refined", 0.0), ("inclined", scene.cvt.geometry.flank_angle)):
+        models[c] = from_scene(scene, reference_geometry(), F, model="chain-A1", contact="hertz-refined",
+                               face_inclination=theta)
     return models
 
 
