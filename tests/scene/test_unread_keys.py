@@ -8,7 +8,7 @@ import pytest
 
 from cvtfem.errors import InputError
 from cvtfem.scene.loader import load_scene, scene_from_dict
-from cvtfem.scene.schema.cvt import CHAIN_UNREAD, ELASTIC_SHAFT_KEYS
+from cvtfem.scene.schema.cvt import BAND_UNREAD, CHAIN_UNREAD, ELASTIC_SHAFT_KEYS
 
 
 @pytest.mark.parametrize("key", sorted(CHAIN_UNREAD))
@@ -98,3 +98,17 @@ def test_a_face_inclination_written_for_a_model_that_does_not_read_it_is_still_r
     stored = tomllib.loads(load_scene("chain-S2").to_toml())           # a results file's scene before session 13
     stored["cvt"]["chain"]["face_inclination"] = 0.0
     assert scene_from_dict(stored).cvt.chain.face_inclination == 0.0
+
+
+@pytest.mark.parametrize("key", sorted(BAND_UNREAD))
+def test_the_discrete_chains_keys_are_refused_on_band_models(key):
+    """Pins, plates, links and the pin-sheave contact model are the discrete chain's: a band model reads none of them
+    (session 13's audit); a discrete chain does."""
+    table, name = key.split(".")[1:]
+    chain = load_scene("variant-b").data["cvt"][table][name]
+    value = "hertz" if name == "contact" else chain * 2
+    for preset in ("band-4dof", "band-6+2n", "band-6+2n+8"):
+        with pytest.raises(InputError, match=rf"`{key}` is not read by `{preset.replace('+', chr(92) + '+')}`"):
+            scene_from_dict({"preset": preset, "cvt": {table: {name: value}}})
+    read = scene_from_dict({"preset": "variant-b", "cvt": {table: {name: value}}})
+    assert read.data["cvt"][table][name] == value

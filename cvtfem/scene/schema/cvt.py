@@ -196,12 +196,25 @@ ELASTIC_SHAFT_KEYS = {
 }
 
 
+#: The discrete chain's own description, read by no band model (the band has a length from ``n_pins`` and the pitch
+#: pattern, a mass, a half-width, a transverse stiffness and a damping ratio; no pins, plates or links).
+BAND_UNREAD = {
+    **{f"cvt.chain.{key}": f"the discrete chain's {what} (a band model's band has no pins, plates or links)"
+       for key, what in (("plates_per_link", "plates per link"), ("lacing_period", "plate lacing period"),
+                         ("pin_length", "pin length"), ("pin_I_min", "pin section's second moment of area"),
+                         ("pin_area", "pin section area"), ("pin_axial_stiffness", "pin axial stiffness"),
+                         ("link_stiffness", "link tensile stiffness"))},
+    "cvt.effects.contact": "the pin-sheave contact model of a discrete chain (a band model's band meets the sheaves "
+                           "along its arcs through the friction law)",
+}
+
+
 def unread_keys(cvt: Mapping[str, Any]) -> dict[str, str]:
     """Dotted keys the validated CVT table ``cvt`` (its model, contact and shafts) does not read, each with what it
-    describes (see :data:`CHAIN_UNREAD`, :data:`FACE_KEYS`, :data:`ELASTIC_SHAFT_KEYS`)."""
+    describes (see :data:`CHAIN_UNREAD`, :data:`FACE_KEYS`, :data:`ELASTIC_SHAFT_KEYS`, :data:`BAND_UNREAD`)."""
     model = cvt["model"]
     if not model.startswith("chain"):
-        return {**FACE_KEYS, **ELASTIC_SHAFT_KEYS}
+        return {**FACE_KEYS, **ELASTIC_SHAFT_KEYS, **BAND_UNREAD}
     unread = dict(CHAIN_UNREAD)
     if not cvt["effects"]["shaft_elasticity"]:
         unread.update(ELASTIC_SHAFT_KEYS)
