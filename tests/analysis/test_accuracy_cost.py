@@ -261,12 +261,13 @@ def test_the_study_measures_a_pin_half_force_and_the_spectrum_on_a5():
 
 def _run_options(sol) -> dict:
     """``solve`` options of a scene's ``[solver]``: its fixed step for a playground method given ``h``, else its
-    tolerances."""
-    from cvtfem.integrate.methods import METHODS
+    tolerances, and the method's own ``options``."""
+    from cvtfem.integrate.methods import METHODS, parse_options
 
+    own = parse_options(sol.options, "solver.options")
     if sol.h > 0 and sol.method in METHODS:
-        return {"h": sol.h}
-    return {"rtol": sol.rtol, "atol": sol.atol}
+        return {"h": sol.h, **own}
+    return {"rtol": sol.rtol, "atol": sol.atol, **own}
 
 
 @pytest.mark.slow
