@@ -21,6 +21,7 @@ interval, from the state the reference method reaches there.
 from __future__ import annotations
 
 import json
+import os
 import time
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -131,6 +132,17 @@ def code_stamp(dirs: tuple[str, ...]) -> str:
     return sources_digest(str(Path(__file__).resolve().parents[1]), dirs).hex()[:16]
 
 
+def _alive(pid: int) -> bool:
+    """Whether process ``pid`` exists on this machine."""
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:                      # another user's process
+        return True
+    return True
+
+
 class StudyCache:
     """Runs of one study kept in a directory, so that a long study can be resumed or split over processes: the
     reference runs' outputs (``reference-METHOD-RTOL.npy``, every component at every sample) and the rows of test 2
@@ -183,11 +195,23 @@ class StudyCache:
         return row if row is not None and row.get("code") == self.run_code else None
 
     def running(self, method: str, rtol: float) -> bool:
-        """True while a process computes this reference run (its mark is removed when the run is kept)."""
-        return self._file(method, rtol, "running").exists()
+        """True while a process computes this reference run: its mark (the process id) is removed when the run is
+        kept; a mark whose process is gone (killed before it could remove it) is removed here, so no study waits for
+        it.  The processes sharing a cache run on one machine."""
+        mark = self._file(method, rtol, "running")
+        try:
+            pid = int(mark.read_text(encoding="utf-8"))
+        except (FileNotFoundError, ValueError):
+            pid = None
+        if pid is not None and _alive(pid):
+            return True
+        mark.unlink(missing_ok=True)
+        return False
 
     def mark_running(self, method: str, rtol: float) -> None:
-        self._file(method, rtol, "running").touch()
+        tmp = self._file(method, rtol, f"running.{os.getpid()}")
+        tmp.write_text(str(os.getpid()), encoding="utf-8")
+        tmp.replace(self._file(method, rtol, "running"))           # complete before it appears
 
     def clear_running(self, method: str, rtol: float) -> None:
         self._file(method, rtol, "running").unlink(missing_ok=True)

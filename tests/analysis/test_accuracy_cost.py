@@ -329,6 +329,25 @@ def test_the_study_cache_keeps_runs_and_refuses_another_study(study, tmp_path):
         ac.StudyCache(tmp_path, "chain-S2 window 0:1e-4")
 
 
+def test_a_reference_mark_left_by_a_killed_process_is_no_wait(tmp_path):
+    """A reference run marks itself running (its process id) so that other processes of the study wait for it; a mark
+    whose process was killed (SIGTERM skips the cleanup) is stale: ``running`` removes it instead of waiting forever
+    (session 13: a killed study left DOP853's mark and the next one waited 20 min)."""
+    import subprocess
+    import sys
+
+    cache = ac.StudyCache(tmp_path, "chain-S2 window 0:5e-5")
+    cache.mark_running("DOP853", 1e-7)
+    assert cache.running("DOP853", 1e-7)                               # this process: alive
+    gone = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"], capture_output=True, text=True)
+    mark = tmp_path / "reference-DOP853-1e-07.running"
+    mark.write_text(gone.stdout.strip(), encoding="utf-8")              # a finished process's id
+    assert not cache.running("DOP853", 1e-7) and not mark.exists()
+    mark.write_text("", encoding="utf-8")                               # a mark from before marks held the id
+    assert not cache.running("DOP853", 1e-7) and not mark.exists()
+    assert cache.reference("DOP853", 1e-7, wait=True) is None           # returns at once
+
+
 def test_the_study_cache_runs_again_what_other_code_computed(study, tmp_path, monkeypatch):
     """Results kept by other code (another stamp of the model or integrator sources) are not reused: the row runs
     again, the reference and the start state read as absent and are computed anew; a stamp follows the sources."""
