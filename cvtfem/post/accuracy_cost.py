@@ -10,6 +10,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
+from matplotlib.ticker import NullFormatter  # noqa: E402
 
 from cvtfem.integrate.study import signed_log  # noqa: E402
 
@@ -76,6 +77,7 @@ def plot_accuracy_cost(rows, path: str | Path, accept: float, title: str = "") -
                             xytext=(3, 3), textcoords="offset points")
         ax.set_xlabel(xlabel)
         ax.grid(alpha=0.3, which="both")
+        ax.xaxis.set_minor_formatter(NullFormatter())        # a decade's minor labels overran each other
     for ax in axes[:2]:
         ax.axhline(accept, color="k", ls="--", lw=0.8)
         ax.set_ylabel("E = max|P - P*| / max|P*| over the window")
