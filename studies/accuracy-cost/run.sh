@@ -5,7 +5,8 @@
 #     bash studies/accuracy-cost/run.sh chain-S2   # the chain-S2 part only (also chain-A1, band, local, variant-e,
 #                                                  # variant-e-4ms, w-short, w-4ms, imex-short, variant-b-4ms,
 #                                                  # w-4ms-dumka3, variant-b-4ms-smoothed, w-4ms-smoothed,
-#                                                  # imex-all-short)
+#                                                  # imex-all-short, elastic-short: both faces,
+#                                                  # elastic-inclined-short)
 # Each test-2 run prints its speed-up table (Table 2.4 style); the logs go next to the results.
 set -euo pipefail
 cd "$(dirname "$0")/../.."
@@ -234,3 +235,17 @@ if [[ $part == all || $part == imex-all-short ]]; then
   done
   uptime | tee -a "$out/variant-e-imex-all-short.log"
 fi
+for tag in elastic elastic-inclined; do    # (e) on elastic shafts, flat face and the presets' inclined face (session 13)
+  if [[ $part == all || $part == elastic-short || $part == "$tag-short" ]]; then
+    cache=out/studies/e-$tag-short-cache
+    ie() { nice "$cvtfem" study accuracy-cost "studies/accuracy-cost/scenes/variant-e-$tag-chapter2-linear-saturated.toml" \
+             --skip-spectrum --window 2e-4:4e-4 --sample 1e-6 --repeats 1 --reference DOP853:1e-7 --check dopri78:1e-7 \
+             --cache "$cache" --png "$out/variant-e-$tag-short.png" --csv "$out/variant-e-$tag-short.csv" \
+             --json "$out/variant-e-$tag-short.json" "$@"; }
+    ie --fixed strang-friction:scheme=imex-rk4:friction=all --steps 1e-6,1.5e-6,2e-6 --adaptive ""
+    ie --fixed dumka3 --steps 3e-6 --adaptive dumka3 --rtols 3e-2
+    ie --fixed rk4 --steps 5e-8 --adaptive ""
+    ie --from-cache | tee "$out/variant-e-$tag-short.log"
+    uptime | tee -a "$out/variant-e-$tag-short.log"
+  fi
+done
