@@ -126,3 +126,32 @@ def assert_jacobian_on_pattern(model, x, n_chain: int = 25) -> None:
     cols = np.concatenate([rng.choice(nc, n_chain, replace=False), n2 + rng.choice(nc, n_chain, replace=False),
                            np.arange(nc, n2), n2 + np.arange(nc, n2), np.arange(2 * n2, 2 * n2 + 4)])
     assert_jacobian_columns(model, x, J, cols)
+
+
+def friction_rate(m, x, halves_only: bool = False) -> np.ndarray:
+    """``f_I`` of an A5 model's friction split at ``x`` from its friction sets: ``M^-1`` times the friction forces on
+    the velocity rows, their power on the work row ``D - P_fr``; ``halves_only``: the halves' friction alone."""
+    n2, out = m.n2, np.zeros(m.size)
+    v = x[n2:2 * n2]
+    sets = m.friction_sets(x)[:1] if halves_only else m.friction_sets(x)
+    for fs in sets:
+        r = fs.forces(fs.S @ v)
+        out[n2:2 * n2] -= m._masses[1] @ (fs.S.T @ r)
+        out[2 * n2 + m.control.size + 2] += r @ (fs.S @ v)
+    return out
+
+
+def assert_friction_solve_all_is_backward_euler(m, states) -> None:
+    """``m.friction_solve_all`` over 0.1 and 2 us from each state: positions and loop states unchanged, the velocity
+    change ``h f_I(x1)`` to the solve's tolerance (set 1e-6 v0 by the caller), and the booked work the kinetic energy
+    removed to round-off."""
+    n2, iw = m.n2, 2 * m.n2 + m.control.size + 2
+    M = m._masses[0]
+    for x in states:
+        for h in (1e-7, 2e-6):
+            x1, _ = m.friction_solve_all(0.0, x, h)
+            assert np.array_equal(x1[:n2], x[:n2]) and np.array_equal(x1[2 * n2:iw], x[2 * n2:iw])
+            dv = x1[n2:2 * n2] - x[n2:2 * n2]
+            assert np.abs(dv - h * friction_rate(m, x1)[n2:2 * n2]).max() <= 1e-6 * np.abs(dv).max()
+            T = [0.5 * y[n2:2 * n2] @ (M @ y[n2:2 * n2]) for y in (x, x1)]
+            assert x1[iw] - x[iw] == pytest.approx(T[0] - T[1], rel=1e-12) and T[0] > T[1]

@@ -2,12 +2,11 @@
 map through the sheaves' frames reproduces the mapped H2 kernel's friction forces (on chain and structure) and power,
 ``f_E + f_I = f`` to round-off for both variants of the split, the friction solve is backward Euler on all velocities
 with the structure's consistent mass and books the kinetic energy it removes, and ``imex-rk4`` runs it."""
-from dataclasses import replace
-
 import numpy as np
 import pytest
 
 from cvtfem.integrate import solve
+from tests.machines.chain_checks import assert_friction_solve_all_is_backward_euler, friction_rate
 from tests.machines.test_chain_halves_elastic import _rigid, _running
 
 
@@ -21,19 +20,6 @@ def model():
 
 def _states(m, x0):
     return [_running(m, x0, seed) for seed in (3, 4)]
-
-
-def friction_rate(m, x, halves_only: bool = False):
-    """``f_I`` at ``x`` from the friction sets: ``M^-1`` times the friction forces on the velocity rows, their power
-    on the work row ``D - P_fr``; ``halves_only``: the halves' friction on the chain's velocities."""
-    n2, out = m.n2, np.zeros(m.size)
-    v = x[n2:2 * n2]
-    sets = m.friction_sets(x)[:1] if halves_only else m.friction_sets(x)
-    for fs in sets:
-        r = fs.forces(fs.S @ v)
-        out[n2:2 * n2] -= m._masses[1] @ (fs.S.T @ r)
-        out[2 * n2 + m.control.size + 2] += r @ (fs.S @ v)
-    return out
 
 
 def test_slip_map_gives_the_mapped_kernels_friction(model):
@@ -74,16 +60,7 @@ def test_friction_solve_all_is_backward_euler_and_books_the_kinetic_energy(model
     mass (its inverse dense over the structure), and the booked work is the kinetic energy removed to round-off."""
     m, x0 = model
     monkeypatch.setattr(type(m), "FRICTION_TOL", 1e-6)
-    n2, iw = m.n2, 2 * m.n2 + m.control.size + 2
-    M = m._masses[0]
-    for x in _states(m, x0):
-        for h in (1e-7, 2e-6):
-            x1, lus = m.friction_solve_all(0.0, x, h)
-            assert np.array_equal(x1[:n2], x[:n2]) and np.array_equal(x1[2 * n2:iw], x[2 * n2:iw])
-            dv = x1[n2:2 * n2] - x[n2:2 * n2]
-            assert np.abs(dv - h * friction_rate(m, x1)[n2:2 * n2]).max() <= 1e-6 * np.abs(dv).max()
-            T = [0.5 * y[n2:2 * n2] @ (M @ y[n2:2 * n2]) for y in (x, x1)]
-            assert x1[iw] - x[iw] == pytest.approx(T[0] - T[1], rel=1e-12) and T[0] > T[1]
+    assert_friction_solve_all_is_backward_euler(m, _states(m, x0))
 
 
 @pytest.mark.slow

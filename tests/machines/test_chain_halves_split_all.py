@@ -8,20 +8,9 @@ import pytest
 from cvtfem.elements.chain import half_end_contact_kernel as HEK
 from cvtfem.errors import InputError
 from cvtfem.integrate import solve
+from tests.machines.chain_checks import assert_friction_solve_all_is_backward_euler, friction_rate
 from tests.machines.test_chain_halves_one_pass import _states
 from tests.machines.test_chain_halves_split import model  # noqa: F401 - the fixture (variant (e), placed)
-
-
-def friction_rate(m, x):
-    """``f_I`` of the variant "all" at ``x`` from :meth:`friction_sets`: ``M^-1`` times all friction forces on the
-    velocity rows, their dissipated power on the work row ``D - P_fr``."""
-    n2, out = m.n2, np.zeros(m.size)
-    v = x[n2:2 * n2]
-    for fs in m.friction_sets(x):
-        r = fs.forces(fs.S @ v)
-        out[n2:2 * n2] -= m._masses[1] @ (fs.S.T @ r)
-        out[2 * n2 + m.control.size + 2] += r @ (fs.S @ v)
-    return out
 
 
 def test_slip_map_gives_the_kernels_friction(model):  # noqa: F811
@@ -59,16 +48,7 @@ def test_friction_solve_all_is_backward_euler_and_books_the_kinetic_energy(model
     energy removed to round-off (at any tolerance)."""
     m, x0 = model
     monkeypatch.setattr(type(m), "FRICTION_TOL", 1e-6)
-    n2, iw = m.n2, 2 * m.n2 + m.control.size + 2
-    M = m._masses[0]
-    for x in _states(m, x0, 2):
-        for h in (1e-7, 2e-6):
-            x1, lus = m.friction_solve_all(0.0, x, h)
-            assert np.array_equal(x1[:n2], x[:n2]) and np.array_equal(x1[2 * n2:iw], x[2 * n2:iw])
-            dv = x1[n2:2 * n2] - x[n2:2 * n2]
-            assert np.abs(dv - h * friction_rate(m, x1)[n2:2 * n2]).max() <= 1e-6 * np.abs(dv).max()
-            T = [0.5 * y[n2:2 * n2] @ (M @ y[n2:2 * n2]) for y in (x, x1)]
-            assert x1[iw] - x[iw] == pytest.approx(T[0] - T[1], rel=1e-12) and T[0] > T[1]
+    assert_friction_solve_all_is_backward_euler(m, _states(m, x0, 2))
 
 
 def test_strang_friction_runs_all_friction(model):  # noqa: F811
