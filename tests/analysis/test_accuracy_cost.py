@@ -140,6 +140,8 @@ def test_speedups_by_cpu_and_by_rhs_equivalents():
          "nlu": 11, "nsolve": 1000, "nsteps": 500, "energy_residual": -1e-3, "dissipated": 0.3}
     assert ac.rhs_equivalents(w, costs) == 1000 + 10 * 50 + 11 * 20 + 1000 * 0.5
     assert ac.rhs_equivalents({"nfev": 7, "njev": 0, "nlu": 0, "nsolve": -1}, costs) == 7
+    split = {"method": "strang-friction", "nfev": 1200, "njev": 0, "nlu": 1355, "nsolve": 0}  # friction LUs: unpriced
+    assert ac.rhs_equivalents(split, costs) is None
     base = {"time": 40.0, "cpu": 20.0, "nfev": 44_000}
     (t,) = ac.speedups([w], base, costs=costs)
     assert t["speedup"] == 20.0 and t["speedup_cpu"] == 20.0 and t["speedup_rhs"] == pytest.approx(44_000 / 2220)
