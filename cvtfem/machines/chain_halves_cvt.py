@@ -368,12 +368,18 @@ class ChainHalvesCVT(ChainACVT):
         and the dissipated-work row only): ``(rhs_explicit, friction_solve, friction_hold, variants)``, the fields of
         :class:`cvtfem.integrate.system.StiffSplit`, with the variant ``"all"`` where the pin-sheave friction can join
         ``f_I`` (:attr:`_sheave_friction`): all friction implicit (:meth:`rhs_explicit_all`,
-        :meth:`friction_solve_all`); None off the one-pass path (numpy chain backend, elastic shafts)."""
-        if not self._one_pass or self.family.chain.f0 == 0.0:
+        :meth:`friction_solve_all`); None without friction in the halves or where :attr:`_splits` is False."""
+        if not self._splits or self.family.chain.f0 == 0.0:
             return None
         variants = {"all": (self.rhs_explicit_all, self.friction_solve_all, self.friction_hold)} if (
             self._sheave_friction) else {}
         return self.rhs_explicit, self.friction_solve, self.friction_hold, variants
+
+    @property
+    def _splits(self) -> bool:
+        """Whether the split's parts exist here: on the one-pass path (not the numpy chain backend; the elastic shafts
+        bring their own parts)."""
+        return self._one_pass
 
     @cached_property
     def _frictionless_args(self) -> tuple:

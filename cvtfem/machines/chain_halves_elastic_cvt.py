@@ -197,18 +197,12 @@ class ElasticChainHalvesRefinedCVT(ElasticChainHalvesCVT, ChainHalvesRefinedCVT)
     half_end_frame: ClassVar[bool] = True
 
     # ----- the friction split off (stiff, solved implicitly), on elastic shafts ---------------------------------------
-    @cached_property
-    def stiff_split(self) -> tuple | None:
-        """:attr:`ChainHalvesCVT.stiff_split` on elastic shafts: ``f_E`` the same model without the halves' internal
-        friction (default) or without any friction (variant ``"all"``), each as a frictionless twin of this model
-        (:attr:`_frictionless`); ``f_I`` solved on the chain's velocities (halves) or on all velocities with the
-        sheaves' structure coordinates as the border (``"all"``: :meth:`sheave_slips` through the sheave frames,
-        :attr:`_masses` with the structure's consistent mass).  None without friction in the halves."""
-        if self.family.chain.f0 == 0.0:
-            return None
-        variants = {"all": (self.rhs_explicit_all, self.friction_solve_all, self.friction_hold)} if (
-            self._sheave_friction) else {}
-        return self.rhs_explicit, self.friction_solve, self.friction_hold, variants
+    #: :attr:`ChainHalvesCVT.stiff_split` on elastic shafts: ``f_E`` the same model without the halves' internal
+    #: friction (default) or without any friction (variant ``"all"``), each a frictionless twin of this model
+    #: (:attr:`_frictionless`); ``f_I`` solved on the chain's velocities (halves) or on all velocities with the
+    #: sheaves' structure coordinates as the border (``"all"``: :meth:`sheave_slips` through the sheave frames,
+    #: :attr:`_masses` with the structure's consistent mass).
+    _splits: ClassVar[bool] = True
 
     @cached_property
     def _frictionless(self) -> dict:

@@ -52,20 +52,10 @@ class FrictionSet:
     def potential(self, s) -> float:
         return float(self.c @ friction_potential(self.speeds(s), self.f0, self.v0, self.law))
 
-    def slopes(self, s, tangent: bool) -> np.ndarray:
-        """The blocks ``d(c psi s)/ds`` (contacts, dim, dim) (``tangent``: ``c [psi (I - tt) + f' tt]``,
-        ``t = s/|s|``) or the secant ``c psi I`` (the majoriser's)."""
-        d, speed = self.dim, self.speeds(s)
-        gain = self.c * friction_gain(speed, self.f0, self.v0, self.law)
-        if not tangent or d == 1:
-            diag = self.c * friction_slope(speed, self.f0, self.v0, self.law) if tangent else gain
-            return diag[:, None, None] * np.eye(d)
-        slope = self.c * friction_slope(speed, self.f0, self.v0, self.law)
-        t = s.reshape(-1, d) / np.where(speed > 0, speed, 1.0)[:, None]
-        return gain[:, None, None] * np.eye(d) + (slope - gain)[:, None, None] * t[:, :, None] * t[:, None, :]
-
     def roots(self, s, tangent: bool) -> np.ndarray:
-        """The symmetric square roots (contacts, dim, dim) of :meth:`slopes` (a convex potential's ``f' >= 0``)."""
+        """The symmetric square roots (contacts, dim, dim) of the blocks ``d(c psi s)/ds`` (``tangent``: ``c [psi (I -
+        tt) + f' tt]``, ``t = s/|s|``) or of the secant ``c psi I`` (the majoriser's); real for a convex potential
+        (``f' >= 0``)."""
         d, speed = self.dim, self.speeds(s)
         gain = np.sqrt(self.c * friction_gain(speed, self.f0, self.v0, self.law))
         if not tangent or d == 1:
