@@ -66,7 +66,9 @@ def test_pin_thrown_at_the_sheave_at_55_m_s_does_not_tunnel():
     face (penetration 0 to 1e-12 m at the event), the impulse leaves no normal approach, the end then leaves the face
     again on its spring with a penetration below 1 um (touch and leave: its discrete state is free again), and the
     energy balance closes to 1e-6 with the impact's loss in it.  The same throw without impact (H1 alone) goes into
-    the face and bounces."""
+    the face and bounces.  The impact run takes rtol 1e-8: the dissipated work (8.8 J, the throw's kinetic energy) is
+    24 times the input work the balance is measured against, and at rtol 1e-6 its quadrature alone errs by 1.2e-6 of
+    it (inclined face; 7e-7 at 1e-7, 1e-8 at 1e-8)."""
     model = chain_loop(_impact_scene())
     x0 = model.start()[0]
     gap = model.events(0.0, x0).reshape(-1, 2)[:, 0]
@@ -78,7 +80,7 @@ def test_pin_thrown_at_the_sheave_at_55_m_s_does_not_tunnel():
     x[n2 + dof] += (-55.0 - w @ normal) * normal
     t_end = 5e-6
     t_eval = np.linspace(0.0, t_end, 501)
-    res = _radau(model, x, t_end, 1e-6, t_eval=t_eval)
+    res = _radau(model, x, t_end, 1e-8, t_eval=t_eval)
     assert res.status == 0 and np.isfinite(res.y).all(), res.message
     assert len(res.t_events[k]) >= 1
     y_hit = res.y_events[k][0]
