@@ -33,11 +33,13 @@ from typing import ClassVar
 import numpy as np
 import scipy.sparse as sp
 
+from cvtfem.assembly import fixed_pattern as FP
+from cvtfem.elements.chain import halves_kernel as HK
 from cvtfem.elements.chain import mapped_contact_kernel as MCK
 from cvtfem.elements.chain import mapped_half_end_slips as MHS
 from cvtfem.elements.contact.friction import POTENTIAL_LAWS
 from cvtfem.errors import NumericalError
-from cvtfem.machines.chain_cvt_elastic import ElasticChainACVT
+from cvtfem.machines.chain_cvt_elastic import ElasticChainACVT, ElasticChainCVT
 from cvtfem.machines.chain_halves_cvt import ChainHalvesCVT, HalvesFamily
 from cvtfem.machines.chain_halves_refined_cvt import ChainHalvesRefinedCVT
 from cvtfem.machines.static_balance import lifted_newton
@@ -66,6 +68,10 @@ def _gather_matrix() -> np.ndarray:
 
 
 SPREAD, GATHER = _spread_matrix(), _gather_matrix()
+#: ElasticChainCVT's steps the one-pass :meth:`ElasticChainHalvesCVT.rhs` stands for (a subclass that changes one of
+#: them keeps the general path).
+_ELASTIC_STEPS = ("evaluate", "_forces", "_mapped_forces", "solve_mass", "_controls", "split", "_idx")
+
 #: Arm (m) at which the elastic start measures the structure's tilts (about the contact radii).
 TILT_ARM = 0.05
 
@@ -91,6 +97,44 @@ class ElasticChainHalvesCVT(ElasticChainACVT, ChainHalvesCVT):
         ends, shafts = self._candidates(q)
         rows = 2 * ends + shafts
         return tuple(a[rows] for a in self._pair_map_table)
+
+    # ----- one-pass right-hand side ---------------------------------------------------------------
+    @cached_property
+    def _elastic_one_pass(self) -> bool:
+        """Whether :meth:`rhs` takes its one-pass form: the compiled chain pass of :class:`HalvesFamily` and
+        ElasticChainCVT's own force, mass and evaluate steps."""
+        cls = type(self)
+        return (self.family.chain.backend == "numba" and type(self.family).forces is HalvesFamily.forces
+                and all(getattr(cls, f) is getattr(ElasticChainCVT, f) for f in _ELASTIC_STEPS))
+
+    def rhs(self, t: float, x):
+        """``dx/dt`` in one pass: :meth:`evaluate` without its bookkeeping (the chain's compiled pass writes its
+        forces and dissipated power straight into the model's force vector); equal to ``evaluate(t, x)[0]`` to
+        round-off (``tests/machines/test_chain_halves_one_pass.py``)."""
+        if not self._elastic_one_pass:
+            return super().rhs(t, x)
+        n2, nz = self.n2, self.control.size
+        nc, iphi, iz, _ = self._idx
+        q, v = x[:n2], x[n2:2 * n2]
+        w = v[iphi]
+        F, M, dz, _ = self._controls(t, w, x[2 * n2:2 * n2 + nz])
+        Q = np.zeros(n2)
+        D = HK.add_forces_power(Q, x, v, *self.family.chain._kernel_args)
+        Pf = self._mapped_forces(q, v, Q)[0]
+        vs = v[nc:]
+        Q[nc:] -= self._structure_operator @ np.concatenate([q[nc:], vs, v[iphi[0]] * vs, v[iphi[1]] * vs])
+        Q[iphi] += M
+        sF = self._sides[:, 1] * F
+        Q[iz] -= sF
+        Q[self._movable_node_u3] += sF
+        out = np.empty(self.size)
+        out[:n2] = v
+        FP.csr_matvec_into(out, n2, *self._chain_inverse_mass, Q)
+        out[n2 + nc:2 * n2] = self._structure_inverse @ Q[nc:]
+        out[2 * n2:2 * n2 + nz] = dz
+        out[2 * n2 + nz:] = (M[0] * w[0], -M[1] * w[1], D - Pf + float(vs @ (self.structure.C @ vs)),
+                             -float(sF @ (v[iz] - v[self._movable_node_u3])))
+        return out
 
     def rigid(self) -> ChainHalvesCVT:
         cls = self.rigid_class

@@ -3,7 +3,7 @@ or H1 (zh) at the half ends, each half-end contact in the frame of its displaced
 the contacts are the rigid model's; the mapped forces are the Hertz gradient with the kernel's friction power; a rigid
 motion of the whole transmission leaves the contacts unchanged (translation exactly, rotation to second order); the
 Jacobian is that of the right-hand side; stiff shafts give the rigid-shaft variant; the start and a short run."""
-from dataclasses import replace
+from dataclasses import fields, replace
 
 import numpy as np
 import pytest
@@ -88,6 +88,30 @@ def _frictionless(model):
     if isinstance(pair, HalfEndContact):
         return replace(model, contact=EndContact(replace(pair, pair=replace(pair.pair, f0=0.0))))
     return replace(model, contact=EndContact(replace(pair, f0=0.0)))
+
+
+def test_one_pass_rhs_equals_evaluate(placed):
+    """The one-pass ``rhs`` against ``evaluate`` (the general path, its twin) entry by entry at running states with
+    tilted, shifted sheaves, with and without friction; a subclass with its own ``evaluate`` keeps the general
+    path."""
+    name, _, model, _, x0 = placed
+    for m in (model, _frictionless(model)):
+        assert m._elastic_one_pass
+        for k in range(2):
+            x = _running(m, x0, 11 + k)
+            x[2 * m.n2:] += np.random.default_rng(k).normal(0.0, 1e-3, x.size - 2 * m.n2)
+            f, ref = m.rhs(0.1 * k, x), m.evaluate(0.1 * k, x, slip=False)[0]
+            assert np.all(np.isfinite(f))
+            assert np.all(np.abs(f - ref) <= 1e-12 * np.abs(ref) + 1e-300), name
+
+    class Traced(type(model)):
+        def evaluate(self, t, x, slip=True):
+            return super().evaluate(t, x, slip)
+
+    sub = Traced(*(getattr(model, f.name) for f in fields(model)))
+    assert not sub._elastic_one_pass
+    x = _running(model, x0, 13)
+    assert np.array_equal(sub.rhs(0.0, x), model.evaluate(0.0, x, slip=False)[0])
 
 
 def test_construction_and_scene_path():
