@@ -136,7 +136,7 @@ def friction_step(M: sp.spmatrix, Mi: sp.spmatrix, sets: list[FrictionSet], v_st
         """``-(M + h S^T E E S)^-1 g`` by Woodbury: ``-y + h M^-1 S^T E C^-1 E S y``, ``y = M^-1 g``, ``C = I + h E
         S M^-1 S^T E`` (SPD), its border part a rank-r update (Woodbury again)."""
         E = np.concatenate([f.roots(s[p], tangent).ravel() for f, p in zip(sets, parts)])
-        return system.direction(K.data, h, E, g, Mi_csr, S, St, U, Q)
+        return system.direction(K.data, h, E, g, Mi_csr, S, St, U, Mi_b)
 
     def small(ds):
         return all(np.max(np.abs(ds[p]), initial=0.0) <= tol * f.v0 for f, p in zip(sets, parts))

@@ -108,10 +108,10 @@ def test_direction_is_the_velocity_space_newton_step(border):
     K = (S @ Mi_in @ St).tocsr()
     K.sort_indices()
     U = np.ascontiguousarray(St[~inner].toarray().T)
-    Q = U @ Mi[~inner][:, ~inner].toarray()
+    Mb = Mi[~inner][:, ~inner].toarray()
     E, h = _blocks(rng, sizes, singular=True), 0.3
     g = rng.standard_normal(S.shape[1])
-    dv, ds = SlipCholesky(K, sizes).direction(K.data, h, E, g, Mi, S, St, U, Q)
+    dv, ds = SlipCholesky(K, sizes).direction(K.data, h, E, g, Mi, S, St, U, Mb)
     Ed = _dense_blocks(E, sizes)
     H = np.linalg.inv(Mi.toarray()) + h * S.T.toarray() @ Ed @ Ed @ S.toarray()
     ref = -np.linalg.solve(H, g)
