@@ -125,11 +125,28 @@ def _objective(M, dv, h, potential):
 
 
 @njit(cache=True)
-def _newton(v, v_star, h, tol, max_lu, M, Mi, S, St, U, Mb, law, sym, Lp, Li, Lx, D, work, Cx, Kx):
-    """:func:`friction_step`'s iteration on ``v`` in place (the arrays: CSR triples, :func:`_contacts`' ``law``,
-    :class:`~.friction_solver.SlipCholesky`'s); returns the LUs taken, ``-1 - k`` for a bad pivot ``k``, or
-    ``max_lu + 1`` without convergence."""
+def _scatter(out, tgt, x, ix, y, iy):
+    """``out[tgt[k]] += x[ix[k]] y[iy[k]]`` after zeroing ``out``: a sparse product on a fixed pattern."""
+    out[:] = 0.0
+    for k in range(tgt.shape[0]):
+        out[tgt[k]] += x[ix[k]] * y[iy[k]]
+
+
+@njit(cache=True)
+def _newton(v, v_star, h, tol, max_lu, M, Mi, Mi_in, Mb, S, St, kmap, umap, law, sym, Lp, Li, Lx, D, work, Cx):
+    """:func:`friction_step`'s iteration on ``v`` in place; returns ``(LUs, W)``, LUs ``-1 - k`` for a bad pivot
+    ``k`` or ``max_lu + 1`` without convergence.  ``M``, ``Mi``, ``Mi_in``, ``S`` CSR triples, ``St`` ``S^T``'s
+    pattern and permutation of ``S``'s data, ``kmap`` and ``umap`` :class:`_Plan`'s maps of ``K`` and ``U``, ``law``
+    :func:`_contacts`', the rest :class:`~.friction_solver.SlipCholesky`'s arrays."""
     n, m = v.shape[0], S[0].shape[0] - 1
+    St = (St[0], St[1], S[2][St[2]])
+    tgtT, pS, q, Tx, tgtK, tt, sK, Kx = kmap
+    _scatter(Tx, tgtT, S[2], pS, Mi_in, q)
+    _scatter(Kx, tgtK, Tx, tt, S[2], sK)
+    Urow, Ucol, Upos = umap
+    U = np.zeros((m, Mb.shape[0]))
+    for k in range(Urow.shape[0]):
+        U[Urow[k], Ucol[k]] = S[2][Upos[k]]
     s, r, t, g = np.empty(m), np.empty(m), np.empty(n), np.empty(n)
     E, Etrial = np.empty(law[2][-1] + law[1][-1] ** 2), np.empty(law[2][-1] + law[1][-1] ** 2)
     rtrial = np.empty(m)
@@ -143,7 +160,7 @@ def _newton(v, v_star, h, tol, max_lu, M, Mi, S, St, U, Mb, law, sym, Lp, Li, Lx
         g += h * t
         bad = _direction(sym, Lp, Li, Lx, D, work, Cx, Kx, h, E, g, Mi, S, St, U, Mb, dv, ds)
         if bad >= 0:
-            return -1 - bad
+            return -1 - bad, 0.0
         lus += 1
         done = _small(ds, law, tol)
         if not done:
@@ -154,7 +171,7 @@ def _newton(v, v_star, h, tol, max_lu, M, Mi, S, St, U, Mb, law, sym, Lp, Li, Lx
                 _contacts(s, law, False, r, E)
                 bad = _direction(sym, Lp, Li, Lx, D, work, Cx, Kx, h, E, g, Mi, S, St, U, Mb, dv, ds)
                 if bad >= 0:
-                    return -1 - bad
+                    return -1 - bad, 0.0
                 lus += 1
                 known = False
             else:
@@ -162,16 +179,9 @@ def _newton(v, v_star, h, tol, max_lu, M, Mi, S, St, U, Mb, law, sym, Lp, Li, Lx
         v += dv
         s += ds
         if done or _small(ds, law, tol):
-            return lus
-    return max_lu + 1
-
-
-@njit(cache=True)
-def _scatter(out, tgt, x, ix, y, iy):
-    """``out[tgt[k]] += x[ix[k]] y[iy[k]]`` after zeroing ``out``: a sparse product on a fixed pattern."""
-    out[:] = 0.0
-    for k in range(tgt.shape[0]):
-        out[tgt[k]] += x[ix[k]] * y[iy[k]]
+            _csr_times(M[0], M[1], M[2], v_star + v, t)
+            return lus, 0.5 * ((v_star - v) @ t)
+    return max_lu + 1, 0.0
 
 
 _PLAN: dict = {}
@@ -196,31 +206,47 @@ def _inner_mass(M, Mi: sp.spmatrix, border) -> tuple:
 
 
 class _Plan:
-    """What depends only on the slip rows' pattern (``indptr``, ``indices`` of the stacked ``S``), the inner mass
-    ``Mi_in`` and the border: ``S^T``'s pattern and permutation, the maps of ``K = S Mi_in S^T`` (through ``T = S
-    Mi_in``) into fixed CSR data arrays, the border's slip columns' positions and the
-    :class:`~.friction_solver.SlipCholesky` of ``K``'s pattern."""
+    """What depends only on the slip rows' pattern (the sets' ``S`` ``indptr``, ``indices``, dims, laws and contact
+    counts), the inner mass ``Mi_in`` and the border: the stacked pattern, ``S^T``'s pattern and permutation, the maps
+    of ``K = S Mi_in S^T`` (through ``T = S Mi_in``; only the entries ``C`` reads) into fixed CSR data arrays, the
+    border's slip columns' positions, the per-contact law arrays and the :class:`~.friction_solver.SlipCholesky` of
+    ``K``'s pattern."""
 
-    def __init__(self, indptr, indices, n: int, Mi_in: sp.csr_matrix, border, sizes):
+    def __init__(self, sets, n: int, Mi_in: sp.csr_matrix, border):
+        self.sets = [(f.dim, f.f0, f.v0, f.law, len(f.c), f.S.shape, f.S.indptr.copy(), f.S.indices.copy())
+                     for f in sets]
+        self.Mi_in, self.border = Mi_in, border.copy()
+        offsets = np.cumsum([0] + [f.S.nnz for f in sets])
+        indptr = np.concatenate([f.S.indptr[:-1] + o for f, o in zip(sets, offsets)] + [offsets[-1:]])
+        indptr, indices = indptr.astype(np.int64), np.concatenate([f.S.indices for f in sets]).astype(np.int64)
+        counts = [len(f.c) for f in sets]
+        sizes = np.repeat([f.dim for f in sets], counts).astype(np.int64)
         m, nnz = indptr.size - 1, indices.size
         St = sp.csr_matrix((np.arange(nnz, dtype=float), indices, indptr), shape=(m, n)).T.tocsr()
-        self.Stp, self.Stj, self.tperm = St.indptr, St.indices, St.data.astype(np.int64)
+        Stp, Stj, tperm = St.indptr.astype(np.int64), St.indices.astype(np.int64), St.data.astype(np.int64)
+        self.S, self.St = (indptr, indices), (Stp, Stj, tperm)
         rows = np.repeat(np.arange(m), np.diff(indptr))
-        self.pS, self.q, keyT = _pairs(indices, Mi_in.indptr, rows, Mi_in.indices, n)
-        uT, self.tgtT = np.unique(keyT, return_inverse=True)
+        pS, q, keyT = _pairs(indices, Mi_in.indptr, rows, Mi_in.indices, n)
+        uT, tgtT = np.unique(keyT, return_inverse=True)
         Trow, Tcol = uT // n, uT % n
-        self.tt, r, keyK = _pairs(Tcol, self.Stp, Trow, self.Stj, m)
-        self.sK = self.tperm[r]
-        uK, self.tgtK = np.unique(keyK, return_inverse=True)
-        self.nT = uT.size
+        tt, r, keyK = _pairs(Tcol, Stp, Trow, Stj, m)
+        uK, tgtK = np.unique(keyK, return_inverse=True)
         K = sp.csr_matrix((np.ones(uK.size), uK % m, np.searchsorted(uK // m, np.arange(m + 1))), shape=(m, m))
         self.system = SlipCholesky(K, sizes)
-        self.Kx = np.empty(uK.size)
-        self.Tx = np.empty(uT.size)
-        pos = np.concatenate([np.arange(self.Stp[b], self.Stp[b + 1]) for b in border] + [np.zeros(0, np.int64)])
-        self.Urow, self.Ucol = self.Stj[pos], np.repeat(np.arange(border.size), np.diff(self.Stp)[border])
-        self.Upos = self.tperm[pos]
-        self.r, self.Mi_in = border.size, Mi_in                     # Mi_in kept: its id is in the key
+        read = np.isin(tgtK, self.system.entry)                      # the K entries that C's upper triangle reads
+        self.kmap = (tgtT, pS, q, np.empty(uT.size), tgtK[read], tt[read], tperm[r[read]], np.zeros(uK.size))
+        pos = np.concatenate([np.arange(Stp[b], Stp[b + 1]) for b in border] + [np.zeros(0, np.int64)])
+        self.umap = (Stj[pos], np.repeat(np.arange(border.size), np.diff(Stp)[border]), tperm[pos])
+        per = lambda a: np.repeat(a, counts)  # noqa: E731
+        system = self.system
+        self.law = (system.first, system.sizes, system.boff, per([float(f.f0) for f in sets]),
+                    per([float(f.v0) for f in sets]), per([LAW_CODES[f.law] for f in sets]).astype(np.int64))
+
+    def fits(self, sets, Mi_in, border) -> bool:
+        """Whether this plan is the one of these sets, ``Mi_in`` and border."""
+        return (Mi_in is self.Mi_in and np.array_equal(border, self.border) and len(sets) == len(self.sets)
+                and all((f.dim, f.f0, f.v0, f.law, len(f.c), f.S.shape) == k[:6] and np.array_equal(f.S.indptr, k[6])
+                        and np.array_equal(f.S.indices, k[7]) for f, k in zip(sets, self.sets)))
 
 
 def _pairs(cols, Bp, rows, Bj, width):
@@ -232,14 +258,13 @@ def _pairs(cols, Bp, rows, Bj, width):
     return p, q, rows[p] * width + Bj[q]
 
 
-def _plan(S_indptr, S_indices, n, Mi_in, border, sizes) -> _Plan:
-    """The :class:`_Plan` of this pattern, kept for the next call with the same (successive solves of a run mostly
-    share it: the same contacts in touch)."""
-    key = (S_indptr.tobytes(), S_indices.tobytes(), sizes.tobytes(), id(Mi_in), border.tobytes())
-    if key not in _PLAN:
-        _PLAN.clear()
-        _PLAN[key] = _Plan(S_indptr, S_indices, n, Mi_in, border, sizes)
-    return _PLAN[key]
+def _plan(sets, n, Mi_in, border) -> _Plan:
+    """The :class:`_Plan` of these sets, kept for the next call with the same pattern (successive solves of a run
+    mostly share it: the same contacts in touch)."""
+    plan = _PLAN.get("last")
+    if plan is None or not plan.fits(sets, Mi_in, border):
+        plan = _PLAN["last"] = _Plan(sets, n, Mi_in, border)
+    return plan
 
 
 def friction_step(M: sp.spmatrix, Mi: sp.spmatrix, sets: list[FrictionSet], v_star: np.ndarray, h: float,
@@ -259,31 +284,18 @@ def friction_step(M: sp.spmatrix, Mi: sp.spmatrix, sets: list[FrictionSet], v_st
     + v) / 2`` (J; equal to the friction's work ``h r(Sv) . S (v + v*) / 2`` to the solve's tolerance), so a run's
     energy balance holds to round-off whatever that tolerance."""
     Mc, Mic, Mi_in, Mb, border_ = _inner_mass(M, Mi, border)
-    heights = [f.S.shape[0] for f in sets]
-    offsets = np.cumsum([0] + [f.S.nnz for f in sets])
-    indptr = np.concatenate([f.S.indptr[:-1] + o for f, o in zip(sets, offsets)] + [offsets[-1:]]).astype(np.int64)
-    indices = np.concatenate([f.S.indices for f in sets]).astype(np.int64)
+    plan = _plan(sets, Mc.shape[0], Mi_in, border_)
     Sx = np.concatenate([f.S.data for f in sets]).astype(float)
-    counts = [len(f.c) for f in sets]
-    sizes = np.repeat([f.dim for f in sets], counts).astype(np.int64)
-    plan = _plan(indptr, indices, Mc.shape[0], Mi_in, border_, sizes)
-    _scatter(plan.Tx, plan.tgtT, Sx, plan.pS, Mi_in.data, plan.q)
-    _scatter(plan.Kx, plan.tgtK, plan.Tx, plan.tt, Sx, plan.sK)
-    U = np.zeros((sum(heights), plan.r))
-    U[plan.Urow, plan.Ucol] = Sx[plan.Upos]
-    system = plan.system
-    law = (system.first, system.sizes, system.boff, np.concatenate([f.c for f in sets]).astype(float),
-           np.repeat([float(f.f0) for f in sets], counts), np.repeat([float(f.v0) for f in sets], counts),
-           np.repeat([LAW_CODES[f.law] for f in sets], counts).astype(np.int64))
+    law = plan.law[:3] + (np.concatenate([f.c for f in sets]).astype(float),) + plan.law[3:]
     v = np.array(v_star if v_start is None else v_start, float)
-    v_star = np.asarray(v_star, float)
-    lus = _newton(v, v_star, float(h), float(tol), int(max_lu), (Mc.indptr, Mc.indices, Mc.data),
-                  (Mic.indptr, Mic.indices, Mic.data), (indptr, indices, Sx), (plan.Stp, plan.Stj, Sx[plan.tperm]),
-                  U, Mb, law, system.sym, system.Lp, system.Li, system.Lx, system.D, system._work, system.Cx, plan.Kx)
+    system = plan.system
+    lus, W = _newton(v, np.asarray(v_star, float), float(h), float(tol), int(max_lu), (Mc.indptr, Mc.indices, Mc.data),
+                     (Mic.indptr, Mic.indices, Mic.data), Mi_in.data, Mb, plan.S + (Sx,), plan.St, plan.kmap,
+                     plan.umap, law, system.sym, system.Lp, system.Li, system.Lx, system.D, system._work, system.Cx)
     if lus < 0:
         raise NumericalError(f"the slip matrix I + h E K E is not positive definite (pivot {-1 - lus})",
                              component="implicit_friction.friction_step")
     if lus > max_lu:
         raise NumericalError(f"the implicit friction step (h = {h:g} s) did not converge in {max_lu} LUs",
                              component="implicit_friction.friction_step")
-    return v, float(0.5 * (v_star - v) @ (Mc @ (v_star + v))), lus
+    return v, W, lus
