@@ -101,6 +101,20 @@ def _ldl_forward(Lp, Li, Lx, X):
 
 
 @njit(cache=True)
+def _ldl_forward_sparse(Lp, Li, Lx, XT):
+    """``X <- L^-1 X`` in place for sparse columns, ``XT`` (columns, n) ``X``'s transpose: each column skips its
+    zeros (exactly: their updates vanish)."""
+    k, n = XT.shape
+    for c in range(k):
+        x = XT[c]
+        for i in range(n):
+            xi = x[i]
+            if xi != 0.0:
+                for p in range(Lp[i], Lp[i + 1]):
+                    x[Li[p]] -= Lx[p] * xi
+
+
+@njit(cache=True)
 def _ldl_backward(Lp, Li, Lx, X):
     """``X <- L^-T X`` in place, ``X`` (n, columns)."""
     n, k = X.shape
@@ -162,18 +176,18 @@ def _direction(sym, Lp, Li, Lx, D, work, Cx, Kx, h, E, g, Mi, S, St, U, Mb, dv, 
     R[:, 1:] = U
     ER = np.empty((m, r + 1))
     _blocks_times(E, boff, first, sizes, R, ER)
-    X = np.empty((m, r + 1))
+    w, YT = np.empty((m, 1)), np.empty((r, m))
     for i in range(m):
-        X[perm[i]] = ER[i]
-    _ldl_forward(Lp, Li, Lx, X)
-    w = np.empty((m, 1))
-    w[:, 0] = X[:, 0]
-    if r > 0:
-        Y = np.ascontiguousarray(X[:, 1:])
-        YD = Y / D.reshape(m, 1)
+        w[perm[i], 0] = ER[i, 0]
+        for c in range(r):
+            YT[c, perm[i]] = ER[i, c + 1]
+    _ldl_forward(Lp, Li, Lx, w)
+    if r > 0:                                                # the border's columns: sparse (each sheave's contacts)
+        _ldl_forward_sparse(Lp, Li, Lx, YT)
+        YD = YT / D.reshape(1, m)
         hMb = h * Mb
-        x = np.linalg.solve(np.eye(r) + hMb @ (YD.T @ Y), hMb @ (YD.T @ w))
-        w -= Y @ x
+        x = np.linalg.solve(np.eye(r) + hMb @ (YD @ YT.T), hMb @ (YD @ w))
+        w -= YT.T @ x
     w[:, 0] /= D
     _ldl_backward(Lp, Li, Lx, w)
     z = np.empty((m, 1))
