@@ -103,7 +103,7 @@ def _contacts(s, law, tangent, r, E):
                 E[o + a * d + a] = root_g
                 if speed > 0:
                     for b in range(d):
-                        E[o + a * d + b] += (root_s - root_g) * s[f + a] * s[f + b] / (speed * speed)
+                        E[o + a * d + b] += (root_s - root_g) * ((s[f + a] / speed) * (s[f + b] / speed))
     return total
 
 
