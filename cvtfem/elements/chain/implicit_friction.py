@@ -227,13 +227,15 @@ class _Plan:
         self.S, self.St = (indptr, indices), (Stp, Stj, tperm)
         rows = np.repeat(np.arange(m), np.diff(indptr))
         pS, q, keyT = _pairs(indices, Mi_in.indptr, rows, Mi_in.indices, n)
-        uT, tgtT = np.unique(keyT, return_inverse=True)
+        uT, tgtT = _unique(keyT, m * n)
         Trow, Tcol = uT // n, uT % n
         tt, r, keyK = _pairs(Tcol, Stp, Trow, Stj, m)
-        uK, tgtK = np.unique(keyK, return_inverse=True)
+        uK, tgtK = _unique(keyK, m * m)
         K = sp.csr_matrix((np.ones(uK.size), uK % m, np.searchsorted(uK // m, np.arange(m + 1))), shape=(m, m))
         self.system = SlipCholesky(K, sizes)
-        read = np.isin(tgtK, self.system.entry)                      # the K entries that C's upper triangle reads
+        read = np.zeros(uK.size, bool)
+        read[self.system.entry] = True
+        read = read[tgtK]                                            # the K entries that C's upper triangle reads
         self.kmap = (tgtT, pS, q, np.empty(uT.size), tgtK[read], tt[read], tperm[r[read]], np.zeros(uK.size))
         pos = np.concatenate([np.arange(Stp[b], Stp[b + 1]) for b in border] + [np.zeros(0, np.int64)])
         self.umap = (Stj[pos], np.repeat(np.arange(border.size), np.diff(Stp)[border]), tperm[pos])
@@ -256,6 +258,16 @@ def _pairs(cols, Bp, rows, Bj, width):
     p = np.repeat(np.arange(cols.size), count)
     q = Bp[cols][p] + np.arange(p.size) - np.repeat(np.cumsum(count) - count, count)
     return p, q, rows[p] * width + Bj[q]
+
+
+def _unique(keys, size):
+    """``(sorted distinct keys, each key's index among them)`` for keys in ``[0, size)`` (a dense marker: no sort)."""
+    mark = np.zeros(size, bool)
+    mark[keys] = True
+    u = np.flatnonzero(mark)
+    where = np.empty(size, np.int64)
+    where[u] = np.arange(u.size)
+    return u, where[keys]
 
 
 def _plan(sets, n, Mi_in, border) -> _Plan:
