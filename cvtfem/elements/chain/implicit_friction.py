@@ -15,7 +15,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from cvtfem.elements.chain.friction_solver import SlipCholesky, _csr_times, _direction
-from cvtfem.elements.contact.friction import _SMALL, POTENTIAL_LAWS
+from cvtfem.elements.contact.friction import _SMALL, POTENTIAL_LAWS, friction_gain
 from cvtfem.elements.jit import njit
 from cvtfem.errors import InputError, NumericalError
 
@@ -38,6 +38,11 @@ class FrictionSet:
         if self.law not in POTENTIAL_LAWS:
             raise InputError("friction_law", self.law, f"must be one of {sorted(POTENTIAL_LAWS)} for the implicit "
                                                        "friction")
+
+    def forces(self, s):
+        """``c psi(|s|) s`` per slip row (N) for the slip rows ``s`` (m/s; numpy: the machines' explicit checks)."""
+        speed = np.abs(s) if self.dim == 1 else np.sqrt((s.reshape(-1, self.dim) ** 2).sum(1))
+        return np.repeat(self.c * friction_gain(speed, self.f0, self.v0, self.law), self.dim) * s
 
 
 #: The compiled laws' codes (:func:`_law`).

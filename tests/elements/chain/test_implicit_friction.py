@@ -118,6 +118,10 @@ def test_the_contact_blocks_are_square_roots_of_the_force_jacobian(law):
     speeds = np.array([np.linalg.norm(s[f:f + d]) for f, d in zip(first, sizes)])
     assert pot == pytest.approx(c @ friction_potential(speeds, f0, v0, law), rel=1e-14)
     assert np.abs(r - np.repeat(c * friction_gain(speeds, f0, v0, law), sizes) * s).max() <= 1e-14 * np.abs(r).max()
+    for d in (1, 2, 3):                                                 # FrictionSet.forces, the numpy twin
+        rows = np.repeat(sizes == d, sizes)
+        fs = FrictionSet(sp.csr_matrix((rows.sum(), 1)), c[sizes == d], d, f0, v0, law)
+        assert np.abs(fs.forces(s[rows]) - r[rows]).max() <= 1e-14 * np.abs(r).max()
     eps = 1e-7 * v0
     for k, (f, d, o) in enumerate(zip(first, sizes, boff)):
         Ek = E[o:o + d * d].reshape(d, d)
