@@ -153,7 +153,10 @@ def _newton(v, v_star, h, tol, max_lu, M, Mi, Mi_in, Mb, S, St, kmap, umap, law,
     for k in range(Urow.shape[0]):
         U[Urow[k], Ucol[k]] = S[2][Upos[k]]
     s, r, t, g = np.empty(m), np.empty(m), np.empty(n), np.empty(n)
-    E, Etrial = np.empty(law[2][-1] + law[1][-1] ** 2), np.empty(law[2][-1] + law[1][-1] ** 2)
+    size = 0
+    for d in law[1]:
+        size += d * d
+    E, Etrial = np.empty(size), np.empty(size)
     rtrial = np.empty(m)
     dv, ds = np.empty(n), np.empty(m)
     _csr_times(S[0], S[1], S[2], v, s)
@@ -301,6 +304,8 @@ def friction_step(M: sp.spmatrix, Mi: sp.spmatrix, sets: list[FrictionSet], v_st
     + v) / 2`` (J; equal to the friction's work ``h r(Sv) . S (v + v*) / 2`` to the solve's tolerance), so a run's
     energy balance holds to round-off whatever that tolerance."""
     Mc, Mic, Mi_in, Mb, border_ = _inner_mass(M, Mi, border)
+    if sum(f.S.shape[0] for f in sets) == 0:                    # no contact in touch: the minimiser is v*
+        return np.array(v_star, float), 0.0, 0
     plan = _plan(sets, Mc.shape[0], Mi_in, border_)
     Sx = np.concatenate([f.S.data for f in sets]).astype(float)
     law = plan.law[:3] + (np.concatenate([f.c for f in sets]).astype(float),) + plan.law[3:]

@@ -174,6 +174,13 @@ def test_the_step_is_the_root_of_the_optimality_condition_and_keeps_its_plan():
     assert np.abs(back[0] - v1).max() <= 1e-14 * np.abs(v).max()
 
 
+def test_no_contact_in_touch_leaves_the_velocities():
+    M, Mi = masses([1.0, 2.0])
+    fs = FrictionSet(sp.csr_matrix((0, 2)), np.zeros(0), 2, F0, V0, "tanh")
+    v, W, lus = friction_step(M, Mi, [fs], np.array([0.3, -0.1]), 1e-3, border=[1])
+    assert np.array_equal(v, [0.3, -0.1]) and W == 0.0 and lus == 0
+
+
 def test_a_law_without_a_potential_is_refused():
     with pytest.raises(InputError, match="friction_law"):
         FrictionSet(sp.csr_matrix([[1.0]]), np.ones(1), 1, F0, V0, "smooth")
