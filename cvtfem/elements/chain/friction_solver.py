@@ -91,20 +91,47 @@ def _ldl(Ap, Ai, Ax, parent, Lp, Li, Lx, D, y, mark, stack, reach, nxt):
 
 
 @njit(cache=True)
-def _ldl_solve(Lp, Li, Lx, D, X):
-    """``X <- (L D L^T)^-1 X`` in place, ``X`` (n, columns)."""
+def _ldl_forward(Lp, Li, Lx, X):
+    """``X <- L^-1 X`` in place, ``X`` (n, columns)."""
     n, k = X.shape
     for i in range(n):
         for p in range(Lp[i], Lp[i + 1]):
             for c in range(k):
                 X[Li[p], c] -= Lx[p] * X[i, c]
-    for i in range(n):
-        for c in range(k):
-            X[i, c] /= D[i]
+
+
+@njit(cache=True)
+def _ldl_forward_sparse(Lp, Li, Lx, XT):
+    """``X <- L^-1 X`` in place for sparse columns, ``XT`` (columns, n) ``X``'s transpose: each column skips its
+    zeros (exactly: their updates vanish)."""
+    k, n = XT.shape
+    for c in range(k):
+        x = XT[c]
+        for i in range(n):
+            xi = x[i]
+            if xi != 0.0:
+                for p in range(Lp[i], Lp[i + 1]):
+                    x[Li[p]] -= Lx[p] * xi
+
+
+@njit(cache=True)
+def _ldl_backward(Lp, Li, Lx, X):
+    """``X <- L^-T X`` in place, ``X`` (n, columns)."""
+    n, k = X.shape
     for i in range(n - 1, -1, -1):
         for p in range(Lp[i], Lp[i + 1]):
             for c in range(k):
                 X[i, c] -= Lx[p] * X[Li[p], c]
+
+
+@njit(cache=True)
+def _ldl_solve(Lp, Li, Lx, D, X):
+    """``X <- (L D L^T)^-1 X`` in place, ``X`` (n, columns)."""
+    _ldl_forward(Lp, Li, Lx, X)
+    for i in range(X.shape[0]):
+        for c in range(X.shape[1]):
+            X[i, c] /= D[i]
+    _ldl_backward(Lp, Li, Lx, X)
 
 
 @njit(cache=True)
@@ -130,10 +157,11 @@ def _csr_times(indptr, indices, data, x, out):
 
 
 @njit(cache=True)
-def _direction(sym, Lp, Li, Lx, D, work, Cx, Kx, h, E, g, Mi, S, St, U, Q, dv, ds):
-    """The Newton direction ``dv = -y + h Mi S^T E z`` (``y = Mi g``, ``(C + h EU Mb (EU)^T) z = E S y``, ``Q = U Mb``)
-    and ``ds = S dv`` after the LDL^T of ``C`` (:class:`SlipCholesky`'s arrays ``sym``); raises nothing, returns the
-    first bad pivot or -1."""
+def _direction(sym, Lp, Li, Lx, D, work, Cx, Kx, h, E, g, Mi, S, St, U, Mb, dv, ds):
+    """The Newton direction ``dv = -y + h Mi S^T E z`` (``y = Mi g``, ``(C + h EU Mb (EU)^T) z = E S y``) and ``ds = S
+    dv`` after the LDL^T of ``C`` (:class:`SlipCholesky`'s arrays ``sym``); raises nothing, returns the first bad
+    pivot or -1.  The border by Woodbury on the forward half only: with ``Y = L^-1 P E U`` and ``y0 = L^-1 P E S y``,
+    ``z = P^T L^-T D^-1 (y0 - Y x)``, ``(I + h Mb Y^T D^-1 Y) x = h Mb Y^T D^-1 y0``."""
     Ap, Ai, parent, tgt, i1, entry, i2, diag, perm, sizes, first, boff = sym
     _fill(Cx, tgt, i1, entry, i2, Kx, E, h, diag)
     bad = _ldl(Ap, Ai, Cx, parent, Lp, Li, Lx, D, *work)
@@ -148,22 +176,25 @@ def _direction(sym, Lp, Li, Lx, D, work, Cx, Kx, h, E, g, Mi, S, St, U, Q, dv, d
     R[:, 1:] = U
     ER = np.empty((m, r + 1))
     _blocks_times(E, boff, first, sizes, R, ER)
-    X = np.empty((m, r + 1))
+    w, YT = np.empty((m, 1)), np.empty((r, m))
     for i in range(m):
-        X[perm[i]] = ER[i]
-    _ldl_solve(Lp, Li, Lx, D, X)
-    z, Z = np.empty(m), np.empty((m, r))
+        w[perm[i], 0] = ER[i, 0]
+        for c in range(r):
+            YT[c, perm[i]] = ER[i, c + 1]
+    _ldl_forward(Lp, Li, Lx, w)
+    if r > 0:                                                # the border's columns: sparse (each sheave's contacts)
+        _ldl_forward_sparse(Lp, Li, Lx, YT)
+        YD = YT / D.reshape(1, m)
+        hMb = h * Mb
+        x = np.linalg.solve(np.eye(r) + hMb @ (YD @ YT.T), hMb @ (YD @ w))
+        w -= YT.T @ x
+    w[:, 0] /= D
+    _ldl_backward(Lp, Li, Lx, w)
+    z = np.empty((m, 1))
     for i in range(m):
-        z[i] = X[perm[i], 0]
-        Z[i] = X[perm[i], 1:]
-    if r > 0:
-        EQ = np.empty((m, r))
-        _blocks_times(E, boff, first, sizes, Q, EQ)
-        EQ *= h
-        W = np.eye(r) + EQ.T @ Z
-        z -= Z @ np.linalg.solve(W, EQ.T @ z)
+        z[i, 0] = w[perm[i], 0]
     Ez = np.empty((m, 1))
-    _blocks_times(E, boff, first, sizes, z.reshape(m, 1), Ez)
+    _blocks_times(E, boff, first, sizes, z, Ez)
     t, u = np.empty(g.shape[0]), np.empty(g.shape[0])
     _csr_times(St[0], St[1], St[2], Ez[:, 0], t)
     _csr_times(Mi[0], Mi[1], Mi[2], t, u)
@@ -214,6 +245,8 @@ class SlipCholesky:
         self.sizes, self.first, self.boff = sizes, first, boff
         self._work = (np.empty(m), np.empty(m, np.bool_), np.empty(m, np.int64), np.empty(m, np.int64),
                       np.empty(m, np.int64))
+        self.sym = (self.Ap, self.Ai, self.parent, self.tgt, self.i1, self.entry, self.i2, self.diag, self.perm,
+                    sizes, first, boff)
 
     def matrix(self, Kx, h: float, E) -> sp.csc_matrix:
         """``C``'s upper triangle in the solver's order (checks)."""
@@ -238,16 +271,15 @@ class SlipCholesky:
         _ldl_solve(self.Lp, self.Li, self.Lx, self.D, X)
         return X[self.perm].reshape(b.shape)
 
-    def direction(self, Kx, h: float, E, g, Mi: sp.csr_matrix, S: sp.csr_matrix, St: sp.csr_matrix, U, Q):
+    def direction(self, Kx, h: float, E, g, Mi: sp.csr_matrix, S: sp.csr_matrix, St: sp.csr_matrix, U, Mb):
         """``(dv, S dv)``: ``dv = -(M + h S^T E E S)^-1 g`` by Woodbury, ``C`` of ``Kx`` (``K = S Mi_in S^T``, ``Mi_in``
-        ``Mi`` without the border) factored here; ``U`` (m, r) the border's slip columns, ``Q = U Mb`` with ``Mb``
-        ``Mi``'s border block (one compiled call: :func:`_direction`)."""
-        sym = (self.Ap, self.Ai, self.parent, self.tgt, self.i1, self.entry, self.i2, self.diag, self.perm, self.sizes,
-               self.first, self.boff)
+        ``Mi`` without the border) factored here; ``U`` (m, r) the border's slip columns, ``Mb`` ``Mi``'s border block
+        (dense r x r; one compiled call: :func:`_direction`)."""
+        sym = self.sym
         dv, ds = np.empty(g.shape[0]), np.empty(S.shape[0])
         bad = _direction(sym, self.Lp, self.Li, self.Lx, self.D, self._work, self.Cx, Kx, h, E, g,
                          (Mi.indptr, Mi.indices, Mi.data), (S.indptr, S.indices, S.data),
-                         (St.indptr, St.indices, St.data), U, Q, dv, ds)
+                         (St.indptr, St.indices, St.data), U, Mb, dv, ds)
         if bad >= 0:
             raise NumericalError(f"the slip matrix I + h E K E is not positive definite (pivot {bad})",
                                  component="friction_solver.SlipCholesky")

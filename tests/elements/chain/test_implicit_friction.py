@@ -6,8 +6,9 @@ import pytest
 import scipy.optimize as so
 import scipy.sparse as sp
 
+from cvtfem.elements.chain import implicit_friction as IF
 from cvtfem.elements.chain.implicit_friction import FrictionSet, friction_step
-from cvtfem.elements.contact.friction import friction_coefficient
+from cvtfem.elements.contact.friction import friction_coefficient, friction_gain, friction_potential, friction_slope
 from cvtfem.errors import InputError
 
 F0, V0, N = 0.3, 0.01, 50.0                       # -, m/s, N
@@ -77,6 +78,107 @@ def test_two_sets_with_a_shared_border_equal_the_dense_solve():
     b = friction_step(M, Mi, sets, v, 1e-3, border=[n - 2, n - 1], tol=1e-12)
     assert np.abs(a[0] - b[0]).max() <= 1e-12 * np.abs(v).max()
     assert a[1] == pytest.approx(b[1], rel=1e-12)
+
+
+@pytest.mark.parametrize("law", sorted(IF.LAW_CODES))
+def test_the_compiled_laws_are_the_numpy_laws(law):
+    """The compiled twin :func:`IF._law` against ``friction_gain``, ``friction_slope``, ``friction_potential`` from
+    0 through the series' switch and the kink at ``v0`` to far past it, to round-off."""
+    f0, v0 = 0.3, 0.02
+    v = v0 * np.concatenate([[0.0, 1e-6, 9.9e-5, 1e-4, 1.01e-4], np.linspace(0.01, 3.0, 301), [0.999999, 1.0, 50.0]])
+    got = np.array([IF._law(IF.LAW_CODES[law], x) for x in v / v0])
+    ref = np.stack([friction_gain(v, f0, v0, law) * v0 / f0, friction_slope(v, f0, v0, law) * v0 / f0,
+                    friction_potential(v, f0, v0, law) / (f0 * v0)], axis=1)
+    assert np.abs(got - ref).max() <= 1e-14 * np.abs(ref).max()
+
+
+@pytest.mark.parametrize("law", ["linear-saturated", "tanh", "arctan", "smoothed"])
+def test_the_contact_blocks_are_square_roots_of_the_force_jacobian(law):
+    """:func:`IF._contacts`: the forces ``c psi(|s|) s``, the potential ``sum c Phi(|s|)``, and ``E E`` equal to the
+    central-difference Jacobian of the forces (tangent) or ``c psi I`` (secant), for scalar slips and slip vectors
+    of 2 and 3 rows (one at rest)."""
+    rng = np.random.default_rng(4)
+    f0, v0 = 0.25, 0.01
+    sizes = np.array([1, 2, 3, 1, 3, 2])
+    first = np.concatenate([[0], np.cumsum(sizes)[:-1]])
+    boff = np.concatenate([[0], np.cumsum(sizes ** 2)[:-1]])
+    c = rng.uniform(5, 50, sizes.size)
+    s = rng.normal(scale=2 * v0, size=sizes.sum())
+    s[first[4]:first[4] + 3] = 0.0
+    lawt = (first, sizes, boff, c, np.full(sizes.size, f0), np.full(sizes.size, v0),
+            np.full(sizes.size, IF.LAW_CODES[law]))
+    r, E, m = np.empty(s.size), np.empty(boff[-1] + 4), s.size
+
+    def forces(x):
+        out = np.empty(m)
+        IF._contacts(x, lawt, True, out, np.empty(E.size))
+        return out
+
+    pot = IF._contacts(s, lawt, True, r, E)
+    speeds = np.array([np.linalg.norm(s[f:f + d]) for f, d in zip(first, sizes)])
+    assert pot == pytest.approx(c @ friction_potential(speeds, f0, v0, law), rel=1e-14)
+    assert np.abs(r - np.repeat(c * friction_gain(speeds, f0, v0, law), sizes) * s).max() <= 1e-14 * np.abs(r).max()
+    for d in (1, 2, 3):                                                 # FrictionSet.forces, the numpy twin
+        rows = np.repeat(sizes == d, sizes)
+        fs = FrictionSet(sp.csr_matrix((rows.sum(), 1)), c[sizes == d], d, f0, v0, law)
+        assert np.abs(fs.forces(s[rows]) - r[rows]).max() <= 1e-14 * np.abs(r).max()
+    eps = 1e-7 * v0
+    for k, (f, d, o) in enumerate(zip(first, sizes, boff)):
+        Ek = E[o:o + d * d].reshape(d, d)
+        assert np.abs(Ek - Ek.T).max() == 0.0
+        if abs(speeds[k] - v0) > 10 * eps:                                  # off linear-saturated's kink
+            J = np.empty((d, d))
+            for b in range(d):
+                e = np.zeros(m)
+                e[f + b] = eps
+                J[:, b] = (forces(s + e) - forces(s - e))[f:f + d] / (2 * eps)
+            assert np.abs(Ek @ Ek - J).max() <= 1e-6 * c[k] * f0 / v0            # the slope's scale
+    IF._contacts(s, lawt, False, r, E)
+    for k, (f, d, o) in enumerate(zip(first, sizes, boff)):
+        Ek = E[o:o + d * d].reshape(d, d)
+        assert np.abs(Ek @ Ek - c[k] * friction_gain(speeds[k], f0, v0, law) * np.eye(d)).max() <= 1e-12 * c[k] / v0
+
+
+def test_the_step_is_the_root_of_the_optimality_condition_and_keeps_its_plan():
+    """Two sets, a sparse border: ``v`` solves ``M (v - v*) + h S^T r(Sv) = 0`` (scipy's root finder on the numpy
+    laws, independent of the compiled path) to the tolerance; a second call on the same pattern reuses the pattern's
+    plan, another pattern gets its own, and a call back on the first gives the first result to round-off."""
+    rng = np.random.default_rng(8)
+    n, h = 14, 1e-3
+    M, Mi = masses(rng.uniform(0.5, 2.0, n))
+    A = sp.csr_matrix(rng.normal(size=(4, n)) * (rng.uniform(size=(4, n)) < 0.4))
+    G = sp.csr_matrix(rng.normal(size=(6, n)) * (rng.uniform(size=(6, n)) < 0.5))
+    sets = [FrictionSet(A, rng.uniform(1, 10, 4), 1, 0.1, 1e-3, "arctan"),
+            FrictionSet(G, rng.uniform(1, 10, 3), 2, 0.2, 1e-3, "linear-saturated")]
+    S = sp.vstack([A, G], format="csr")
+    v = rng.normal(size=n)
+
+    def residual(w, v_star=v):
+        s = S @ w
+        speed = np.concatenate([np.abs(s[:4]), np.linalg.norm(s[4:].reshape(3, 2), axis=1)])
+        psi = np.concatenate([sets[0].c * friction_gain(speed[:4], 0.1, 1e-3, "arctan"),
+                              np.repeat(sets[1].c * friction_gain(speed[4:], 0.2, 1e-3, "linear-saturated"), 2)])
+        return M @ (w - v_star) + h * (S.T @ (psi * s))
+
+    v1, W, _ = friction_step(M, Mi, sets, v, h, border=[n - 3, n - 1], tol=1e-12)
+    plan = IF._PLAN["last"]
+    ref = so.root(residual, v1 + 1e-6, tol=1e-15).x
+    assert np.abs(v1 - ref).max() <= 1e-10 * np.abs(v).max()
+    assert W == pytest.approx(0.5 * (v - v1) @ (M @ (v + v1)), rel=1e-12)
+    again = friction_step(M, Mi, sets, v * 1.1, h, border=[n - 3, n - 1], tol=1e-12)
+    assert IF._PLAN["last"] is plan and np.abs(residual(again[0], 1.1 * v)).max() <= 1e-10
+    other = [sets[0], FrictionSet(G[:4], sets[1].c[:2], 2, 0.2, 1e-3, "linear-saturated")]
+    friction_step(M, Mi, other, v, h, border=[n - 3, n - 1], tol=1e-12)
+    assert IF._PLAN["last"] is not plan
+    back = friction_step(M, Mi, sets, v, h, border=[n - 3, n - 1], tol=1e-12)
+    assert np.abs(back[0] - v1).max() <= 1e-14 * np.abs(v).max()
+
+
+def test_no_contact_in_touch_leaves_the_velocities():
+    M, Mi = masses([1.0, 2.0])
+    fs = FrictionSet(sp.csr_matrix((0, 2)), np.zeros(0), 2, F0, V0, "tanh")
+    v, W, lus = friction_step(M, Mi, [fs], np.array([0.3, -0.1]), 1e-3, border=[1])
+    assert np.array_equal(v, [0.3, -0.1]) and W == 0.0 and lus == 0
 
 
 def test_a_law_without_a_potential_is_refused():
