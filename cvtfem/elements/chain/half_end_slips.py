@@ -104,7 +104,7 @@ def _plane(vectors, basis):
         a += 1
     t0, t1, t2 = 1.0, 0.0, 0.0
     if best > 0.0:
-        root = np.sqrt(best)
+        root = np.sqrt(vectors[a, 0] ** 2 + vectors[a, 1] ** 2 + vectors[a, 2] ** 2)
         t0, t1, t2 = vectors[a, 0] / root, vectors[a, 1] / root, vectors[a, 2] / root
     big = 0.0
     for r in range(vectors.shape[0]):
