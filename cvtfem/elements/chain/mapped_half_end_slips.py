@@ -4,9 +4,11 @@ The elastic twin of :mod:`~cvtfem.elements.chain.half_end_slips`: every H2 half-
 displaced, tilted sheave (:mod:`~cvtfem.elements.chain.mapped_contact_kernel`), whose kernel rates are ``dK P'``, linear
 in the mapped rates ``P'`` (the half end, its chord, ``x3``, slope, the sheave's translation, tilt, the other sheave's
 axial position) and the spin.  With the positions frozen the slip of a contact in touch is therefore ``s = G v`` (3
-components: the tangent-plane relative velocity, m/s), read from the kernel itself: one evaluation with the rates zero (its
-normal force, friction off) and one per mapped rate set to 1 (that slip is ``G``'s column), mapped to the state's
-velocities through the pair table, in the orthonormal basis of the tangent plane of
+components: the tangent-plane relative velocity, m/s), read from the kernel itself: one evaluation per candidate with
+the rates zero (its normal force, friction off; which are in touch), then, for those in touch, one per kernel rate (the
+half end's 8, the spin) set to 1 (the slip's derivative in it); the mapped rates' slips (``G``'s columns) follow by
+the frame map's transpose (``spread^T dK^T gather^T``), mapped to the state's velocities through the pair table, in
+the orthonormal basis of the tangent plane of
 :func:`~cvtfem.elements.chain.half_end_slips._plane` (2 rows a contact, as the rigid shafts' map).  The contact's
 friction forces are ``-G^T (N psi(|s|) s)``, those of :func:`mapped_contact_kernel.forces`.  Units SI.
 """
