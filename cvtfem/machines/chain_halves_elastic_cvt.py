@@ -280,10 +280,10 @@ class ElasticChainHalvesRefinedCVT(ElasticChainHalvesCVT, ChainHalvesRefinedCVT)
         n2, table, ck = self.n2, self._mapped_table, self._sheave_friction[0]
         cols = table[0]
         P, size = cols.shape[0], 2 * cols.shape[0] * cols.shape[1] * cols.shape[2]
-        N, r, c, d = np.empty(P), np.empty(size, np.int64), np.empty(size, np.int64), np.empty(size)
-        m, k, bad = MHS.slip_map(np.ascontiguousarray(x[:2 * n2]), *table[:4], *ck[:4], *ck[5:11], n2, N, r, c, d)
+        N, ptr, ind, d = np.empty(P), np.empty(2 * P + 1, np.int32), np.empty(size, np.int32), np.empty(size)
+        m, k, bad = MHS.slip_map(np.ascontiguousarray(x[:2 * n2]), *table[:4], *ck[:4], *ck[5:11], n2, N, ptr, ind, d)
         self._raise_on_axis(bad)
-        return sp.csr_matrix((d[:k], (r[:k], c[:k])), shape=(2 * m, n2)), N[:m]
+        return sp.csr_matrix((d[:k], ind[:k], ptr[:2 * m + 1]), shape=(2 * m, n2)), N[:m]
 
     @cached_property
     def _masses(self) -> tuple:

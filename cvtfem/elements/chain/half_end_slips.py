@@ -18,10 +18,13 @@ import numpy as np
 from cvtfem.elements.chain.half_end_contact import N_POS, _spread
 from cvtfem.elements.chain.half_end_contact_kernel import N_IN, N_OUT, _candidates
 from cvtfem.elements.chain.sheave_contact_refined_kernel import refined_local_kernel
+from cvtfem.elements.contact.kernels import _cross
 from cvtfem.elements.jit import njit
 
 __all__ = ["slip_map"]
 
+#: Relative tolerance of a tie in :func:`_plane`'s choices.
+TIE = 1e-9
 #: Velocity inputs of a pair (its 8 coordinate rates and the shaft speed), the columns of its local slip map.
 N_VEL = N_IN - N_POS
 
@@ -90,23 +93,40 @@ def _local(X, sh, sel, units, centres, meridians, face_radius, slope_factor, c, 
 @njit(cache=True)
 def _plane(vectors, basis):
     """An orthonormal ``basis`` (2, 3) of a plane holding all ``vectors`` (rows; slips in one tangent plane): the
-    longest one's direction and, normal to it in the plane, the direction of the largest cross product with it."""
-    best, a = -1.0, 0
+    first longest one's direction and, normal to it in the plane, the direction of the first largest cross product
+    with it ("first" to :data:`TIE`: a tie of two vectors, e.g. a rate and its sheave's opposite one, does not hang
+    on round-off)."""
+    best = 0.0
     for r in range(vectors.shape[0]):
-        q = vectors[r, 0] ** 2 + vectors[r, 1] ** 2 + vectors[r, 2] ** 2
-        if q > best:
-            best, a = q, r
-    t1 = vectors[a] / np.sqrt(best) if best > 0.0 else np.array([1.0, 0.0, 0.0])
-    nrm, big = np.zeros(3), 0.0
+        best = max(best, vectors[r, 0] ** 2 + vectors[r, 1] ** 2 + vectors[r, 2] ** 2)
+    a = 0
+    while vectors[a, 0] ** 2 + vectors[a, 1] ** 2 + vectors[a, 2] ** 2 < (1.0 - TIE) * best:
+        a += 1
+    t0, t1, t2 = 1.0, 0.0, 0.0
+    if best > 0.0:
+        root = np.sqrt(vectors[a, 0] ** 2 + vectors[a, 1] ** 2 + vectors[a, 2] ** 2)
+        t0, t1, t2 = vectors[a, 0] / root, vectors[a, 1] / root, vectors[a, 2] / root
+    big = 0.0
     for r in range(vectors.shape[0]):
-        c = np.cross(t1, vectors[r])
-        q = c[0] ** 2 + c[1] ** 2 + c[2] ** 2
-        if q > big:
-            big, nrm = q, c
+        c0, c1, c2 = _cross(t0, t1, t2, vectors[r, 0], vectors[r, 1], vectors[r, 2])
+        big = max(big, c0 ** 2 + c1 ** 2 + c2 ** 2)
+    n0 = n1 = n2 = q = 0.0
+    for r in range(vectors.shape[0]):
+        c0, c1, c2 = _cross(t0, t1, t2, vectors[r, 0], vectors[r, 1], vectors[r, 2])
+        q = c0 ** 2 + c1 ** 2 + c2 ** 2
+        if big > 0.0 and q >= (1.0 - TIE) * big:
+            n0, n1, n2 = c0, c1, c2
+            break
     if not big > 1e-24 * max(best, 1e-300):         # all along t1 (or zero): any plane through t1
-        e = np.zeros(3)
-        e[np.argmin(np.abs(t1))] = 1.0
-        nrm, big = np.cross(t1, e), 1.0 - t1[np.argmin(np.abs(t1))] ** 2
-    nrm = nrm / np.sqrt(big)
-    basis[0] = t1
-    basis[1] = np.cross(nrm, t1)
+        k = 0
+        if abs(t1) < abs(t0):
+            k = 1
+        if abs(t2) < min(abs(t0), abs(t1)):
+            k = 2
+        e = (1.0 if k == 0 else 0.0, 1.0 if k == 1 else 0.0, 1.0 if k == 2 else 0.0)
+        n0, n1, n2 = _cross(t0, t1, t2, e[0], e[1], e[2])
+        q = 1.0 - (t0, t1, t2)[k] ** 2
+    root = np.sqrt(q)
+    n0, n1, n2 = n0 / root, n1 / root, n2 / root
+    basis[0, 0], basis[0, 1], basis[0, 2] = t0, t1, t2
+    basis[1, 0], basis[1, 1], basis[1, 2] = _cross(n0, n1, n2, t0, t1, t2)

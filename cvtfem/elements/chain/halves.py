@@ -666,7 +666,7 @@ class ChainA5:
             HSK.rolling_slip_values(u, self._next, self.axis_link, self._cs, *self._slip_constants, roll, N)
             vals.append(roll)
             c.append(N.ravel())
-            return self._slips_out(pattern, vals, c, (3 + len(CONTACTS) * len(GAUSS_XI)) * n, groups)
+            return self._slips_out(pattern, vals, c, groups)
         fr = self._frames(u)
         H = shape_functions(GAUSS_XI, l)                                  # (4, S)
         Ux = np.einsum("is,hinc->hsnc", H, u)
@@ -698,18 +698,20 @@ class ChainA5:
             unique, where = np.unique(key, return_inverse=True)
             indptr = np.searchsorted(unique // self.n2, np.arange(m + 1))
             pattern = self._slip_pattern = (where, unique % self.n2, indptr)
-        return self._slips_out(pattern, vals, c, m, groups)
+        return self._slips_out(pattern, vals, c, groups)
 
-    def _slips_out(self, pattern, vals, c, m, groups) -> tuple:
+    def _slips_out(self, pattern, vals, c, groups) -> tuple:
         """:meth:`friction_slips`' rows from the values ``vals`` on the CSR ``pattern``, those with ``c > 0``."""
         n = self.n_pins
         where, indices, indptr = pattern
-        B = sp.csr_matrix((np.bincount(where, np.concatenate(vals), len(indices)), indices, indptr), shape=(m, self.n2))
         c = np.concatenate(c)
         keep = np.flatnonzero(c > 0)
+        B = sp.csr_matrix(HSK.kept_rows(where, np.concatenate(vals), indices, indptr, keep), shape=(len(keep), self.n2))
+        if not groups:
+            return B, c[keep]
         label = np.concatenate([np.zeros(n, int), np.ones(2 * n, int), np.repeat(2 + np.arange(len(CONTACTS)),
                                                                                  len(GAUSS_XI) * n)])
-        return (B[keep], c[keep], label[keep]) if groups else (B[keep], c[keep])
+        return B, c[keep], label[keep]
 
     @property
     def _slip_constants(self) -> tuple:

@@ -1,6 +1,7 @@
 """Compiled twin of the rolling-contact part of :meth:`~cvtfem.elements.chain.halves.ChainA5.friction_slips`: the
 values of the slip rows (m/s per unit velocity) in the order the numpy method adds them, and the normal forces (N)
-of every contact and Gauss station.  The numpy method stays the reference (its tests check this kernel to 1e-12).
+of every contact and Gauss station; :func:`kept_rows` the slip map's rows with a normal force, in CSR.  The numpy
+method stays the reference (its tests check this kernel to 1e-12).
 """
 from __future__ import annotations
 
@@ -8,7 +9,7 @@ import numpy as np
 
 from cvtfem.elements.jit import njit
 
-__all__ = ["rolling_slip_values"]
+__all__ = ["kept_rows", "rolling_slip_values"]
 
 
 @njit(cache=True)
@@ -70,3 +71,22 @@ def rolling_slip_values(u, nxt, axis_link, cs, H, ws, contacts, offs, radii, rho
                         vals[o + 8 * n + p * 2 + c] = g * nl[e, c]
                         vals[o + 10 * n + p * 2 + c] = -g * nl[e, c]
                 o += 12 * n
+
+
+@njit(cache=True)
+def kept_rows(where, vals, indices, indptr, keep):
+    """The rows ``keep`` of the CSR matrix with the pattern ``indices``, ``indptr`` whose entry ``where[i]`` sums
+    ``vals[i]``: ``(data, indices, indptr)`` of the kept rows, in order."""
+    full = np.zeros(indices.shape[0])
+    for i in range(where.shape[0]):
+        full[where[i]] += vals[i]
+    ptr = np.empty(keep.shape[0] + 1, np.int32)
+    ptr[0] = 0
+    for k in range(keep.shape[0]):
+        ptr[k + 1] = ptr[k] + indptr[keep[k] + 1] - indptr[keep[k]]
+    data, ind = np.empty(ptr[-1]), np.empty(ptr[-1], np.int32)
+    for k in range(keep.shape[0]):
+        o = indptr[keep[k]]
+        for b in range(ptr[k + 1] - ptr[k]):
+            data[ptr[k] + b], ind[ptr[k] + b] = full[o + b], indices[o + b]
+    return data, ind, ptr
