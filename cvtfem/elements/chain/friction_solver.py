@@ -16,7 +16,7 @@ import scipy.sparse.linalg as spla
 from cvtfem.elements.jit import njit
 from cvtfem.errors import NumericalError
 
-__all__ = ["SlipCholesky"]
+__all__ = ["SlipCholesky", "fill_reducing_order"]
 
 
 @njit(cache=True)
@@ -204,6 +204,18 @@ def _direction(sym, Lp, Li, Lx, D, work, Cx, Kx, h, E, g, Mi, S, St, U, Mb, dv, 
     return -1
 
 
+def fill_reducing_order(r: np.ndarray, c: np.ndarray, m: int) -> np.ndarray:
+    """SuperLU's minimum-degree column order (``MMD_AT_PLUS_A``) of the m x m pattern with entries ``(r, c)``
+    (repeats allowed) and the diagonal: old index -> new.  The order depends on the pattern alone; the values given
+    to SuperLU make the matrix strictly diagonally dominant, so its factorisation never meets a zero pivot (ones with
+    the repeats summed can be exactly singular)."""
+    pattern = sp.csc_matrix((np.ones(r.size), (r, c)), shape=(m, m))
+    pattern.sum_duplicates()
+    pattern.data[:] = 1.0
+    pattern = pattern + sp.diags(np.diff(pattern.indptr) + 1.0, format="csc")
+    return spla.splu(pattern, permc_spec="MMD_AT_PLUS_A").perm_c
+
+
 class SlipCholesky:
     """``C = I + h E K E`` on the pattern of ``K`` (CSR, symmetric pattern, sorted indices) and contacts of ``sizes``
     rows: the symbolic work in the constructor, :meth:`factor` per new ``(K data, h, E)``, :meth:`solve` after it.
@@ -227,8 +239,7 @@ class SlipCholesky:
         r, c = first[ge] + a, first[fe] + b                              # C[r, c] += E_g[a, .] K E_f[., b]
         i1 = boff[ge] + a * dg[entry] + rows[entry] - first[ge]
         i2 = boff[fe] + (cols[entry] - first[fe]) * df[entry] + b
-        pattern = sp.csc_matrix((np.ones(r.size), (r, c)), shape=(m, m)) + sp.identity(m, format="csc")
-        self.perm = spla.splu(pattern, permc_spec="MMD_AT_PLUS_A").perm_c    # old index -> new
+        self.perm = fill_reducing_order(r, c, m)                         # old index -> new
         pr, pc = self.perm[r], self.perm[c]
         up = pr <= pc
         key = np.unique(np.concatenate([pc[up] * m + pr[up], np.arange(m) * (m + 1)]))

@@ -6,7 +6,7 @@ import pytest
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from cvtfem.elements.chain.friction_solver import SlipCholesky
+from cvtfem.elements.chain.friction_solver import SlipCholesky, fill_reducing_order
 from cvtfem.errors import NumericalError
 
 
@@ -129,3 +129,21 @@ def test_an_indefinite_matrix_is_refused():
     system = SlipCholesky(K, sizes)
     with pytest.raises(NumericalError, match="not positive definite"):
         system.factor(K.data, -1e3, _blocks(rng, sizes))
+
+
+def test_the_fill_reducing_order_needs_the_pattern_only():
+    """The order of a pattern whose entries, counted with their repeats, make an exactly singular matrix (it stopped
+    an imex run of (e) elastic, session 14: 725 slip rows with entries 1, 2, 4, 5): a permutation, equal to SuperLU's
+    order of the same pattern with random SPD values."""
+    r, c = np.array([0, 1, 0, 1, 0, 1]), np.array([0, 1, 1, 0, 1, 0])
+    ones = sp.csc_matrix((np.ones(r.size), (r, c)), shape=(2, 2)) + sp.identity(2, format="csc")
+    with pytest.raises(RuntimeError, match="singular"):
+        spla.splu(ones.tocsc(), permc_spec="MMD_AT_PLUS_A")     # [[2, 2], [2, 2]]: the construction this replaces
+    assert sorted(fill_reducing_order(r, c, 2)) == [0, 1]
+    rng = np.random.default_rng(3)
+    m = 120
+    r, c = rng.integers(0, m, 600), rng.integers(0, m, 600)
+    r, c = np.concatenate([r, c, r]), np.concatenate([c, r, c])              # symmetric, with repeats
+    A = sp.csc_matrix((rng.random(r.size), (r, c)), shape=(m, m))
+    A = A + A.T + m * sp.identity(m)
+    assert np.array_equal(fill_reducing_order(r, c, m), spla.splu(A.tocsc(), permc_spec="MMD_AT_PLUS_A").perm_c)
