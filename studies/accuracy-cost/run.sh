@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Regenerates every figure, CSV and JSON of studies/accuracy-cost/README.md (issue 16; spec
 # numerics-and-periodic section 9) into studies/accuracy-cost/results/.  Run from the repository root:
-#     bash studies/accuracy-cost/run.sh            # all (about 2 h of one core)
+#     bash studies/accuracy-cost/run.sh            # all (many hours of one core: the (e) parts dominate)
 #     bash studies/accuracy-cost/run.sh chain-S2   # the chain-S2 part only (also chain-A1, band, local, variant-e,
 #                                                  # variant-e-4ms, w-short, w-4ms, imex-short, variant-b-4ms,
 #                                                  # w-4ms-dumka3, variant-b-4ms-smoothed, w-4ms-smoothed,
