@@ -154,6 +154,19 @@ def _spread_back(F, half_end, Qp):
 
 
 @njit(cache=True, inline="always")
+def _frame_back(Y, half_end, dK, Y10, F, Qp):
+    """The mapped contact's outputs ``Qp`` (n_p,) on the mapped positions from the kernel's ``Y`` (its outputs, or a
+    slip component): :func:`_gather_back`, the frame map's transpose ``dK^T`` on :data:`PATTERN` (``dK`` (46,) of the
+    contact), :func:`_spread_back`; ``Y10`` (10,) and ``F`` (15,) scratch."""
+    _gather_back(Y, half_end, Y10)
+    for b in range(N_FRAME):
+        F[b] = 0.0
+    for e in range(N_PATTERN):
+        F[_PAT_COL[e]] += dK[e] * Y10[_PAT_ROW[e]]
+    _spread_back(F, half_end, Qp)
+
+
+@njit(cache=True, inline="always")
 def _gather_in(K, half_end, out):
     """The contact's positions ``out`` from the ten mapped kernel positions ``K``: A5 the end, half the front less
     the rear point (the chord), ``x3``, slope, ``z`` (``chain_halves_elastic_cvt.GATHER``); A1 the ten."""
@@ -217,12 +230,7 @@ def _refined_outputs(Z, sh, sv, centres, frame, kind, meridians, face, slope_fac
     Y10, F = np.empty(N_KERNEL), np.empty(N_FRAME)
     Qp = np.empty(n_p)
     for t in range(m):
-        _gather_back(Y[t], half_end, Y10)
-        for b in range(N_FRAME):
-            F[b] = 0.0
-        for e in range(N_PATTERN):
-            F[_PAT_COL[e]] += dK[t, e] * Y10[_PAT_ROW[e]]
-        _spread_back(F, half_end, Qp)
+        _frame_back(Y[t], half_end, dK[t], Y10, F, Qp)
         for o in range(n_p):
             R[t, o] = par[3] * Qp[o]
         R[t, n_p] = par[3] * Y[t, n_c]

@@ -18,15 +18,13 @@ import numpy as np
 
 from cvtfem.elements.chain.half_end_contact import _spread as _half_spread
 from cvtfem.elements.chain.half_end_slips import _plane
-from cvtfem.elements.chain.mapped_contact_kernel import (N_FRAME, N_KERNEL, N_PATTERN, PATTERN, _candidates,
-                                                         _gather_back, _gather_in, _spread_back, _spread_in,
-                                                         frame_a1)
+from cvtfem.elements.chain.mapped_contact_kernel import (N_FRAME, N_KERNEL, N_PATTERN, _candidates, _frame_back,
+                                                         _gather_in, _spread_in, frame_a1)
 from cvtfem.elements.chain.sheave_contact_refined_kernel import refined_local_kernel
 from cvtfem.elements.jit import njit
 
 __all__ = ["slip_map"]
 
-_PAT_ROW, _PAT_COL = PATTERN
 #: The half-end contact's kernel positions (end 2, chord 2, ``x3``, slope 2, ``z``) and its kernel rates (theirs, the
 #: spin).
 N_HALF = 8
@@ -69,12 +67,7 @@ def slip_map(y, cols, coef, shaft, sheave, centres, r2, frame, ends, meridians, 
         for a in range(3):                             # the slips of the mapped rates: spread^T dK^T gather^T J
             for i in range(N_HALF):
                 Jc[i] = J[i, a]
-            _gather_back(Jc, True, Y10)
-            for b in range(N_FRAME):
-                F[b] = 0.0
-            for e in range(N_PATTERN):
-                F[_PAT_COL[e]] += dK[t, e] * Y10[_PAT_ROW[e]]
-            _spread_back(F, True, Qp)
+            _frame_back(Jc, True, dK[t], Y10, F, Qp)
             for r in range(n_p):
                 E[r, a] = Qp[r]
         E[n_p] = J[N_HALF]
