@@ -265,17 +265,23 @@ class ElasticChainCVT(CompiledMappedContacts, ChainCVT):
     def _forces(self, q, v, F, M, slip: bool = False):
         """Generalized forces (N, N m) and the friction power (W); with ``slip`` also the contact-force-weighted
         mean slip speed on each shaft (m/s, 0 without contact), as ChainCVT's."""
-        nc, iphi, iz, _ = self._idx
+        nc = self._idx[0]
         Q = np.zeros(self.n2)
         Q[:nc] = self.family.forces(q[:nc], v[:nc])
         Pf, mean_slip = self._mapped_forces(q, v, Q, slip)
-        qs, vs = q[nc:], v[nc:]
-        Q[nc:] -= self._structure_operator @ np.concatenate([qs, vs, v[iphi[0]] * vs, v[iphi[1]] * vs])
+        self._add_structure_loads(q, v, F, M, Q)
+        return (Q, Pf, mean_slip) if slip else (Q, Pf)
+
+    def _add_structure_loads(self, q, v, F, M, Q) -> None:
+        """Add to ``Q`` (n2,) the structure's linear forces, the shaft torques ``M`` (N m) and the clamping forces
+        ``F`` (N) on the movable sheaves and their shaft nodes."""
+        nc, iphi, iz, _ = self._idx
+        vs = v[nc:]
+        Q[nc:] -= self._structure_operator @ np.concatenate([q[nc:], vs, v[iphi[0]] * vs, v[iphi[1]] * vs])
         Q[iphi] += M
         side = self._sides[:, 1]
         Q[iz] -= side * F
         Q[self._movable_node_u3] += side * F
-        return (Q, Pf, mean_slip) if slip else (Q, Pf)
 
     @cached_property
     def _structure_operator(self) -> sp.csr_matrix:

@@ -70,7 +70,8 @@ def _gather_matrix() -> np.ndarray:
 SPREAD, GATHER = _spread_matrix(), _gather_matrix()
 #: ElasticChainCVT's steps the one-pass :meth:`ElasticChainHalvesCVT.rhs` stands for (a subclass that changes one of
 #: them keeps the general path).
-_ELASTIC_STEPS = ("evaluate", "_forces", "_mapped_forces", "solve_mass", "_controls", "split", "_idx")
+_ELASTIC_STEPS = ("evaluate", "_forces", "_mapped_forces", "_add_structure_loads", "solve_mass", "_controls",
+                  "split", "_idx")
 
 #: Arm (m) at which the elastic start measures the structure's tilts (about the contact radii).
 TILT_ARM = 0.05
@@ -110,7 +111,7 @@ class ElasticChainHalvesCVT(ElasticChainACVT, ChainHalvesCVT):
     def rhs(self, t: float, x):
         """``dx/dt`` in one pass: :meth:`evaluate` without its bookkeeping (the chain's compiled pass writes its
         forces and dissipated power straight into the model's force vector); equal to ``evaluate(t, x)[0]`` to
-        round-off (``tests/machines/test_chain_halves_one_pass.py``)."""
+        round-off (``tests/machines/test_chain_halves_elastic.py``)."""
         if not self._elastic_one_pass:
             return super().rhs(t, x)
         n2, nz = self.n2, self.control.size
@@ -121,12 +122,8 @@ class ElasticChainHalvesCVT(ElasticChainACVT, ChainHalvesCVT):
         Q = np.zeros(n2)
         D = HK.add_forces_power(Q, x, v, *self.family.chain._kernel_args)
         Pf = self._mapped_forces(q, v, Q)[0]
-        vs = v[nc:]
-        Q[nc:] -= self._structure_operator @ np.concatenate([q[nc:], vs, v[iphi[0]] * vs, v[iphi[1]] * vs])
-        Q[iphi] += M
-        sF = self._sides[:, 1] * F
-        Q[iz] -= sF
-        Q[self._movable_node_u3] += sF
+        self._add_structure_loads(q, v, F, M, Q)
+        vs, sF = v[nc:], self._sides[:, 1] * F
         out = np.empty(self.size)
         out[:n2] = v
         FP.csr_matvec_into(out, n2, *self._chain_inverse_mass, Q)
