@@ -6,7 +6,8 @@
 #                                                  # variant-e-4ms, w-short, w-4ms, imex-short, variant-b-4ms,
 #                                                  # w-4ms-dumka3, variant-b-4ms-smoothed, w-4ms-smoothed,
 #                                                  # imex-all-short, elastic-short: both faces,
-#                                                  # elastic-inclined-short, elastic-inclined-4ms)
+#                                                  # elastic-inclined-short, elastic-inclined-4ms,
+#                                                  # elastic-inclined-4ms-smoothed)
 # Each test-2 run prints its speed-up table (Table 2.4 style); the logs go next to the results.
 set -euo pipefail
 cd "$(dirname "$0")/../.."
@@ -251,16 +252,20 @@ for tag in elastic elastic-inclined; do    # (e) on elastic shafts, flat face an
 done
 # Session 14: the source's window [1, 5] ms on (e) as the presets build it (elastic shafts, the inclined face): the
 # RK4 baseline, DUMKA3 fixed and the preset's adaptive DUMKA3, imex-rk4 with all friction implicit (about 40 min of one
-# core, most of it the two references).
-if [[ $part == all || $part == elastic-inclined-4ms ]]; then
-  cache=out/studies/e-elastic-inclined-4ms-cache
-  e4i() { nice "$cvtfem" study accuracy-cost studies/accuracy-cost/scenes/variant-e-elastic-inclined-chapter2-linear-saturated.toml \
-            --skip-spectrum --window 1e-3:5e-3 --sample 1e-6 --repeats 1 --reference DOP853:1e-6 --check dopri78:1e-6 \
-            --cache "$cache" --png "$out/variant-e-elastic-inclined-4ms.png" --csv "$out/variant-e-elastic-inclined-4ms.csv" \
-            --json "$out/variant-e-elastic-inclined-4ms.json" "$@"; }
-  e4i --fixed rk4 --steps 5e-8 --adaptive ""
-  e4i --fixed dumka3 --steps 2e-6,3e-6 --adaptive dumka3 --rtols 3e-2
-  e4i --fixed strang-friction:scheme=imex-rk4:friction=all --steps 2e-6 --adaptive ""
-  e4i --from-cache | tee "$out/variant-e-elastic-inclined-4ms.log"
-  uptime | tee -a "$out/variant-e-elastic-inclined-4ms.log"
-fi
+# core, most of it the two references); session 15: the same with the smoothed pin-sheave law (the study's second law).
+for law in linear-saturated smoothed; do
+  tag=elastic-inclined-4ms
+  if [[ $law == smoothed ]]; then tag+=-smoothed; fi
+  if [[ $part == all || $part == "$tag" ]]; then
+    cache=out/studies/e-$tag-cache
+    e4i() { nice "$cvtfem" study accuracy-cost "studies/accuracy-cost/scenes/variant-e-elastic-inclined-chapter2-$law.toml" \
+              --skip-spectrum --window 1e-3:5e-3 --sample 1e-6 --repeats 1 --reference DOP853:1e-6 --check dopri78:1e-6 \
+              --cache "$cache" --png "$out/variant-e-$tag.png" --csv "$out/variant-e-$tag.csv" \
+              --json "$out/variant-e-$tag.json" "$@"; }
+    e4i --fixed rk4 --steps 5e-8 --adaptive ""
+    e4i --fixed dumka3 --steps 2e-6,3e-6 --adaptive dumka3 --rtols 3e-2
+    e4i --fixed strang-friction:scheme=imex-rk4:friction=all --steps 2e-6 --adaptive ""
+    e4i --from-cache | tee "$out/variant-e-$tag.log"
+    uptime | tee -a "$out/variant-e-$tag.log"
+  fi
+done
