@@ -16,7 +16,7 @@ import scipy.sparse.linalg as spla
 from cvtfem.elements.jit import njit
 from cvtfem.errors import NumericalError
 
-__all__ = ["SlipCholesky", "fill_reducing_order"]
+__all__ = ["SlipCholesky", "distinct", "fill_reducing_order"]
 
 
 @njit(cache=True)
@@ -157,36 +157,45 @@ def _csr_times(indptr, indices, data, x, out):
 
 
 @njit(cache=True)
-def _direction(sym, Lp, Li, Lx, D, work, Cx, Kx, h, E, g, Mi, S, St, U, Mb, dv, ds):
-    """The Newton direction ``dv = -y + h Mi S^T E z`` (``y = Mi g``, ``(C + h EU Mb (EU)^T) z = E S y``) and ``ds = S
-    dv`` after the LDL^T of ``C`` (:class:`SlipCholesky`'s arrays ``sym``); raises nothing, returns the first bad
-    pivot or -1.  The border by Woodbury on the forward half only: with ``Y = L^-1 P E U`` and ``y0 = L^-1 P E S y``,
-    ``z = P^T L^-T D^-1 (y0 - Y x)``, ``(I + h Mb Y^T D^-1 Y) x = h Mb Y^T D^-1 y0``."""
+def _factor(sym, Lp, Li, Lx, D, work, Cx, Kx, h, E, U, Mb, YT, A):
+    """The LDL^T of ``C`` (:class:`SlipCholesky`'s arrays ``sym``) for ``K``'s data ``Kx``, ``h`` and blocks ``E``,
+    and the border's part of the Woodbury update: ``YT`` (r, m) ``= (L^-1 P E U)^T`` and ``A = I + h Mb Y^T D^-1 Y``
+    (r, r).  Returns the first bad pivot or -1."""
     Ap, Ai, parent, tgt, i1, entry, i2, diag, perm, sizes, first, boff = sym
     _fill(Cx, tgt, i1, entry, i2, Kx, E, h, diag)
     bad = _ldl(Ap, Ai, Cx, parent, Lp, Li, Lx, D, *work)
     if bad >= 0:
         return bad
     m, r = U.shape
-    y, sy = np.empty(g.shape[0]), np.empty(m)
-    _csr_times(Mi[0], Mi[1], Mi[2], g, y)
-    _csr_times(S[0], S[1], S[2], y, sy)
-    R = np.empty((m, r + 1))
-    R[:, 0] = sy
-    R[:, 1:] = U
-    ER = np.empty((m, r + 1))
-    _blocks_times(E, boff, first, sizes, R, ER)
-    w, YT = np.empty((m, 1)), np.empty((r, m))
-    for i in range(m):
-        w[perm[i], 0] = ER[i, 0]
-        for c in range(r):
-            YT[c, perm[i]] = ER[i, c + 1]
-    _ldl_forward(Lp, Li, Lx, w)
     if r > 0:                                                # the border's columns: sparse (each sheave's contacts)
+        EU = np.empty((m, r))
+        _blocks_times(E, boff, first, sizes, U, EU)
+        for i in range(m):
+            for c in range(r):
+                YT[c, perm[i]] = EU[i, c]
         _ldl_forward_sparse(Lp, Li, Lx, YT)
-        YD = YT / D.reshape(1, m)
-        hMb = h * Mb
-        x = np.linalg.solve(np.eye(r) + hMb @ (YD @ YT.T), hMb @ (YD @ w))
+        A[:, :] = np.eye(r) + (h * Mb) @ ((YT / D.reshape(1, m)) @ YT.T)
+    return -1
+
+
+@njit(cache=True)
+def _solve(sym, Lp, Li, Lx, D, h, E, g, Mi, S, St, YT, A, Mb, dv, ds):
+    """The Newton direction ``dv = -y + h Mi S^T E z`` (``y = Mi g``, ``(C + h EU Mb (EU)^T) z = E S y``) and ``ds = S
+    dv`` on :func:`_factor`'s ``L``, ``D``, ``YT`` and ``A`` of the blocks ``E``.  The border by Woodbury on the forward
+    half only: with ``Y = L^-1 P E U`` and ``y0 = L^-1 P E S y``, ``z = P^T L^-T D^-1 (y0 - Y x)``,
+    ``A x = h Mb Y^T D^-1 y0``."""
+    perm, sizes, first, boff = sym[8], sym[9], sym[10], sym[11]
+    m, r = D.shape[0], YT.shape[0]
+    y, sy = np.empty(g.shape[0]), np.empty((m, 1))
+    _csr_times(Mi[0], Mi[1], Mi[2], g, y)
+    _csr_times(S[0], S[1], S[2], y, sy[:, 0])
+    Esy, w = np.empty((m, 1)), np.empty((m, 1))
+    _blocks_times(E, boff, first, sizes, sy, Esy)
+    for i in range(m):
+        w[perm[i], 0] = Esy[i, 0]
+    _ldl_forward(Lp, Li, Lx, w)
+    if r > 0:
+        x = np.linalg.solve(A, (h * Mb) @ ((YT / D.reshape(1, m)) @ w))
         w -= YT.T @ x
     w[:, 0] /= D
     _ldl_backward(Lp, Li, Lx, w)
@@ -201,7 +210,29 @@ def _direction(sym, Lp, Li, Lx, D, work, Cx, Kx, h, E, g, Mi, S, St, U, Mb, dv, 
     for i in range(g.shape[0]):
         dv[i] = h * u[i] - y[i]
     _csr_times(S[0], S[1], S[2], dv, ds)
-    return -1
+
+
+@njit(cache=True)
+def _direction(sym, Lp, Li, Lx, D, work, Cx, Kx, h, E, g, Mi, S, St, U, Mb, dv, ds):
+    """:func:`_factor` then :func:`_solve`: the Newton direction ``dv`` and ``ds = S dv`` on a new LDL^T; returns the
+    first bad pivot or -1."""
+    r = U.shape[1]
+    YT, A = np.empty((r, D.shape[0])), np.empty((r, r))
+    bad = _factor(sym, Lp, Li, Lx, D, work, Cx, Kx, h, E, U, Mb, YT, A)
+    if bad < 0:
+        _solve(sym, Lp, Li, Lx, D, h, E, g, Mi, S, St, YT, A, Mb, dv, ds)
+    return bad
+
+
+def distinct(keys: np.ndarray, size: int) -> tuple[np.ndarray, np.ndarray]:
+    """``(sorted distinct keys, each key's index among them)`` for integer keys in ``[0, size)``: a dense marker, no
+    sort (the patterns here are small: ``size`` is m^2 for m of about a thousand)."""
+    mark = np.zeros(size, bool)
+    mark[keys] = True
+    u = np.flatnonzero(mark)
+    where = np.empty(size, np.int64)
+    where[u] = np.arange(u.size)
+    return u, where[keys]
 
 
 def fill_reducing_order(r: np.ndarray, c: np.ndarray, m: int) -> np.ndarray:
@@ -209,10 +240,11 @@ def fill_reducing_order(r: np.ndarray, c: np.ndarray, m: int) -> np.ndarray:
     (repeats allowed) and the diagonal: old index -> new.  The order depends on the pattern alone; the values given
     to SuperLU make the matrix strictly diagonally dominant, so its factorisation never meets a zero pivot (ones with
     the repeats summed can be exactly singular)."""
-    pattern = sp.csc_matrix((np.ones(r.size), (r, c)), shape=(m, m))
-    pattern.sum_duplicates()
-    pattern.data[:] = 1.0
-    pattern = pattern + sp.diags(np.diff(pattern.indptr) + 1.0, format="csc")
+    u, _ = distinct(np.concatenate([c * m + r, np.arange(m) * (m + 1)]), m * m)   # column-major: CSC order
+    rows, cols = u % m, u // m
+    count = np.bincount(cols, minlength=m)
+    data = np.where(rows == cols, (count + 1.0)[cols], 1.0)                       # each column's off-diagonals < 1
+    pattern = sp.csc_matrix((data, rows, np.concatenate([[0], np.cumsum(count)])), shape=(m, m))
     return spla.splu(pattern, permc_spec="MMD_AT_PLUS_A").perm_c
 
 
@@ -242,12 +274,12 @@ class SlipCholesky:
         self.perm = fill_reducing_order(r, c, m)                         # old index -> new
         pr, pc = self.perm[r], self.perm[c]
         up = pr <= pc
-        key = np.unique(np.concatenate([pc[up] * m + pr[up], np.arange(m) * (m + 1)]))
-        self.Ap = np.searchsorted(key // m, np.arange(m + 1))
+        nu = int(np.count_nonzero(up))
+        key, where = distinct(np.concatenate([pc[up] * m + pr[up], np.arange(m) * (m + 1)]), m * m)
+        self.Ap = np.concatenate([[0], np.cumsum(np.bincount(key // m, minlength=m))])
         self.Ai = key % m
-        self.tgt = np.searchsorted(key, pc[up] * m + pr[up])
+        self.tgt, self.diag = where[:nu], where[nu:]
         self.i1, self.entry, self.i2 = i1[up], entry[up], i2[up]
-        self.diag = np.searchsorted(key, np.arange(m) * (m + 1))
         Lnz, self.parent, work = np.empty(m, np.int64), np.empty(m, np.int64), np.empty(m, np.int64)
         _etree(self.Ap, self.Ai, Lnz, self.parent, work)
         self.Lp = np.concatenate([[0], np.cumsum(Lnz)])

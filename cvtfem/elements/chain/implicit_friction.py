@@ -14,7 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
-from cvtfem.elements.chain.friction_solver import SlipCholesky, _csr_times, _direction
+from cvtfem.elements.chain.friction_solver import SlipCholesky, _csr_times, _factor, _solve, distinct
 from cvtfem.elements.contact.friction import _SMALL, POTENTIAL_LAWS, friction_gain
 from cvtfem.elements.jit import njit
 from cvtfem.errors import InputError, NumericalError
@@ -137,6 +137,11 @@ def _scatter(out, tgt, x, ix, y, iy):
         out[tgt[k]] += x[ix[k]] * y[iy[k]]
 
 
+#: A full Newton step that changed no slip by more than this many times the tolerance is followed by a chord step on
+#: the same LDL^T (a solve, no new factorisation), which ends the iteration when it is below the tolerance.
+CHORD = 10.0
+
+
 @njit(cache=True)
 def _newton(v, v_star, h, tol, max_lu, M, Mi, Mi_in, Mb, S, St, kmap, umap, law, sym, Lp, Li, Lx, D, work, Cx):
     """:func:`friction_step`'s iteration on ``v`` in place; returns ``(LUs, W)``, LUs ``-1 - k`` for a bad pivot
@@ -159,31 +164,45 @@ def _newton(v, v_star, h, tol, max_lu, M, Mi, Mi_in, Mb, S, St, kmap, umap, law,
     E, Etrial = np.empty(size), np.empty(size)
     rtrial = np.empty(m)
     dv, ds = np.empty(n), np.empty(m)
+    r_b = Mb.shape[0]
+    YT, A, Ef = np.empty((r_b, m)), np.empty((r_b, r_b)), np.empty(size)
     _csr_times(S[0], S[1], S[2], v, s)
-    lus, value, known = 0, 0.0, False
+    lus, value, known, near = 0, 0.0, False, False
     while lus < max_lu:
         potential = _contacts(s, law, True, r, E)
         _csr_times(St[0], St[1], St[2], r, t)
         _csr_times(M[0], M[1], M[2], v - v_star, g)
         g += h * t
-        bad = _direction(sym, Lp, Li, Lx, D, work, Cx, Kx, h, E, g, Mi, S, St, U, Mb, dv, ds)
+        if near:                     # a chord step on the last LDL^T: ends the iteration when it is small
+            _solve(sym, Lp, Li, Lx, D, h, Ef, g, Mi, S, St, YT, A, Mb, dv, ds)
+            if _small(ds, law, tol):
+                v += dv
+                _csr_times(M[0], M[1], M[2], v_star + v, t)
+                return lus, 0.5 * ((v_star - v) @ t)
+        bad = _factor(sym, Lp, Li, Lx, D, work, Cx, Kx, h, E, U, Mb, YT, A)
         if bad >= 0:
             return -1 - bad, 0.0
+        Ef[:] = E
+        _solve(sym, Lp, Li, Lx, D, h, E, g, Mi, S, St, YT, A, Mb, dv, ds)
         lus += 1
         done = _small(ds, law, tol)
+        near = False
         if not done:
             if not known:
                 value = _objective(M, v - v_star, h, potential)
             trial = _objective(M, v + dv - v_star, h, _contacts(s + ds, law, False, rtrial, Etrial))
             if trial > value + 1e-4 * (g @ dv):
                 _contacts(s, law, False, r, E)
-                bad = _direction(sym, Lp, Li, Lx, D, work, Cx, Kx, h, E, g, Mi, S, St, U, Mb, dv, ds)
+                bad = _factor(sym, Lp, Li, Lx, D, work, Cx, Kx, h, E, U, Mb, YT, A)
                 if bad >= 0:
                     return -1 - bad, 0.0
+                Ef[:] = E
+                _solve(sym, Lp, Li, Lx, D, h, E, g, Mi, S, St, YT, A, Mb, dv, ds)
                 lus += 1
                 known = False
             else:
                 value, known = trial, True
+                near = _small(ds, law, CHORD * tol)
         v += dv
         s += ds
         if done or _small(ds, law, tol):
@@ -235,10 +254,10 @@ class _Plan:
         self.S, self.St = (indptr, indices), (Stp, Stj, tperm)
         rows = np.repeat(np.arange(m), np.diff(indptr))
         pS, q, keyT = _pairs(indices, Mi_in.indptr, rows, Mi_in.indices, n)
-        uT, tgtT = _unique(keyT, m * n)
+        uT, tgtT = distinct(keyT, m * n)
         Trow, Tcol = uT // n, uT % n
         tt, r, keyK = _pairs(Tcol, Stp, Trow, Stj, m)
-        uK, tgtK = _unique(keyK, m * m)
+        uK, tgtK = distinct(keyK, m * m)
         K = sp.csr_matrix((np.ones(uK.size), uK % m, np.searchsorted(uK // m, np.arange(m + 1))), shape=(m, m))
         self.system = SlipCholesky(K, sizes)
         read = np.zeros(uK.size, bool)
@@ -268,16 +287,6 @@ def _pairs(cols, Bp, rows, Bj, width):
     return p, q, rows[p] * width + Bj[q]
 
 
-def _unique(keys, size):
-    """``(sorted distinct keys, each key's index among them)`` for keys in ``[0, size)`` (a dense marker: no sort)."""
-    mark = np.zeros(size, bool)
-    mark[keys] = True
-    u = np.flatnonzero(mark)
-    where = np.empty(size, np.int64)
-    where[u] = np.arange(u.size)
-    return u, where[keys]
-
-
 def _plan(sets, n, Mi_in, border) -> _Plan:
     """The :class:`_Plan` of these sets, kept for the next call with the same pattern (successive solves of a run
     mostly share it: the same contacts in touch)."""
@@ -298,7 +307,9 @@ def friction_step(M: sp.spmatrix, Mi: sp.spmatrix, sets: list[FrictionSet], v_st
     the shafts', which couple every contact on them) enter that matrix as a low-rank update (Woodbury again), so its
     LU stays sparse.  Where a Newton step does not lower the function (a saturated law's tangent sends a slip far
     off) the majorise-minimise step (secant slopes ``c psi``; lies above ``Phi`` for laws with falling ``psi``)
-    instead, until a step changes every slip by less than ``tol v0``.  The whole iteration is compiled
+    instead, until a step changes every slip by less than ``tol v0``; after a Newton step of less than :data:`CHORD`
+    times that, the next step is first tried as a chord step on the same LDL^T (a solve instead of a factorisation),
+    which ends the iteration when it is below ``tol v0``.  The whole iteration is compiled
     (:func:`_newton`), what depends only on the slips' pattern kept from call to call (:class:`_Plan`).  Returns
     ``(v, W, LUs)`` with the work the step dissipates, booked as the kinetic energy it removes ``W = (v* - v)^T M (v*
     + v) / 2`` (J; equal to the friction's work ``h r(Sv) . S (v + v*) / 2`` to the solve's tolerance), so a run's

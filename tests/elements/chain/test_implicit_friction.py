@@ -174,6 +174,25 @@ def test_the_step_is_the_root_of_the_optimality_condition_and_keeps_its_plan():
     assert np.abs(back[0] - v1).max() <= 1e-14 * np.abs(v).max()
 
 
+def test_a_small_newton_step_is_checked_by_a_chord_step_not_a_new_factorisation():
+    """All slips in the linear part of the piecewise-linear law: the function is quadratic, one Newton step is exact.
+    That step (between the tolerance and :data:`CHORD` times it) is checked by a chord step on the same LDL^T, which is
+    zero: one factorisation in all (a second Newton step would need two), and ``v`` the linear solve's."""
+    rng = np.random.default_rng(3)
+    n, h, v0, f0 = 30, 1e-2, 1e-3, 0.2
+    M, Mi = masses(rng.uniform(0.5, 2.0, n))
+    G = sp.csr_matrix(rng.normal(size=(20, n)) * (rng.uniform(size=(20, n)) < 0.3))
+    c = rng.uniform(1, 10, 10)
+    v = rng.normal(size=n)
+    v *= 0.5 * v0 / np.linalg.norm((G @ v).reshape(-1, 2), axis=1).max()          # every slip below v0
+    v1, _, lus = friction_step(M, Mi, [FrictionSet(G, c, 2, f0, v0, "linear-saturated")], v, h, tol=0.1)
+    exact = np.linalg.solve((M + h * G.T @ sp.diags(np.repeat(c * f0 / v0, 2)) @ G).toarray(), M @ v)
+    assert np.linalg.norm((G @ exact).reshape(-1, 2), axis=1).max() < v0
+    assert np.abs(G @ (v - exact)).max() > 0.1 * v0 * 1.0001                   # the Newton step is not small
+    assert lus == 1
+    assert np.abs(v1 - exact).max() <= 1e-12 * np.abs(v).max()
+
+
 def test_no_contact_in_touch_leaves_the_velocities():
     M, Mi = masses([1.0, 2.0])
     fs = FrictionSet(sp.csr_matrix((0, 2)), np.zeros(0), 2, F0, V0, "tanh")
