@@ -15,8 +15,8 @@ method whose stage count follows the spectral radius of ``f_E`` alone, ``f_I`` t
   ESDIRK :data:`IMEX_RK4_IMPLICIT` (the same nodes and weights; ``R(inf) = 0``) on ``f_I``, each implicit stage one
   backward-Euler solve of the split at the stage's positions (three per step) whose rate is booked with the power of
   its forces at the stage's velocities (the split's ``hold``: ``f_I`` of the stage state, not the solve's own
-  kinetic-energy balance over the stage), ``f_I`` at the step's start as ``F - f_E`` (one RHS call); the option
-  ``explicit`` is not used;
+  kinetic-energy balance over the stage), ``f_I`` at the step's start as ``F - f_E`` (one RHS call, shared with the
+  dense output of the step before); the option ``explicit`` is not used;
 * ``imex-rk4-2``: the same with an explicit third stage of the ESDIRK (``f_I = F - f_E`` there: one RHS call instead
   of a solve), two solves per step.
 
@@ -93,11 +93,12 @@ class StrangFriction(Stepper):
         return x1
 
     def _imex_rk4(self, t, x, h):
-        """One step of ``imex-rk4`` or ``imex-rk4-2`` (module docstring)."""
+        """One step of ``imex-rk4`` or ``imex-rk4-2`` (module docstring) and ``F`` at its start."""
         split, st, fun = self.split, self.stats, self.system.fun
+        F0 = self.f0(t, x)                                   # the dense output's F at the last step's end
         KE = [split.explicit(t, x)]
-        KI = [fun(t, x) - KE[0]]
-        st.add("nfev", 2)
+        KI = [F0 - KE[0]]
+        st.add("nfev")
         for aE, aI in zip(_RK4_EXPLICIT, IMEX_RK4_IMPLICIT[self.scheme]):
             ti = t + h * sum(aE)
             pred = x + h * (sum(a * k for a, k in zip(aE, KE)) + sum(a * k for a, k in zip(aI[:-1], KI)))
@@ -113,13 +114,13 @@ class StrangFriction(Stepper):
                 KI.append(fun(ti, y) - KE[-1])
                 st.add("nfev", 2)
         b = IMEX_RK4_IMPLICIT[self.scheme][-1]
-        return x + h * sum(bi * (ke + ki) for bi, ke, ki in zip(b, KE, KI))
+        return x + h * sum(bi * (ke + ki) for bi, ke, ki in zip(b, KE, KI)), F0
 
     def attempt(self, t, x, h):
         if self.scheme in IMEX_RK4_IMPLICIT:
-            y = self._imex_rk4(t, x, h)
+            y, F0 = self._imex_rk4(t, x, h)
             self.stages = 4
-            return Attempt(t, x, h, y)
+            return Attempt(t, x, h, y, f0=F0)
         if self.scheme != "strang":
             fe = self.split.explicit(t, x)
             self.stats.add("nfev")

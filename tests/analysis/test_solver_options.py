@@ -60,7 +60,8 @@ def test_a_run_with_strang_friction_options_resumes(tmp_path):
     ``friction=all``, the options through the scene): the checkpoint layout is built with the run's split and options,
     and a run killed at 30 us and resumed to 60 us gives the uninterrupted run's series.  Not bit for bit: the friction
     solve's Newton starts from the previous solve's friction acceleration, which a checkpoint does not keep, and stops at
-    slip changes below 0.1 v0 (quadratic convergence: found 3e-7 of each series' largest value)."""
+    slip changes below ``ChainHalvesCVT.FRICTION_TOL`` v0 (its chord-step end: within 1e-5 of each series' largest
+    value, 3e-7 before the chord step of session 15)."""
     from cvtfem.analysis.run import resume_run
     from cvtfem.io.results import read_results
 
