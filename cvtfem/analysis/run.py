@@ -141,7 +141,7 @@ def resume_run(results: str | Path, show_progress: bool = True,
     except BaseException as err:
         writer.close("failed", f"resume: {err}")
         raise
-    run.retry, run.x_start = int(values["retry"][0]), run.loop.initial_state()
+    run.retry = int(values["retry"][0])
     with single_thread_blas():
         return run.drive_with_policy(writer, float(values["t"][0]), values["x"], (seq, values), show_progress,
                                      on_checkpoint)
@@ -211,6 +211,7 @@ class _Run:
                 raise InputError("solver.fallback", sol.fallback, "must be a method with an error estimate (it runs "
                                  "with adaptive steps), e.g. 'Radau', 'BDF', 'trapezoidal'") from None
         self.start_note = ""    # how the run started: "steady", "no-slip" or the warning of a start without slip
+        self.x_start = None     # the start state (`start_state`: solved when first needed, not on a resume)
         self.retry = 0          # retries of `solver.on_failure = "retry"` so far
         self.retry_log: list[str] = []
         self._layout = None
@@ -218,22 +219,31 @@ class _Run:
         self.switch = None      # the model's discrete-state switch at its own events (`check_events`)
         self.event_names: list[str] = []
 
+    def start_state(self) -> np.ndarray:
+        """The model's start state (its ``initial_state``: for a chain the quasi-static solve, minutes on elastic
+        shafts), solved once and only where needed (a resumed run starts from its checkpoint)."""
+        if self.x_start is None:
+            with single_thread_blas():
+                self.x_start = self.loop.initial_state()
+        return self.x_start
+
     @classmethod
     def prepared(cls, scene, t_end: float | None = None) -> _Run:
         """A run of ``scene`` to ``t_end`` (default ``solver.t_end``) with its events checked (as for a resume)."""
         run = cls(scene, scene.solver.t_end if t_end is None else t_end)
-        run.check_events(run.loop.initial_state())
+        run.check_events(None)
         return run
 
     def check_events(self, x0) -> None:
-        """Event indicators ``output(t, x) - value`` of the scene's ``[[solver.event]]`` (scalar outputs only), then
-        the model's own (its discrete state: :attr:`switch` applies them)."""
+        """Event indicators ``output(t, x) - value`` of the scene's ``[[solver.event]]`` (scalar outputs only, checked
+        at the state ``x0``, or at the model's start state when None and there are such events), then the model's own
+        (its discrete state: :attr:`switch` applies them)."""
         declared = self.scene.solver.event
         if not declared:
             self.events = None
             self._model_events(0)
             return
-        outputs = self.loop.outputs(0.0, x0)
+        outputs = self.loop.outputs(0.0, self.start_state() if x0 is None else x0)
         for i, ev in enumerate(declared):
             if ev.output not in outputs:
                 raise InputError(f"solver.event[{i}].output", ev.output,
@@ -335,13 +345,13 @@ class _Run:
                         writer, seq, values = ResultsWriter.resume(writer.path)
                     except InputError:  # no checkpoint on disk yet: start again
                         writer = self._restart_file(writer)
-                        start = (0.0, self.x_start, None)
+                        start = (0.0, self.start_state(), None)
                     else:
                         start = (float(values["t"][0]), values["x"], (seq, values))
                         note += f", from the checkpoint at t = {start[0]:.6g} s"
                 else:
                     writer = None if writer is None else self._restart_file(writer)
-                    start = (0.0, self.x_start, None)
+                    start = (0.0, self.start_state(), None)
                 self.retry_log.append(note)
                 log.warning("%s", note)
 

@@ -311,6 +311,27 @@ def test_finished_run_extended_equals_one_longer_run(tmp_path, cli):
     assert summary.efficiency == pytest.approx((W[-1, 1] - W[j, 1]) / (W[-1, 0] - W[j, 0]), rel=1e-12)
 
 
+def test_a_resume_does_not_solve_the_start_state(tmp_path, monkeypatch):
+    """A resumed run continues from its checkpoint: the model's start state (a chain's quasi-static solve, minutes on
+    elastic shafts; twice per resume before session 15) is never solved, and the series equal one run's bitwise."""
+    from cvtfem.machines.band_cvt import BandCVT
+
+    scene_file = tmp_path / "scene.toml"
+    scene_file.write_text(SCENE, encoding="utf-8")
+    ref_path, path = tmp_path / "ref.h5", tmp_path / "part.h5"
+    run_scene(load_scene(scene_file), until=UNTIL, results=ref_path, show_progress=False)
+    run_scene(load_scene(scene_file), until=0.6 * UNTIL, results=path, show_progress=False)
+
+    def refuse(self, *args, **kwargs):
+        raise AssertionError("the start state was solved on a resume")
+
+    monkeypatch.setattr(BandCVT, "initial_state", refuse)
+    monkeypatch.setattr(BandCVT, "start", refuse)
+    resume_run(path, show_progress=False, until=UNTIL)
+    ref, res = read_results(ref_path), read_results(path)
+    assert res.attrs["status"] == "finished" and _series_equal(ref, res), _difference(ref, res)
+
+
 def test_extension_before_the_checkpoint_is_refused_untouched(tmp_path, cli):
     scene_file = tmp_path / "scene.toml"
     scene_file.write_text(SCENE, encoding="utf-8")
