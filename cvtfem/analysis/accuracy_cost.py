@@ -243,6 +243,18 @@ class StudyCache:
         (self.path / "start.tmp.npy").replace(self.path / "start.npy")
         (self.path / "start.code").write_text(self.model_code, encoding="utf-8")
 
+    def face_ref(self) -> np.ndarray | None:
+        """The kept sheave faces' reference positions (2, 2) m of a chain on elastic shafts, or ``None``."""
+        f = self.path / "face_ref.npy"
+        return np.load(f) if f.exists() and self._current(self.path / "face_ref.code") else None
+
+    def keep_face_ref(self, z_ref) -> None:
+        """Keep the faces' reference positions (the rigid start that sets them costs about a minute of CPU per process
+        on (e) at the chapter-2 regime, again in every process that builds the model)."""
+        np.save(self.path / "face_ref.tmp.npy", np.asarray(z_ref, float))
+        (self.path / "face_ref.tmp.npy").replace(self.path / "face_ref.npy")
+        (self.path / "face_ref.code").write_text(self.model_code, encoding="utf-8")
+
     def keep_row(self, key: str, row: dict) -> None:
         """Keep a row of test 2 (re-reading the file first: another process may have added rows)."""
         runs = self.path / "runs.json"
@@ -287,6 +299,10 @@ def cvt_problem(scene, t_end: float, settle: float = 0.0, settle_by: tuple[str, 
         raise InputError("--placed", scene.cvt.model, "must be a chain with independent pin halves (chain-A5): only "
                          "they have a placed start state")
     kept = cache.start() if cache is not None else None
+    elastic = hasattr(type(loop), "face_ref")      # a chain on elastic shafts (the class: no solve to ask)
+    z_ref = cache.face_ref() if cache is not None and elastic else None
+    if z_ref is not None:                 # the rigid start that sets the faces' positions, not solved again
+        loop = replace(loop, z_ref=z_ref)
     if kept is not None:
         x0, start = kept[0], {"kind": kept[1]}
     elif placed:
@@ -296,6 +312,8 @@ def cvt_problem(scene, t_end: float, settle: float = 0.0, settle_by: tuple[str, 
         x0, start = loop.start()
     if cache is not None and kept is None:
         cache.keep_start(x0, start["kind"])
+    if cache is not None and z_ref is None and elastic:
+        cache.keep_face_ref(loop.face_ref)
     sparsity = loop.jac_sparsity() if callable(loop.jac_sparsity) else loop.jac_sparsity
     problem = PinForceProblem(scene.cvt.model, loop.rhs, x0, (0.0, t_end), n2=loop.n2, jac=loop.jac,
                               jac_sparsity=sparsity, loop=loop, output=output_of(scene, loop),

@@ -327,6 +327,9 @@ def test_the_study_cache_keeps_runs_and_refuses_another_study(study, tmp_path):
     p = np.arange(6.0).reshape(3, 2)
     cache.keep_reference("Radau", 1e-6, p)
     assert np.array_equal(cache.reference("Radau", 1e-6), p)
+    assert cache.face_ref() is None                       # elastic shafts' faces: kept beside the start
+    cache.keep_face_ref(p[:2])
+    assert np.array_equal(ac.StudyCache.existing(tmp_path).face_ref(), p[:2])
     with pytest.raises(InputError, match="--cache"):
         ac.StudyCache(tmp_path, "chain-S2 window 0:1e-4")
 
@@ -357,14 +360,16 @@ def test_the_study_cache_runs_again_what_other_code_computed(study, tmp_path, mo
     cache = ac.StudyCache(tmp_path, "chain-S2 window 0:5e-5")
     first = ac.measure(problem, [parse_method("rk4")], [1e-6], [], [], repeats=1, cache=cache)
     cache.keep_start(problem.y0, "quasi-static")
+    cache.keep_face_ref(np.ones((2, 2)))
     cache.keep_reference("Radau", 1e-6, np.ones((2, 2)))
     assert cache.stale_rows() == [] and cache.start() is not None and cache.reference("Radau", 1e-6) is not None
+    assert cache.face_ref() is not None
     stamps = {"model": ac.code_stamp(ac.MODEL_CODE), "run": ac.code_stamp(ac.RUN_CODE)}
     assert stamps["model"] != stamps["run"] and stamps["run"] == ac.code_stamp(ac.RUN_CODE)
     monkeypatch.setattr(ac, "code_stamp", lambda dirs: "edited-" + dirs[-1])
     edited = ac.StudyCache(tmp_path, "chain-S2 window 0:5e-5")
     assert edited.stale_rows() == list(edited.rows) and len(edited.rows) == 1
-    assert edited.start() is None and edited.reference("Radau", 1e-6) is None
+    assert edited.start() is None and edited.reference("Radau", 1e-6) is None and edited.face_ref() is None
     again = ac.measure(problem, [parse_method("rk4")], [1e-6], [], [], repeats=1, cache=edited)
     assert again[0]["time"] != first[0]["time"] and again[0]["error"] == first[0]["error"]
     assert edited.stale_rows() == []
