@@ -426,7 +426,7 @@ class _Run:
                 on_checkpoint(float(run.t), seq)
 
         checkpoints = writer is not None and self.interval > 0
-        wall0 = time.perf_counter()
+        wall0, cpu0 = time.perf_counter(), time.process_time()
         bar = progress(t_end, "s", f"run {scene.cvt.model}") if show_progress else None
         if bar is not None and t0 > 0:
             bar.update(t0)
@@ -472,7 +472,8 @@ class _Run:
         counts = run.counts
         stats = {"name": method, "steps": steps, "nfev": int(counts["nfev"]), "njev": int(counts["njev"]),
                  "nlu": int(counts["nlu"]), "rtol": rtol, "atol": atol,
-                 "kernel": getattr(getattr(loop, "model", loop), "backend", "numpy")}  # numba or numpy RHS
+                 "kernel": getattr(getattr(loop, "model", loop), "backend", "numpy"),  # numba or numpy RHS
+                 "process_cpu_s": time.process_time() - cpu0}   # this process's stepping (since its start or resume)
         stats.update(run.engine.report())
         warning = run.engine.warning()
         if warning is not None:
