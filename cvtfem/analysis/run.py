@@ -472,14 +472,14 @@ class _Run:
         counts = run.counts
         stats = {"name": method, "steps": steps, "nfev": int(counts["nfev"]), "njev": int(counts["njev"]),
                  "nlu": int(counts["nlu"]), "rtol": rtol, "atol": atol,
-                 "kernel": getattr(getattr(loop, "model", loop), "backend", "numpy"),  # numba or numpy RHS
-                 "process_cpu_s": time.process_time() - cpu0}   # this process's stepping (since its start or resume)
+                 "kernel": getattr(getattr(loop, "model", loop), "backend", "numpy")}  # numba or numpy RHS
         stats.update(run.engine.report())
         warning = run.engine.warning()
         if warning is not None:
             stats["warning"] = warning
             log.warning("%s", warning)
         summary = summarise(scene, loop, last, (t_out[self.j_window], x_window), t_end, wall, stats, status)
+        summary.process_cpu_time_s = time.process_time() - cpu0
         diverged = self._diverged(summary, method, h_fixed)
         if diverged:
             status, message = "failed", diverged
@@ -492,7 +492,8 @@ class _Run:
             if run.status == "event":
                 fired = np.flatnonzero(run.fired & run.system.event_terminal)
                 extra.update(event_t=float(run.t), event_name=", ".join(self.event_names[i] for i in fired))
-            writer.set_stats({**{f"solver_{k}": v for k, v in stats.items()}, "wall_time_s": wall, **extra,
+            writer.set_stats({**{f"solver_{k}": v for k, v in stats.items()}, "wall_time_s": wall,
+                              "process_cpu_time_s": summary.process_cpu_time_s, **extra,
                               **retry_stats})
             if self.events is not None:
                 for i, name in enumerate(self.event_names):

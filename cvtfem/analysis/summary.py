@@ -33,6 +33,7 @@ class RunSummary:
     results: str = ""
     efficiency_note: str = ""  # why efficiency is None, else empty
     off_face_fraction: list[float] | None = None  # refined contact: share of contacts off the pin end face at the end
+    process_cpu_time_s: float = 0.0  # CPU time of this process's stepping (since its start or its resume), s
 
     def to_dict(self) -> dict[str, Any]:
         return asdict(self)

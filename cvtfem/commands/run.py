@@ -69,7 +69,7 @@ def run(args: argparse.Namespace) -> int:
                             on_checkpoint=on_checkpoint)
     s = summary
     print(f"{s.model}: {s.simulated_time_s:g} s simulated in {s.wall_time_s:.3g} s wall, "
-          f"{s.solver['process_cpu_s']:.3g} s CPU in this process "
+          f"{s.process_cpu_time_s:.3g} s CPU in this process "
           f"({s.solver['name']}, {s.solver['steps']} steps, {s.solver['nfev']} RHS calls, "
           f"{s.solver['kernel']} right-hand side)")
     print(f"  ratio {s.ratio:.4f} (target {s.target_ratio:g}), input {s.input_speed_rpm:.1f} rpm, "
