@@ -157,10 +157,10 @@ def _csr_times(indptr, indices, data, x, out):
 
 
 @njit(cache=True)
-def _factor(sym, Lp, Li, Lx, D, work, Cx, Kx, h, E, U, Mb, YT, A):
+def _factor(sym, Lp, Li, Lx, D, work, Cx, Kx, h, E, U, Mb, YT, YD, A):
     """The LDL^T of ``C`` (:class:`SlipCholesky`'s arrays ``sym``) for ``K``'s data ``Kx``, ``h`` and blocks ``E``,
-    and the border's part of the Woodbury update: ``YT`` (r, m) ``= (L^-1 P E U)^T`` and ``A = I + h Mb Y^T D^-1 Y``
-    (r, r).  Returns the first bad pivot or -1."""
+    and the border's part of the Woodbury update: ``YT`` (r, m) ``= (L^-1 P E U)^T``, ``YD = YT D^-1`` and
+    ``A = I + h Mb Y^T D^-1 Y`` (r, r).  Returns the first bad pivot or -1."""
     Ap, Ai, parent, tgt, i1, entry, i2, diag, perm, sizes, first, boff = sym
     _fill(Cx, tgt, i1, entry, i2, Kx, E, h, diag)
     bad = _ldl(Ap, Ai, Cx, parent, Lp, Li, Lx, D, *work)
@@ -174,14 +174,15 @@ def _factor(sym, Lp, Li, Lx, D, work, Cx, Kx, h, E, U, Mb, YT, A):
             for c in range(r):
                 YT[c, perm[i]] = EU[i, c]
         _ldl_forward_sparse(Lp, Li, Lx, YT)
-        A[:, :] = np.eye(r) + (h * Mb) @ ((YT / D.reshape(1, m)) @ YT.T)
+        YD[:, :] = YT / D.reshape(1, m)
+        A[:, :] = np.eye(r) + (h * Mb) @ (YD @ YT.T)
     return -1
 
 
 @njit(cache=True)
-def _solve(sym, Lp, Li, Lx, D, h, E, g, Mi, S, St, YT, A, Mb, dv, ds):
+def _solve(sym, Lp, Li, Lx, D, h, E, g, Mi, S, St, YT, YD, A, Mb, dv, ds):
     """The Newton direction ``dv = -y + h Mi S^T E z`` (``y = Mi g``, ``(C + h EU Mb (EU)^T) z = E S y``) and ``ds = S
-    dv`` on :func:`_factor`'s ``L``, ``D``, ``YT`` and ``A`` of the blocks ``E``.  The border by Woodbury on the forward
+    dv`` on :func:`_factor`'s ``L``, ``D``, ``YT``, ``YD`` and ``A`` of the blocks ``E``.  The border by Woodbury on the forward
     half only: with ``Y = L^-1 P E U`` and ``y0 = L^-1 P E S y``, ``z = P^T L^-T D^-1 (y0 - Y x)``,
     ``A x = h Mb Y^T D^-1 y0``."""
     perm, sizes, first, boff = sym[8], sym[9], sym[10], sym[11]
@@ -195,7 +196,7 @@ def _solve(sym, Lp, Li, Lx, D, h, E, g, Mi, S, St, YT, A, Mb, dv, ds):
         w[perm[i], 0] = Esy[i, 0]
     _ldl_forward(Lp, Li, Lx, w)
     if r > 0:
-        x = np.linalg.solve(A, (h * Mb) @ ((YT / D.reshape(1, m)) @ w))
+        x = np.linalg.solve(A, (h * Mb) @ (YD @ w))
         w -= YT.T @ x
     w[:, 0] /= D
     _ldl_backward(Lp, Li, Lx, w)
@@ -217,10 +218,10 @@ def _direction(sym, Lp, Li, Lx, D, work, Cx, Kx, h, E, g, Mi, S, St, U, Mb, dv, 
     """:func:`_factor` then :func:`_solve`: the Newton direction ``dv`` and ``ds = S dv`` on a new LDL^T; returns the
     first bad pivot or -1."""
     r = U.shape[1]
-    YT, A = np.empty((r, D.shape[0])), np.empty((r, r))
-    bad = _factor(sym, Lp, Li, Lx, D, work, Cx, Kx, h, E, U, Mb, YT, A)
+    YT, YD, A = np.empty((r, D.shape[0])), np.empty((r, D.shape[0])), np.empty((r, r))
+    bad = _factor(sym, Lp, Li, Lx, D, work, Cx, Kx, h, E, U, Mb, YT, YD, A)
     if bad < 0:
-        _solve(sym, Lp, Li, Lx, D, h, E, g, Mi, S, St, YT, A, Mb, dv, ds)
+        _solve(sym, Lp, Li, Lx, D, h, E, g, Mi, S, St, YT, YD, A, Mb, dv, ds)
     return bad
 
 

@@ -165,7 +165,7 @@ def _newton(v, v_star, h, tol, max_lu, M, Mi, Mi_in, Mb, S, St, kmap, umap, law,
     rtrial = np.empty(m)
     dv, ds = np.empty(n), np.empty(m)
     r_b = Mb.shape[0]
-    YT, A, Ef = np.empty((r_b, m)), np.empty((r_b, r_b)), np.empty(size)
+    YT, YD, A, Ef = np.empty((r_b, m)), np.empty((r_b, m)), np.empty((r_b, r_b)), np.empty(size)
     _csr_times(S[0], S[1], S[2], v, s)
     lus, value, known, near = 0, 0.0, False, False
     while lus < max_lu:
@@ -174,16 +174,16 @@ def _newton(v, v_star, h, tol, max_lu, M, Mi, Mi_in, Mb, S, St, kmap, umap, law,
         _csr_times(M[0], M[1], M[2], v - v_star, g)
         g += h * t
         if near:                     # a chord step on the last LDL^T: ends the iteration when it is small
-            _solve(sym, Lp, Li, Lx, D, h, Ef, g, Mi, S, St, YT, A, Mb, dv, ds)
+            _solve(sym, Lp, Li, Lx, D, h, Ef, g, Mi, S, St, YT, YD, A, Mb, dv, ds)
             if _small(ds, law, tol):
                 v += dv
                 _csr_times(M[0], M[1], M[2], v_star + v, t)
                 return lus, 0.5 * ((v_star - v) @ t)
-        bad = _factor(sym, Lp, Li, Lx, D, work, Cx, Kx, h, E, U, Mb, YT, A)
+        bad = _factor(sym, Lp, Li, Lx, D, work, Cx, Kx, h, E, U, Mb, YT, YD, A)
         if bad >= 0:
             return -1 - bad, 0.0
         Ef[:] = E
-        _solve(sym, Lp, Li, Lx, D, h, E, g, Mi, S, St, YT, A, Mb, dv, ds)
+        _solve(sym, Lp, Li, Lx, D, h, E, g, Mi, S, St, YT, YD, A, Mb, dv, ds)
         lus += 1
         done = _small(ds, law, tol)
         near = False
@@ -193,11 +193,11 @@ def _newton(v, v_star, h, tol, max_lu, M, Mi, Mi_in, Mb, S, St, kmap, umap, law,
             trial = _objective(M, v + dv - v_star, h, _contacts(s + ds, law, False, rtrial, Etrial))
             if trial > value + 1e-4 * (g @ dv):
                 _contacts(s, law, False, r, E)
-                bad = _factor(sym, Lp, Li, Lx, D, work, Cx, Kx, h, E, U, Mb, YT, A)
+                bad = _factor(sym, Lp, Li, Lx, D, work, Cx, Kx, h, E, U, Mb, YT, YD, A)
                 if bad >= 0:
                     return -1 - bad, 0.0
                 Ef[:] = E
-                _solve(sym, Lp, Li, Lx, D, h, E, g, Mi, S, St, YT, A, Mb, dv, ds)
+                _solve(sym, Lp, Li, Lx, D, h, E, g, Mi, S, St, YT, YD, A, Mb, dv, ds)
                 lus += 1
                 known = False
             else:
