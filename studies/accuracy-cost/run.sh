@@ -248,6 +248,11 @@ for tag in elastic elastic-inclined; do    # (e) on elastic shafts, flat face an
     ie --fixed rk4 --steps 5e-8 --adaptive ""
     ie --from-cache | tee "$out/variant-e-$tag-short.log"
     uptime | tee -a "$out/variant-e-$tag-short.log"
+    if [[ $tag == elastic-inclined ]]; then   # session 16: the modes an explicit step meets, group by group
+      nice .venv/bin/python studies/accuracy-cost/a5_explicit_ladder.py \
+        "studies/accuracy-cost/scenes/variant-e-$tag-chapter2-linear-saturated.toml" "$cache" 2e-4 \
+        | tee "$out/variant-e-$tag-explicit-ladder.log"
+    fi
   fi
 done
 # Session 14: the source's window [1, 5] ms on (e) as the presets build it (elastic shafts, the inclined face): the
@@ -267,5 +272,8 @@ for law in linear-saturated smoothed; do
     e4i --fixed strang-friction:scheme=imex-rk4:friction=all --steps 2e-6 --adaptive ""
     e4i --from-cache | tee "$out/variant-e-$tag.log"
     uptime | tee -a "$out/variant-e-$tag.log"
+    # session 16: what the judged output itself asks of a step (the reference rebuilt from every H-th sample)
+    .venv/bin/python studies/accuracy-cost/step_floor.py "$out/variant-e-$tag.json" "$cache" \
+      | tee "$out/variant-e-$tag-step-floor.log"
   fi
 done

@@ -9,6 +9,7 @@ import contextlib
 import copy
 import functools
 import io
+import math
 import re
 import signal
 import tempfile
@@ -39,7 +40,11 @@ BASES = {name: {k: v for k, v in resolve_presets(tomllib.loads(preset_text(prese
          for name, (preset, _) in COMMANDS.items()}
 VALUES = st.one_of(st.sampled_from([0, -1, 10 ** 9, 1e300, 1e-300, -0.0, "x", True, [1, 2], {"a": 1}]),
                    st.floats(allow_nan=True, allow_infinity=True), st.integers(-10 ** 6, 10 ** 6))
-HANG = 60  # s: an example running longer is a hang
+HANG = 60  # s: an example running longer is a hang ...
+#: ... plus this per output row the mutated scene asks for: a run's every row is a model evaluation and a write
+#: (36 us per band-4dof row measured; a mutated `output.step` times 1e-6 asks for 2e6 rows, legitimate work of a
+#: minute or more that the fixed alarm reported as a hang on a loaded machine)
+ROW_TIME = 1e-4  # s
 
 
 def _paths(node):
@@ -79,11 +84,22 @@ def _alarm(*_):
     raise _Hang
 
 
-def _main(argv: list[str], what) -> tuple[int, list[str]]:
-    """``cvtfem ARGV`` in this process under the hang alarm: (exit status, stderr lines); argparse's exit counts."""
+def _rows(doc, until: float) -> float:
+    """The output rows a run of the scene ``doc`` to ``until`` s asks for (0 for a step the schema refuses)."""
+    output = doc.get("output")
+    step = output.get("step", 1e-3) if isinstance(output, dict) else None
+    if isinstance(step, bool) or not isinstance(step, (int, float)) or not 0 < step < float("inf"):
+        return 0.0
+    return until / step
+
+
+def _main(argv: list[str], what, rows: float = 0.0) -> tuple[int, list[str]]:
+    """``cvtfem ARGV`` in this process under the hang alarm (:data:`HANG` plus :data:`ROW_TIME` per output row
+    asked for): (exit status, stderr lines); argparse's exit counts."""
     err = io.StringIO()
+    budget = HANG + math.ceil(ROW_TIME * min(rows, 1e7))   # more than 1e7 rows: refused by `cvtfem run`
     previous = signal.signal(signal.SIGALRM, _alarm)
-    signal.alarm(HANG)
+    signal.alarm(budget)
     try:
         with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(err):
             try:
@@ -91,7 +107,7 @@ def _main(argv: list[str], what) -> tuple[int, list[str]]:
             except SystemExit as stop:   # argparse: unknown option, missing value, wrong type
                 code = stop.code
     except _Hang:
-        pytest.fail(f"{argv[0]} hung (> {HANG} s) on {what}")
+        pytest.fail(f"{argv[0]} hung (> {budget} s) on {what}")
     finally:
         signal.alarm(0)
         signal.signal(signal.SIGALRM, previous)
@@ -114,7 +130,8 @@ def _check(data):
             return
         # Floquet stability (3 of the 4 s of a periodic call here) runs in one example of ten
         extra = ["--no-stability"] if command == "periodic" and data.draw(st.integers(0, 9)) else []
-        code, _ = _main([command, "s.toml", *COMMANDS[command][1], *extra], doc)
+        rows = _rows(doc, float(COMMANDS[command][1][1])) if command == "run" else 0.0
+        code, _ = _main([command, "s.toml", *COMMANDS[command][1], *extra], doc, rows)
         if command == "run" and code == 0:
             from cvtfem.io.results import read_results
 
