@@ -12,7 +12,6 @@ integrated implicitly: the ladder of step limits an explicit part meets (RK4: ``
 from __future__ import annotations
 
 import sys
-from dataclasses import replace
 
 import numpy as np
 import scipy.sparse as sp
@@ -20,24 +19,17 @@ import scipy.sparse.linalg as spla
 
 from cvtfem.analysis import accuracy_cost as ac
 from cvtfem.blas import single_thread_blas
-from cvtfem.elements.chain.end_contact import EndContact
-from cvtfem.elements.chain.half_end_contact import HalfEndContact
 from cvtfem.integrate import solve
-from cvtfem.machines.chain_halves_cvt import HalvesFamily
 from cvtfem.scene.loader import load_scene
+
+sys.path.insert(0, "studies/accuracy-cost")
+from a5_all_friction_radius import frictionless  # noqa: E402  (the split's f_E: all friction off)
 
 #: Coordinate groups taken out of the explicit part one after another (suffixes of the chain's state blocks).
 LADDER = (("pin-half bending u_2, u_3", ("u_perp2", "u_perp3")), ("pin-half axial stretch w_1", ("u_par1",)),
           ("pin-half axial position w_0", ("u_par0",)), ("pin-half tilt u_1", ("u_perp1",)),
           ("pin-half position u_0 (links, contacts)", ("u_perp0",)), ("plate packs", ("chain.pack",)),
           ("shafts and sheaves", ("structure",)))
-
-
-def frictionless(loop):
-    """``loop`` with the halves' and the pin-sheave friction off (``f_E`` of the split variant "all")."""
-    fam, h2 = loop.family, loop.contact.pair.pair
-    return replace(loop, family=HalvesFamily(fam.chain.without_friction(), fam.geom),
-                   contact=EndContact(HalfEndContact(replace(h2, f0=0.0))))
 
 
 def top(J, k: int = 6):
