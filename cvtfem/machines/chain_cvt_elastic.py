@@ -144,6 +144,10 @@ class ElasticChainCVT(CompiledMappedContacts, ChainCVT):
                                f"sheave of the {name} shaft.", 4),
                     OutputSpec(f"{name}.sheave_shift", "m", f"Translation u1, u2 of the fixed, then the movable "
                                f"sheave of the {name} shaft.", 4)]
+        for name, x in zip(("driving", "driven"), self.structure.x):
+            new.append(OutputSpec(f"{name}.shaft_coordinates", "m, rad", f"Structure coordinates of the {name} shaft "
+                                  "(per beam node u1 u2 u3 theta1 theta2 phi, then the movable sheave's zeta): "
+                                  "renderings of a results file.", 6 * len(x) + 1))
         rigid_only = ("driving.sheave_position", "driven.sheave_position")   # the rigid model's z: here sheave_shift
         return tuple(o for o in super().output_specs if o.name not in rigid_only) + tuple(new)
 
@@ -492,6 +496,7 @@ class ElasticChainCVT(CompiledMappedContacts, ChainCVT):
             out[f"{name}.bearing_force"] = bearing[i].ravel()
             out[f"{name}.sheave_tilt"] = tilt[i]
             out[f"{name}.sheave_shift"] = shift[i]
+            out[f"{name}.shaft_coordinates"] = qs[s.offset[i]:s.offset[i] + 6 * len(s.x[i]) + 1]
         return {o.name: out[o.name] for o in self.output_specs}
 
     # ----- initial state -----------------------------------------------------------------------

@@ -1,9 +1,9 @@
 """A chain-CVT results file opened for drawing: the model rebuilt from the stored scene and the stored rows.
 
-A row's chain is drawn from the stored outputs ``chain.coordinates`` (the chain family's q) and
-``driving.sheave_position`` / ``driven.sheave_position`` through the rebuilt model's geometry
-(:func:`~cvtfem.render.transmission.chain_frame`); colours come from the stored per-link, per-pin or
-per-pin-end series, so nothing is recomputed.
+A row's chain is drawn from the stored outputs ``chain.coordinates`` (the chain family's q) and, on rigid shafts,
+``driving.sheave_position`` / ``driven.sheave_position``, on elastic shafts ``driving.shaft_coordinates`` /
+``driven.shaft_coordinates`` (the shafts' beam nodes and sheaves), through the rebuilt model's geometry (:func:`~cvtfem.render.transmission.chain_frame`);
+colours come from the stored per-link, per-pin, per-pin-half or per-pin-end series, so nothing is recomputed.
 """
 from __future__ import annotations
 
@@ -17,10 +17,9 @@ from cvtfem.errors import InputError
 from cvtfem.io.results import Results
 from cvtfem.render.transmission import ChainFrame, chain_frame, check_colour, colour_kind
 
-#: Chains whose pins and sheaves are drawn (the halves of A2 and A5 and elastic shafts are not yet).
-DRAWN_CHAINS = ("chain-S1", "chain-S2", "chain-S3", "chain-A1")
-#: Series a results file needs for drawing its chain.
-GEOMETRY = ("chain.coordinates", "driving.sheave_position", "driven.sheave_position")
+#: Series a results file needs for drawing its chain: on rigid shafts, on elastic shafts.
+GEOMETRY = {False: ("chain.coordinates", "driving.sheave_position", "driven.sheave_position"),
+            True: ("chain.coordinates", "driving.shaft_coordinates", "driven.shaft_coordinates")}
 
 
 @dataclass(frozen=True, eq=False)
@@ -45,17 +44,17 @@ class StoredRun:
 
         res = results
         model_name = scene.cvt.model if scene.kind == "cvt" and scene.cvt is not None else None
-        drawn = model_name in DRAWN_CHAINS and not scene.cvt.effects.shaft_elasticity
-        if model_name is None or not drawn or chain_refusal(scene) is not None:
+        if model_name is None or chain_refusal(scene) is not None:
             what = f"a {scene.kind} scene" if model_name is None else f"cvt.model = {model_name!r}"
-            raise InputError(where, str(res.path), "must be the results file of a chain-CVT run on rigid shafts "
-                             f"that can be drawn ({', '.join(DRAWN_CHAINS)}); its scene has {what}"
-                             + (" on elastic shafts" if model_name in DRAWN_CHAINS and not drawn else ""))
-        missing = [name for name in GEOMETRY if name not in res.series]
+            raise InputError(where, str(res.path), "must be the results file of a chain-CVT run (a chain model that "
+                             "runs, on rigid or elastic shafts); its scene has " + what)
+        elastic = bool(scene.cvt.effects.shaft_elasticity)
+        missing = [name for name in GEOMETRY[elastic] if name not in res.series]
         if missing:
             raise InputError(where, str(res.path), "must store the chain's geometry to be drawn: it lacks the "
                              "series " + ", ".join(missing), "add them to `output.names` (or leave it empty: all "
-                             "outputs) and run again")
+                             "outputs) and run again" + (" (runs on elastic shafts store their shafts' "
+                                                         "coordinates since session 17)" if elastic else ""))
         if res.time.size == 0:
             raise InputError(where, str(res.path), "must hold at least one output row (it has none)")
         return cls(res, scene)
@@ -103,8 +102,12 @@ class StoredRun:
         return np.array([self.row_at(t, option) for t in np.linspace(self.time[rows[0]], self.time[rows[-1]], frames)])
 
     def geometry(self, row: int) -> tuple[np.ndarray, np.ndarray]:
-        """Chain coordinates and sheave positions ``z`` (2,) m stored at ``row``."""
+        """Chain coordinates and the placement of :func:`~cvtfem.render.transmission.chain_frame` stored at ``row``:
+        the sheave positions ``z`` (2,) m on rigid shafts, the structure's coordinates on elastic ones."""
         s = self.results.series
+        if self.scene.cvt.effects.shaft_elasticity:
+            return s["chain.coordinates"][row], np.concatenate([s["driving.shaft_coordinates"][row],
+                                                                s["driven.shaft_coordinates"][row]])
         return s["chain.coordinates"][row], np.array([s["driving.sheave_position"][row, 0],
                                                       s["driven.sheave_position"][row, 0]])
 

@@ -3,14 +3,19 @@
 Model coordinates are drawn as they are: the chain plane is ``(x1, x2)`` with the driven shaft at the
 origin and the driving shaft at ``(L, 0)``, ``x3`` along the shafts.  Each pulley's two sheaves are the
 faces ``x3 = side (z_side + s(r))`` of :func:`~cvtfem.elements.chain.sheave_contact.face_profile` between the
-shaft and the outer radius (the one at ``x3 > 0`` translucent): both at the pair's ``z`` for the symmetric
-chains (S2, S3), the movable sheave at ``z`` and the fixed one at ``fixed_z`` for the whole-pin chains (A1).
-Each pin is drawn along its axis from its far end (``x3 < 0``) to its near end: straight from ``-u3`` to
-``u3`` (S2, S3; the S3 pin bending is not drawn), through the shape functions (1.132) of its ten
-coordinates (A family: two independent ends, bent axis).  Each link is a ribbon between its two pins across
-the plate pack (the pin axes at ``xi = +-PACK_FRACTION``), coloured by a per-link output, or by a per-pin or
-per-pin-end output interpolated along the link and the pins.  Axial positions (pin axes, sheaves) can be
-exaggerated about a reference state: ``x3 = x3_ref + axial_scale (x3 - x3_ref)``.
+shaft and the outer radius (the one at ``x3 > 0`` translucent): on rigid shafts both at the pair's ``z`` for the
+symmetric chains (S2, S3), the movable sheave at ``z`` and the fixed one at ``fixed_z`` for the whole-pin chains
+(A family).  On elastic shafts (:mod:`~cvtfem.machines.chain_cvt_elastic`) each face is that surface at its
+reference position ``z_ref`` in the frame of its sheave, carried by the sheave's translation ``a`` and tilt
+``theta`` about its pivot ``o`` exactly as the contacts see it (``X = o + (I - theta x)(x - o - a)``, inverted),
+and each shaft is the polyline of its displaced beam nodes.  Each pin is drawn along its axis from its far end
+(``x3 < 0``) to its near end: straight from ``-u3`` to ``u3`` (S2, S3; the S3 pin bending is not drawn), through
+the shape functions (1.132) of its ten coordinates (A family: two independent ends, bent axis); A5 draws each
+pin half so (2 axes per pin, half - then half +).  Each link is a ribbon across the plate pack (the axes at
+``xi = +-PACK_FRACTION``) between its two pins, or A5's half - of pin ``p`` and half + of pin ``p + 1``,
+coloured by a per-link output, or by a per-pin, per-half or per-pin-end output interpolated along the link and
+the axes.  Axial positions (the ``x3`` of every drawn point: pins, faces, shafts) can be exaggerated about a
+reference state: ``x3 = x3_ref + axial_scale (x3 - x3_ref)``; in-plane positions are drawn as they are.
 """
 from __future__ import annotations
 
@@ -20,6 +25,7 @@ from pathlib import Path
 import numpy as np
 
 from cvtfem.elements.chain.asymmetric import shape_functions
+from cvtfem.elements.chain.halves import ChainA5
 from cvtfem.elements.chain.sheave_contact import face_profile
 from cvtfem.errors import InputError
 from cvtfem.render.rotor import plotter
@@ -30,25 +36,44 @@ SHAFT_FRACTION, PIN_FRACTION = 0.12, 0.018
 PACK_FRACTION = 0.8
 #: Points drawn along each pin axis (a curve for the A family).
 PIN_POINTS = 9
+#: Radial and angular grid points of a drawn sheave face.
+FACE_GRID = (12, 96)
 
 
 def whole_pin(model) -> bool:
-    """True for the whole-pin chains (A family: each pin end its own coordinates, a fixed and a movable sheave)."""
+    """True for the chains whose pin ends are coordinates (A family: a fixed and a movable sheave per shaft)."""
     return hasattr(model, "fixed_z")
 
 
+def halves(model) -> bool:
+    """True for the chain of independent pin halves (A5): each half is drawn as its own axis."""
+    return isinstance(getattr(model.family, "chain", None), ChainA5)
+
+
+def elastic(model) -> bool:
+    """True for a transmission on elastic shafts (beam FE shafts with the sheaves on their nodes)."""
+    return hasattr(model, "structure")
+
+
 def pin_axis_points(model, q_chain, xi, z=None) -> np.ndarray:
-    """Points (n, len(xi), 3), m, on each pin's axis at the parameters ``xi`` (-1 far end, +1 near end); S1's pin
-    ends follow the sheave faces at the sheave positions ``z`` (2,) m (``model.pin_end_axial``)."""
+    """Points (N, len(xi), 3), m, on each drawn axis at the parameters ``xi`` (-1 far end, +1 near end): one per
+    pin, or per pin half of A5 (pin-major: ``2 p + half``, half 0 = ``p-``); S1's pin ends follow the sheave faces
+    at the sheave positions ``z`` (2,) m (``model.pin_end_axial``)."""
     xi = np.asarray(xi, float)
     fam = model.family
-    if whole_pin(model):
-        u, w = fam.split(np.asarray(q_chain, float))
+    q_chain = np.asarray(q_chain, float)
+    if halves(model):
+        u, w, _ = fam.split(q_chain)                                     # (2, 4, n, 2), (2, 2, n)
+        h = shape_functions(xi, fam.chain.l)
+        perp = np.einsum("im,hinc->nhmc", h, u).reshape(-1, xi.size, 2)
+        axial = (w[:, 0, :, None] + xi * w[:, 1, :, None]).transpose(1, 0, 2).reshape(-1, xi.size)
+    elif whole_pin(model):
+        u, w = fam.split(q_chain)
         h = shape_functions(xi, getattr(fam.chain, "base", fam.chain).l)          # (4, m)
         perp = np.einsum("im,inc->nmc", h, u)
         axial = w[0][:, None] + xi[None, :] * w[1][:, None]
     else:
-        u, u3, _ = fam.split(np.asarray(q_chain, float))
+        u, u3, _ = fam.split(q_chain)
         if u3 is None:                                   # S1: the ends are not coordinates
             u3 = model.pin_end_axial(q_chain, np.asarray(z, float))
         perp = np.repeat(u[:, None, :], xi.size, axis=1)
@@ -56,10 +81,17 @@ def pin_axis_points(model, q_chain, xi, z=None) -> np.ndarray:
     return np.concatenate([perp, axial[..., None]], axis=2)
 
 
+def link_axes(model) -> np.ndarray:
+    """(n, 2) drawn axes each link joins: pins ``p`` and ``p + 1``, or A5's half - of ``p`` and half + of ``p + 1``."""
+    p = np.arange(model.family.n)
+    nxt = np.roll(p, -1)
+    return np.column_stack([2 * p, 2 * nxt + 1]) if halves(model) else np.column_stack([p, nxt])
+
+
 def sheave_positions(model, z) -> np.ndarray:
     """Axial positions (2 shafts, 2 sides), m, of the sheaves on the sides ``x3 < 0`` and ``x3 > 0`` of each
-    shaft, counted outwards from ``x3 = 0``: the pair's ``z`` on both sides (S), or the movable sheave's ``z``
-    on its side and the fixed sheave's position on the other (A)."""
+    rigid shaft, counted outwards from ``x3 = 0``: the pair's ``z`` on both sides (S), or the movable sheave's
+    ``z`` on its side and the fixed sheave's position on the other (A)."""
     z = np.asarray(z, float)
     if not whole_pin(model):
         return np.column_stack([z, z])
@@ -70,38 +102,123 @@ def sheave_positions(model, z) -> np.ndarray:
     return out
 
 
+def _cross_matrix(th) -> np.ndarray:
+    """``[theta x]`` (3, 3) of a tilt vector ``th`` (3,)."""
+    return np.array([[0.0, -th[2], th[1]], [th[2], 0.0, -th[0]], [-th[1], th[0], 0.0]])
+
+
+def sheave_pose(model, q_structure, k: int, jj: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(o, a, theta)`` (3,) each of sheave ``jj`` (0 fixed, 1 movable) of elastic shaft ``k``: pivot (m), translation
+    (m; the symmetric chains' axial part from the pair's mid-plane) and tilt (rad), as the contacts map them."""
+    s, q = model.structure, np.asarray(q_structure, float)
+    dofs = s.sheave_dofs[k, jj]
+    o = np.append(model.contact.centres[k], s.sheave_x3[k, jj])
+    a = q[dofs[:3]].copy()
+    if model.axial_relative:
+        a[2] = 0.5 * (a[2] - q[s.sheave_dofs[k, 1 - jj, 2]])
+    return o, a, np.array([q[dofs[3]], q[dofs[4]], 0.0])
+
+
+def sheave_faces(model, placement) -> np.ndarray:
+    """Points (2 shafts, 2 sides, 3, *FACE_GRID), m, of the four faces (side 0: ``x3 < 0``): on rigid shafts at the
+    sheave positions of ``placement = z`` (2,); on elastic shafts at ``z_ref`` in their sheaves' frames, carried by
+    the poses (:func:`sheave_pose`) of ``placement = q_structure``."""
+    contact = model.contact
+    r_in, r_out = SHAFT_FRACTION * contact.r_outer, contact.r_outer
+    out = np.empty((2, 2, 3) + FACE_GRID)
+    for k in range(2):
+        face, c = contact.faces[k], contact.centres[k]
+        if not elastic(model):
+            pos = sheave_positions(model, placement)[k]
+            for j, side in enumerate((-1.0, 1.0)):
+                out[k, j] = sheave_face_points(face, c, pos[j], side, r_in, r_out, *FACE_GRID)
+            continue
+        for jj in range(2):
+            side = float(model._sides[k, jj])
+            X = np.stack(sheave_face_points(face, c, model.face_ref[k, jj], side, r_in, r_out, *FACE_GRID))
+            o, a, th = sheave_pose(model, placement, k, jj)
+            back = np.linalg.inv(np.eye(3) - _cross_matrix(th))                # x - o - a = A^-1 (X - o)
+            out[k, int(side > 0)] = (o + a)[:, None, None] + np.einsum("ij,jrt->irt", back, X - o[:, None, None])
+    return out
+
+
+def shaft_lines(model, placement) -> tuple[np.ndarray, np.ndarray]:
+    """Each shaft's drawn axis (points, 3), m: on rigid shafts a straight line through its sheaves; on elastic
+    shafts the polyline of its beam nodes displaced by ``placement = q_structure``."""
+    contact, out = model.contact, []
+    for k in range(2):
+        c = contact.centres[k]
+        if elastic(model):
+            s, q = model.structure, np.asarray(placement, float)
+            x = np.asarray(s.x[k], float)
+            idx = s.offset[k] + 6 * np.arange(x.size)[:, None] + np.arange(3)
+            u = q[idx]
+            out.append(np.column_stack([c[0] + u[:, 0], c[1] + u[:, 1], x - s.params[k].length / 2 + u[:, 2]]))
+            continue
+        half = abs(sheave_positions(model, placement)[k].max() - face_profile(contact.faces[k])(contact.r_outer)[0]) \
+            + 0.25 * contact.r_outer
+        out.append(np.array([[c[0], c[1], -half], [c[0], c[1], half]]))
+    return tuple(out)
+
+
 @dataclass(frozen=True)
 class ChainFrame:
-    """What is drawn of the transmission at one state (m): pin axes (n, PIN_POINTS, 3) from the far end to the
-    near end, link ribbon corners (n, 4, 3) (pin ``p`` at ``-+PACK``, pin ``p+1`` at ``+-PACK``) and the sheave
-    positions (2 shafts, 2 sides) of :func:`sheave_positions`."""
+    """What is drawn of the transmission at one state (m): the axes (N, PIN_POINTS, 3) of the pins (or pin halves)
+    from the far end to the near end, the axes each link joins (n, 2), link ribbon corners (n, 4, 3) (first axis
+    at ``-+PACK``, second at ``+-PACK``), the sheave positions (2 shafts, 2 sides) of :func:`sheave_positions`
+    (rigid shafts; elastic: the faces' reference positions ``z_ref`` in their sheaves' frames), the face grids of
+    :func:`sheave_faces` and the shafts' axes of :func:`shaft_lines`."""
 
     pin_axes: np.ndarray
+    link_ends: np.ndarray
     link_corners: np.ndarray
     sheaves: np.ndarray
+    faces: np.ndarray
+    shafts: tuple
 
 
-def chain_frame(model, q_chain, z, reference=None, axial_scale: float = 1.0) -> ChainFrame:
-    """The drawn geometry at chain coordinates ``q_chain`` and sheave positions ``z`` (2,); with ``reference``
-    ``(q_chain_ref, z_ref)`` the axial coordinates are exaggerated by ``axial_scale`` about those."""
+def sheave_reference(model, placement) -> np.ndarray:
+    """:attr:`ChainFrame.sheaves` of ``placement``."""
+    if not elastic(model):
+        return sheave_positions(model, placement)
+    ref = np.empty((2, 2))
+    for k in range(2):
+        for jj in range(2):
+            ref[k, int(model._sides[k, jj] > 0)] = model.face_ref[k, jj]
+    return ref
+
+
+def chain_frame(model, q_chain, placement, reference=None, axial_scale: float = 1.0) -> ChainFrame:
+    """The drawn geometry at chain coordinates ``q_chain`` and ``placement`` (rigid shafts: the sheave positions
+    ``z`` (2,); elastic shafts: the structure's coordinates); with ``reference`` ``(q_chain_ref, placement_ref)``
+    the axial coordinates of every drawn point are exaggerated by ``axial_scale`` about those."""
     xi = np.concatenate([np.linspace(-1.0, 1.0, PIN_POINTS), [-PACK_FRACTION, PACK_FRACTION]])
-    pts = pin_axis_points(model, q_chain, xi, z)
-    sheaves = sheave_positions(model, z)
+
+    def points(q, place):
+        return pin_axis_points(model, q, xi, place), sheave_faces(model, place), shaft_lines(model, place)
+    pts, faces, shafts = points(q_chain, placement)
+    sheaves = sheave_reference(model, placement)
     if reference is not None and axial_scale != 1.0:
-        ref = pin_axis_points(model, reference[0], xi, reference[1])
-        pts[..., 2] = ref[..., 2] + axial_scale * (pts[..., 2] - ref[..., 2])
-        ref_sheaves = sheave_positions(model, reference[1])
+        r_pts, r_faces, r_shafts = points(*reference)
+        pts[..., 2] = r_pts[..., 2] + axial_scale * (pts[..., 2] - r_pts[..., 2])
+        faces[:, :, 2] = r_faces[:, :, 2] + axial_scale * (faces[:, :, 2] - r_faces[:, :, 2])
+        for line, r_line in zip(shafts, r_shafts):
+            line[:, 2] = r_line[:, 2] + axial_scale * (line[:, 2] - r_line[:, 2])
+        ref_sheaves = sheave_reference(model, reference[1])
         sheaves = ref_sheaves + axial_scale * (sheaves - ref_sheaves)
     pack = pts[:, PIN_POINTS:]
-    nxt = np.roll(np.arange(len(pts)), -1)
-    corners = np.stack([pack[:, 0], pack[:, 1], pack[nxt, 1], pack[nxt, 0]], axis=1)
-    return ChainFrame(pts[:, :PIN_POINTS], corners, sheaves)
+    a, b = link_axes(model).T
+    corners = np.stack([pack[a, 0], pack[a, 1], pack[b, 1], pack[b, 0]], axis=1)
+    return ChainFrame(pts[:, :PIN_POINTS], np.column_stack([a, b]), corners, sheaves, faces, shafts)
 
 
 def chain_state(model, x) -> tuple[np.ndarray, np.ndarray]:
-    """Chain coordinates and sheave positions ``z`` (2,) m of a full model state."""
+    """Chain coordinates and the placement of :func:`chain_frame` (rigid: sheave positions ``z`` (2,) m; elastic:
+    the structure's coordinates) of a full model state."""
     q = model.split(np.asarray(x, float))[0]
     nc, _, iz, _ = model._idx
+    if elastic(model):
+        return np.array(q[:nc]), np.array(q[nc:nc + model.structure.n])
     return np.array(q[:nc]), np.array(q[iz])
 
 
@@ -124,24 +241,28 @@ def sheave_face_points(face, centre, z: float, side: float, r_in: float, r_out: 
     return centre[0] + R * np.cos(T), centre[1] + R * np.sin(T), side * (z + s)
 
 
-def chain_meshes(frame: ChainFrame, pin_radius: float):
-    """Pins (polylines along their axes, tubes, one polydata) and links (ribbons: one quad cell per link)."""
+def chain_meshes(frame: ChainFrame):
+    """Pins (polylines along their axes, one polydata) and links (ribbons: one quad cell per link)."""
     import pyvista as pv
 
     n, m, _ = frame.pin_axes.shape
     lines = np.column_stack([np.full(n, m), np.arange(n * m).reshape(n, m)]).ravel()
     axes = pv.PolyData(frame.pin_axes.reshape(-1, 3), lines=lines)
-    faces = np.column_stack([np.full(n, 4), 4 * np.arange(n)[:, None] + np.arange(4)]).ravel()
+    k = len(frame.link_corners)
+    faces = np.column_stack([np.full(k, 4), 4 * np.arange(k)[:, None] + np.arange(4)]).ravel()
     return axes, pv.PolyData(frame.link_corners.reshape(-1, 3), faces=faces)
 
 
 # ----- colours ---------------------------------------------------------------------------------------------
 def colour_kind(model, spec) -> str | None:
-    """How output ``spec`` colours the chain: ``"link"`` (one value per link), ``"pin"`` (per pin), ``"end"``
-    (per pin end and shaft, ``contact.*``), or None (not drawable)."""
+    """How output ``spec`` colours the chain: ``"link"`` (one value per link), ``"pin"`` (per pin), ``"half"`` (per
+    pin half of A5: half - of every pin, then half +), ``"end"`` (per pin end, or pin-half end, and shaft,
+    ``contact.*``), or None (not drawable)."""
     n = model.family.n
     if spec.name.startswith("contact.") and spec.size == 2 * model.n_ends:
         return "end"
+    if halves(model) and spec.size == 2 * n and "half" in spec.name:
+        return "half"
     if spec.size != n:
         return None
     doc = spec.doc.lower()
@@ -155,15 +276,16 @@ def check_colour(model, name: str, stored=None, option: str = "--color") -> str:
                and (stored is None or s.name in stored)}
     if name not in allowed:
         where = " stored in the results file" if stored is not None else ""
-        raise InputError(option, name, f"must be an output{where} with one value per link, per pin or per pin end "
-                         "and shaft: " + ", ".join(sorted(allowed)))
+        raise InputError(option, name, f"must be an output{where} with one value per link, per pin, per pin half or "
+                         "per pin end and shaft: " + ", ".join(sorted(allowed)))
     return allowed[name]
 
 
 def colour_values(model, name: str, values) -> tuple[np.ndarray, str]:
-    """``(values, kind)``: per link or per pin (n,), or per pin end (n, 2) (far, near; A family) for an output
-    per pin end and shaft, summed over the two shafts (a pin end touches one shaft at a time); a symmetric
-    chain's contact outputs (one end per pin, the mirror end implied) become per pin."""
+    """``(values, kind)`` as drawn: per link (n,) with kind ``"link"``; per drawn axis (N,) with kind ``"pin"`` (a
+    pin's value on both of A5's halves, A5's per-half values on their halves); per axis end (N, 2) (far, near) with
+    kind ``"end"`` for an output per pin end and shaft, summed over the two shafts (an end touches one shaft at a
+    time).  A symmetric chain's contact outputs (one end per pin, the mirror end implied) become per pin."""
     spec = next(s for s in model.output_specs if s.name == name)
     kind = colour_kind(model, spec)
     v = np.asarray(values, float).reshape(-1)
@@ -172,23 +294,28 @@ def colour_values(model, name: str, values) -> tuple[np.ndarray, str]:
         if not whole_pin(model):
             return v, "pin"
         return v.reshape(-1, 2), "end"
+    if kind == "half":
+        return v.reshape(2, -1).T.ravel(), "pin"
+    if kind == "pin" and halves(model):
+        return np.repeat(v, 2), "pin"
     return v, kind
 
 
-def colour_meshes(pins, links, values: np.ndarray, kind: str, name: str) -> None:
-    """Attach ``values`` of :func:`colour_values` as scalars ``name`` to the pin polylines and link ribbons
-    (links only for per-link values; the other kinds interpolate per pin or per pin end)."""
-    n = len(values)
-    m = pins.n_points // n
+def colour_meshes(pins, links, values: np.ndarray, kind: str, name: str, link_ends: np.ndarray) -> None:
+    """Attach ``values`` of :func:`colour_values` as scalars ``name`` to the axis polylines and link ribbons
+    (links only for per-link values; the other kinds interpolate per axis or per axis end, and along each ribbon
+    between the axes ``link_ends`` (n, 2) it joins)."""
     if kind == "link":
         links.cell_data[name] = values
         return
-    ends = np.column_stack([values, values]) if kind == "pin" else values            # (n, 2): far, near
+    n = len(values)
+    m = pins.n_points // n
+    ends = np.column_stack([values, values]) if kind == "pin" else values            # (N, 2): far, near
     xi = np.linspace(-1.0, 1.0, m)
     pins.point_data[name] = (ends[:, :1] + (ends[:, 1:] - ends[:, :1]) * (xi + 1) / 2).ravel()
     at = ends[:, 0] + (ends[:, 1] - ends[:, 0]) * (1 + np.array([-1.0, 1.0])[:, None] * PACK_FRACTION) / 2
-    nxt = np.roll(np.arange(n), -1)
-    links.point_data[name] = np.column_stack([at[0], at[1], at[1][nxt], at[0][nxt]]).ravel()
+    a, b = link_ends.T
+    links.point_data[name] = np.column_stack([at[0][a], at[1][a], at[1][b], at[0][b]]).ravel()
 
 
 def colour_limits(values) -> tuple[float, float]:
@@ -205,26 +332,29 @@ def colour_limits(values) -> tuple[float, float]:
 def draw_frame(p, model, frame: ChainFrame, name: str, values, unit: str, clim=None) -> None:
     """Add the sheaves, shafts, pins and links of ``frame`` to plotter ``p``, coloured by ``values`` of output
     ``name`` (:func:`colour_values`) with the colour limits ``clim`` (default: the values' range)."""
+    import pyvista as pv
+
     v, kind = colour_values(model, name, values)
     contact = model.contact
     r_out = contact.r_outer
-    axes, links = chain_meshes(frame, pin_radius=PIN_FRACTION * r_out)
-    colour_meshes(axes, links, v, kind, name)
+    axes, links = chain_meshes(frame)
+    colour_meshes(axes, links, v, kind, name, frame.link_ends)
     clim = colour_limits(v) if clim is None else clim
     bar = {"title": f"{name} ({unit})", "color": "black", "position_x": 0.25, "width": 0.5, "fmt": "%.4g"}
     p.add_mesh(links, scalars=name, cmap="viridis", clim=clim, show_edges=False, scalar_bar_args=bar)
-    tubes = axes.tube(radius=PIN_FRACTION * r_out, n_sides=12, capping=True)
+    radius = PIN_FRACTION * r_out * (0.6 if halves(model) else 1.0)
+    tubes = axes.tube(radius=radius, n_sides=12, capping=True)
     if kind == "link":
         p.add_mesh(tubes, color="dimgray", smooth_shading=True)
     else:
         p.add_mesh(tubes, scalars=name, cmap="viridis", clim=clim, smooth_shading=True, show_scalar_bar=False)
     for k in range(2):
-        c = contact.centres[k]
-        for j, (side, opacity) in enumerate(((-1.0, 1.0), (1.0, 0.25))):
-            p.add_mesh(sheave_surface(contact.faces[k], c, frame.sheaves[k, j], side, SHAFT_FRACTION * r_out, r_out),
-                       color="lightsteelblue", opacity=opacity, smooth_shading=True)
-        length = 2 * abs(frame.sheaves[k].max() - face_profile(contact.faces[k])(r_out)[0]) + 0.5 * r_out
-        p.add_mesh(_shaft(c, SHAFT_FRACTION * r_out, length), color="slategray", smooth_shading=True)
+        for j, opacity in enumerate((1.0, 0.25)):
+            p.add_mesh(pv.StructuredGrid(*frame.faces[k, j]), color="lightsteelblue", opacity=opacity,
+                       smooth_shading=True)
+        line = frame.shafts[k]
+        shaft = pv.lines_from_points(line).tube(radius=SHAFT_FRACTION * r_out, n_sides=48, capping=True)
+        p.add_mesh(shaft, color="slategray", smooth_shading=True)
     p.add_point_labels(np.column_stack([contact.centres, np.full(2, 0.5 * r_out)]), ["driving", "driven"],
                        font_size=14, text_color="black", shape_opacity=0.0, always_visible=True)
 
@@ -254,9 +384,3 @@ def render_transmission(model, x, path: str | Path, color_by: str = "chain.link_
     p.close()
     return Path(path)
 
-
-def _shaft(centre, radius: float, length: float):
-    import pyvista as pv
-
-    return pv.Cylinder(center=(centre[0], centre[1], 0.0), direction=(0, 0, 1), radius=radius, height=length,
-                       resolution=48)

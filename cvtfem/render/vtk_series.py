@@ -1,14 +1,15 @@
 """A window of a chain-CVT results file as a VTU time series for ParaView (meshio), one file per stored row
 and mesh, collected by a ``.pvd`` file per mesh (``chain.pvd``, ``sheaves.pvd``) with the stored times.
 
-``chain_NNNNN.vtu``: every pin a polyline of ``PIN_POINTS - 1`` line cells along its axis (block 0), every link
-a line cell between the mid-points of its two pins (block 1), with the chain's points of
-:func:`~cvtfem.render.transmission.chain_frame` (m); for each stored output that colours the chain, cell data
-(per-pin values on the pin cells, per-link values on the link cells, NaN on the other block; per-pin-end
-values: their mean on a pin's cells) and, for per-pin and per-pin-end outputs, point data (a pin end's value
-at its end, linear along the axis).  ``sheaves_NNNNN.vtu``: the four sheave faces as quads with cell data
-``shaft`` (0 driving, 1 driven) and ``side`` (-1, +1).  The times are in the ``.pvd`` files (meshio's VTU
-writer drops field data).  meshio reads a chain file back as one line block: the pin cells, then the links.
+``chain_NNNNN.vtu``: every drawn axis (a pin, or a pin half of A5) a polyline of ``PIN_POINTS - 1`` line cells
+(block 0), every link a line cell between the mid-points of the two axes it joins (block 1), with the chain's
+points of :func:`~cvtfem.render.transmission.chain_frame` (m); for each stored output that colours the chain, cell
+data (per-axis values on the axis cells, per-link values on the link cells, NaN on the other block; per-end values:
+their mean on an axis's cells) and, for the per-axis outputs, point data (an end's value at its end, linear along
+the axis).  ``sheaves_NNNNN.vtu``: the four sheave faces as drawn (on elastic shafts displaced and tilted) as quads
+with cell data ``shaft`` (0 driving, 1 driven) and ``side`` (-1, +1).  The times are in the ``.pvd`` files
+(meshio's VTU writer drops field data).  meshio reads a chain file back as one line block: the axis cells, then the
+links.
 """
 from __future__ import annotations
 
@@ -19,7 +20,7 @@ import numpy as np
 
 from cvtfem.errors import InputError
 from cvtfem.render.stored_run import StoredRun
-from cvtfem.render.transmission import PIN_POINTS, SHAFT_FRACTION, colour_values, sheave_face_points
+from cvtfem.render.transmission import colour_values
 
 
 def chain_mesh(run: StoredRun, row: int, names, axial_scale: float = 1.0):
@@ -31,8 +32,7 @@ def chain_mesh(run: StoredRun, row: int, names, axial_scale: float = 1.0):
     points = np.concatenate([frame.pin_axes.reshape(-1, 3), frame.pin_axes[:, (m - 1) // 2]])
     start = m * np.arange(n)[:, None] + np.arange(m - 1)
     pin_cells = np.stack([start, start + 1], axis=-1).reshape(-1, 2)
-    mid = n * m + np.arange(n)
-    link_cells = np.column_stack([mid, np.roll(mid, -1)])
+    link_cells = n * m + frame.link_ends
     point_data, cell_data = {}, {}
     xi = np.linspace(-1.0, 1.0, m)
     for name in names:
@@ -43,29 +43,26 @@ def chain_mesh(run: StoredRun, row: int, names, axial_scale: float = 1.0):
         ends = np.column_stack([v, v]) if kind == "pin" else v
         along = ends[:, :1] + (ends[:, 1:] - ends[:, :1]) * (xi + 1) / 2
         point_data[name] = np.concatenate([along.ravel(), ends.mean(axis=1)])
-        cell_data[name] = [np.repeat(ends.mean(axis=1), m - 1), np.full(n, np.nan)]
+        cell_data[name] = [np.repeat(ends.mean(axis=1), m - 1), np.full(len(link_cells), np.nan)]
     return meshio.Mesh(points, [("line", pin_cells), ("line", link_cells)], point_data=point_data,
                        cell_data=cell_data)
 
 
-def sheave_mesh(run: StoredRun, row: int, axial_scale: float = 1.0, n_r: int = 8, n_theta: int = 72):
-    """The four sheave faces at ``row`` as one quad mesh (cell data ``shaft``, ``side``)."""
+def sheave_mesh(run: StoredRun, row: int, axial_scale: float = 1.0):
+    """The four sheave faces at ``row`` as drawn, one quad mesh (cell data ``shaft``, ``side``)."""
     import meshio
 
-    model, sheaves = run.model, run.frame(row, axial_scale).sheaves
-    contact = model.contact
+    faces = run.frame(row, axial_scale).faces                  # (2, 2, 3, n_r, n_theta)
+    n_r, n_theta = faces.shape[-2:]
+    idx = np.arange(n_r * n_theta).reshape(n_r, n_theta)
+    one = np.stack([idx[:-1, :-1], idx[1:, :-1], idx[1:, 1:], idx[:-1, 1:]], axis=-1).reshape(-1, 4)
     points, quads, shaft, side = [], [], [], []
     for k in range(2):
-        for j, s in enumerate((-1.0, 1.0)):
-            X, Y, Z = sheave_face_points(contact.faces[k], contact.centres[k], sheaves[k, j], s,
-                                         SHAFT_FRACTION * contact.r_outer, contact.r_outer, n_r, n_theta)
-            base = sum(len(p) for p in points)
-            idx = base + np.arange(n_r * n_theta).reshape(n_r, n_theta)
-            q = np.stack([idx[:-1, :-1], idx[1:, :-1], idx[1:, 1:], idx[:-1, 1:]], axis=-1).reshape(-1, 4)
-            points.append(np.column_stack([X.ravel(), Y.ravel(), Z.ravel()]))
-            quads.append(q)
-            shaft.append(np.full(len(q), k))
-            side.append(np.full(len(q), int(s)))
+        for j, s in enumerate((-1, 1)):
+            quads.append(one + len(points) * n_r * n_theta)
+            points.append(faces[k, j].reshape(3, -1).T)
+            shaft.append(np.full(len(one), k))
+            side.append(np.full(len(one), s))
     return meshio.Mesh(np.concatenate(points), [("quad", np.concatenate(quads))],
                        cell_data={"shaft": [np.concatenate(shaft)], "side": [np.concatenate(side)]})
 

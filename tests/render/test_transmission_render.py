@@ -60,7 +60,7 @@ def test_links_are_ribbons_between_their_pins(running):
     model, x = running
     frame = tr.chain_frame(model, *tr.chain_state(model, x))
     u, u3 = frame.pin_axes[:, -1, :2], frame.pin_axes[:, -1, 2]
-    pins, links = tr.chain_meshes(frame, 1e-3)
+    pins, links = tr.chain_meshes(frame)
     n = len(u)
     assert links.n_cells == n and pins.n_cells == n
     corners = np.asarray(links.points).reshape(n, 4, 3)
