@@ -17,6 +17,11 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
                    "results file: axial positions exaggerated by this factor about the first row (default 1)")
     p.add_argument("--color", default="chain.link_tension",
                    help="chain transmission: output colouring the links (per link, per pin, or per pin end and shaft)")
+    p.add_argument("--zoom", type=float, help="chain transmission: camera zoom over the whole transmission "
+                   "(default 1)")
+    p.add_argument("--look-at", type=float, nargs=2, metavar=("X1", "X2"), help="chain transmission: chain-plane "
+                   "point the camera aims at, m (the driven shaft at the origin, the driving one at (L, 0); default "
+                   "the transmission's centre)")
     p.add_argument("--png", metavar="OUT", help="PNG file")
     p.add_argument("--gif", metavar="OUT", help="animated GIF of the mode over one period, or of a run's window")
     p.add_argument("--mp4", metavar="OUT", help="results file: MP4 of the window (needs imageio-ffmpeg)")
@@ -47,6 +52,9 @@ def run(args: argparse.Namespace) -> int:
 
     if load_scene(args.scene).kind == "cvt":
         return _render_chain(args)
+    for name in ("zoom", "look_at"):
+        if getattr(args, name) is not None:
+            raise InputError(f"--{name.replace('_', '-')}", getattr(args, name), "is for chain transmissions")
     scene, model = load_rotor(args.scene)
     from cvtfem.render import rotor as r
 
@@ -74,6 +82,22 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
+def _view(args: argparse.Namespace):
+    """The camera of ``--zoom`` and ``--look-at`` (InputError for a zoom that is not positive and finite, or a
+    point that is not finite)."""
+    import math
+
+    from cvtfem.errors import InputError
+    from cvtfem.render.transmission import View
+
+    zoom = 1.0 if args.zoom is None else args.zoom
+    if not (math.isfinite(zoom) and zoom > 0):
+        raise InputError("--zoom", args.zoom, "must be a positive, finite zoom factor")
+    if args.look_at is not None and not all(math.isfinite(v) for v in args.look_at):
+        raise InputError("--look-at", args.look_at, "must be two finite coordinates x1 x2, m")
+    return View(zoom, None if args.look_at is None else tuple(args.look_at))
+
+
 def _render_chain(args: argparse.Namespace) -> int:
     """The chain transmission of a CVT scene in its start state (the quasi-static state on the sheaves)."""
     from cvtfem.errors import InputError
@@ -87,8 +111,9 @@ def _render_chain(args: argparse.Namespace) -> int:
                              "its start state to --png")
     model = chain_loop(load_scene(args.scene))
     check_colour(model, args.color)
+    view = _view(args)
     x0, report = model.start()
-    path = render_transmission(model, x0, args.png, color_by=args.color,
+    path = render_transmission(model, x0, args.png, color_by=args.color, view=view,
                                title=f"{args.scene}: start state ({report['kind']}), links coloured by {args.color}")
     print(f"wrote {path}")
     return 0
@@ -119,6 +144,7 @@ def _render_run(args: argparse.Namespace) -> int:
     scale = 1.0 if args.scale is None else args.scale
     if not (scale == scale and abs(scale) != float("inf") and scale > 0):
         raise InputError("--scale", args.scale, "must be a positive, finite exaggeration factor")
+    view = _view(args)
     run = open_run(args.scene)
     if args.time is not None and not args.png:
         raise InputError("--time", args.time, "is the time of the --png still (animations take --window)")
@@ -135,14 +161,14 @@ def _render_run(args: argparse.Namespace) -> int:
             check_animation(path, args.fps, option)
     if args.png:
         asked = "" if args.time is None else f" (nearest to --time {args.time:g} s)"
-        path = render_row(run, row, args.png, args.color, scale)
+        path = render_row(run, row, args.png, args.color, scale, view=view)
         print(f"wrote {path}: t = {run.time[row]:.9g} s, row {row}{asked}")
     if not animated:
         return 0
     span = f"{len(rows)} frames, t = {run.time[rows[0]]:.9g} .. {run.time[rows[-1]]:.9g} s"
     for option, path in (("--gif", args.gif), ("--mp4", args.mp4)):
         if path:
-            print(f"wrote {write_animation(run, rows, path, args.color, scale, args.fps, option)}: {span}")
+            print(f"wrote {write_animation(run, rows, path, args.color, scale, args.fps, option, view=view)}: {span}")
     if args.vtu:
         chain, sheaves = write_vtu_series(run, rows, args.vtu, scale)
         print(f"wrote {chain} and {sheaves}: {span}")

@@ -12,7 +12,7 @@ import numpy as np
 from cvtfem.errors import InputError
 from cvtfem.render.rotor import plotter
 from cvtfem.render.stored_run import StoredRun
-from cvtfem.render.transmission import colour_limits, colour_values, draw_frame, set_view
+from cvtfem.render.transmission import View, colour_limits, colour_values, draw_frame, set_view
 
 #: Pixel size of animation frames (stills use the size their caller gives).
 MOVIE_SIZE = (960, 560)
@@ -29,12 +29,12 @@ def _draw(p, run: StoredRun, row: int, name: str, unit: str, axial_scale: float,
 
 
 def render_row(run: StoredRun, row: int, path: str | Path, name: str = "chain.link_tension",
-               axial_scale: float = 1.0, size: tuple[int, int] = (1400, 800)) -> Path:
+               axial_scale: float = 1.0, size: tuple[int, int] = (1400, 800), view: View = View()) -> Path:
     """PNG of the transmission at stored ``row``, coloured by the stored output ``name``."""
     unit = run.check_colour(name)
     p = plotter(size)
     _draw(p, run, row, name, unit, axial_scale, None)
-    set_view(p)
+    set_view(p, view)
     p.screenshot(str(path))
     p.close()
     return Path(path)
@@ -61,7 +61,7 @@ def check_animation(path: str | Path, fps: float, option: str = "--gif") -> bool
 
 def write_animation(run: StoredRun, rows, path: str | Path, name: str = "chain.link_tension",
                     axial_scale: float = 1.0, fps: float = 10.0, option: str = "--gif",
-                    size: tuple[int, int] = MOVIE_SIZE) -> Path:
+                    size: tuple[int, int] = MOVIE_SIZE, view: View = View()) -> Path:
     """GIF (``.gif``) or MP4 (other suffixes, needs imageio-ffmpeg) of the stored ``rows``, one frame each at
     ``fps`` frames per second, coloured by ``name`` with fixed limits over the rows."""
     unit = run.check_colour(name)
@@ -76,7 +76,7 @@ def write_animation(run: StoredRun, rows, path: str | Path, name: str = "chain.l
         p.clear()
         _draw(p, run, int(row), name, unit, axial_scale, clim)
         if i == 0:
-            set_view(p)
+            set_view(p, view)
         p.write_frame()
     p.close()
     return Path(path)

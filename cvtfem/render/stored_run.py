@@ -2,7 +2,8 @@
 
 A row's chain is drawn from the stored outputs ``chain.coordinates`` (the chain family's q) and, on rigid shafts,
 ``driving.sheave_position`` / ``driven.sheave_position``, on elastic shafts ``driving.shaft_coordinates`` /
-``driven.shaft_coordinates`` (the shafts' beam nodes and sheaves), through the rebuilt model's geometry (:func:`~cvtfem.render.transmission.chain_frame`);
+``driven.shaft_coordinates`` (the shafts' beam nodes and sheaves), through the rebuilt model's geometry
+(:func:`~cvtfem.render.transmission.chain_frame`);
 colours come from the stored per-link, per-pin, per-pin-half or per-pin-end series, so nothing is recomputed.
 """
 from __future__ import annotations

@@ -36,6 +36,8 @@ SHAFT_FRACTION, PIN_FRACTION = 0.12, 0.018
 PACK_FRACTION = 0.8
 #: Points drawn along each pin axis (a curve for the A family).
 PIN_POINTS = 9
+#: Drawn width of a plate across its link, as a fraction of the distance of its end centres.
+PLATE_HEIGHT = 0.45
 #: Radial and angular grid points of a drawn sheave face.
 FACE_GRID = (12, 96)
 
@@ -86,6 +88,49 @@ def link_axes(model) -> np.ndarray:
     p = np.arange(model.family.n)
     nxt = np.roll(p, -1)
     return np.column_stack([2 * p, 2 * nxt + 1]) if halves(model) else np.column_stack([p, nxt])
+
+
+def plate_outputs(model) -> int | None:
+    """Size of the family's per-plate outputs (links x Kmax for A1 and A5, one per plate for A3/A4), None for the
+    chains without plates (S)."""
+    chain = getattr(model.family, "chain", None)
+    if halves(model):
+        return chain.plate_w.size
+    if not whole_pin(model):
+        return None
+    base = getattr(chain, "base", chain)
+    return base.plate_mask.size if base is chain else chain.plate_link.size
+
+
+def plate_stations(model, q_chain):
+    """``(ends, slot, size)`` of the chains that have plates (A family, A5), else None: the two end centres
+    ``(P, 2, 3)`` m of every plate on the axes its link joins (A1, A3/A4: at the plate's station ``xi^k`` on both
+    pins; A5: at the pack coordinate plus the plate's offset ``d^k`` on each half, (1.211)), the index of each
+    plate in the family's per-plate outputs and those outputs' size."""
+    fam, q = model.family, np.asarray(q_chain, float)
+    chain, size = getattr(fam, "chain", None), plate_outputs(model)
+    if size is None:
+        return None
+    if halves(model):
+        _, w, qp = fam.split(q)
+        mask = chain.plate_w > 0
+        e, k = np.nonzero(mask)
+        nxt = chain._next[e]
+        xi_a = 2 / chain.l * (qp[e] - w[0, 0, e] + chain.plate_d[e, k])
+        xi_b = 2 / chain.l * (qp[nxt] - w[1, 0, nxt] + chain.plate_d[e, k])
+        ends = np.stack([chain.axis_points(q, e, np.zeros_like(e), xi_a),
+                         chain.axis_points(q, nxt, np.ones_like(e), xi_b)], axis=1)
+        return ends, e * chain.kmax + k, size
+    base = getattr(chain, "base", chain)
+    if base is chain:                                     # A1: links x Kmax outputs
+        e, k = np.nonzero(base.plate_mask)
+        xi, slot = base.plate_xi[e, k], e * base.plate_xi.shape[1] + k
+    else:                                                 # A3/A4: one output per plate
+        e, xi = chain.plate_link, chain.xi
+        slot = np.arange(e.size)
+    nxt = (e + 1) % base.n_pins
+    ends = np.stack([base.axis_points(q, e, xi), base.axis_points(q, nxt, xi)], axis=1)
+    return ends, slot, size
 
 
 def sheave_positions(model, z) -> np.ndarray:
@@ -167,7 +212,8 @@ class ChainFrame:
     from the far end to the near end, the axes each link joins (n, 2), link ribbon corners (n, 4, 3) (first axis
     at ``-+PACK``, second at ``+-PACK``), the sheave positions (2 shafts, 2 sides) of :func:`sheave_positions`
     (rigid shafts; elastic: the faces' reference positions ``z_ref`` in their sheaves' frames), the face grids of
-    :func:`sheave_faces` and the shafts' axes of :func:`shaft_lines`."""
+    :func:`sheave_faces`, the shafts' axes of :func:`shaft_lines` and, for chains with plates, the plates' end
+    centres (P, 2, 3) and output slots of :func:`plate_stations`."""
 
     pin_axes: np.ndarray
     link_ends: np.ndarray
@@ -175,6 +221,8 @@ class ChainFrame:
     sheaves: np.ndarray
     faces: np.ndarray
     shafts: tuple
+    plate_ends: np.ndarray | None = None
+    plate_slots: np.ndarray | None = None
 
 
 def sheave_reference(model, placement) -> np.ndarray:
@@ -195,21 +243,29 @@ def chain_frame(model, q_chain, placement, reference=None, axial_scale: float = 
     xi = np.concatenate([np.linspace(-1.0, 1.0, PIN_POINTS), [-PACK_FRACTION, PACK_FRACTION]])
 
     def points(q, place):
-        return pin_axis_points(model, q, xi, place), sheave_faces(model, place), shaft_lines(model, place)
-    pts, faces, shafts = points(q_chain, placement)
+        plates = plate_stations(model, q)
+        return (pin_axis_points(model, q, xi, place), sheave_faces(model, place), shaft_lines(model, place),
+                (None, None) if plates is None else plates[:2])
+    pts, faces, shafts, (plate_ends, slots) = points(q_chain, placement)
     sheaves = sheave_reference(model, placement)
     if reference is not None and axial_scale != 1.0:
-        r_pts, r_faces, r_shafts = points(*reference)
-        pts[..., 2] = r_pts[..., 2] + axial_scale * (pts[..., 2] - r_pts[..., 2])
-        faces[:, :, 2] = r_faces[:, :, 2] + axial_scale * (faces[:, :, 2] - r_faces[:, :, 2])
-        for line, r_line in zip(shafts, r_shafts):
-            line[:, 2] = r_line[:, 2] + axial_scale * (line[:, 2] - r_line[:, 2])
+        ref = points(*reference)
+
+        def exaggerate(x, x_ref):
+            x[..., 2] = x_ref[..., 2] + axial_scale * (x[..., 2] - x_ref[..., 2])
+        exaggerate(pts, ref[0])
+        exaggerate(faces.swapaxes(2, -1), ref[1].swapaxes(2, -1))
+        for line, r_line in zip(shafts, ref[2]):
+            exaggerate(line, r_line)
+        if plate_ends is not None:
+            exaggerate(plate_ends, ref[3][0])
         ref_sheaves = sheave_reference(model, reference[1])
         sheaves = ref_sheaves + axial_scale * (sheaves - ref_sheaves)
     pack = pts[:, PIN_POINTS:]
     a, b = link_axes(model).T
     corners = np.stack([pack[a, 0], pack[a, 1], pack[b, 1], pack[b, 0]], axis=1)
-    return ChainFrame(pts[:, :PIN_POINTS], np.column_stack([a, b]), corners, sheaves, faces, shafts)
+    return ChainFrame(pts[:, :PIN_POINTS], np.column_stack([a, b]), corners, sheaves, faces, shafts, plate_ends,
+                      slots)
 
 
 def chain_state(model, x) -> tuple[np.ndarray, np.ndarray]:
@@ -253,14 +309,35 @@ def chain_meshes(frame: ChainFrame):
     return axes, pv.PolyData(frame.link_corners.reshape(-1, 3), faces=faces)
 
 
+def plate_corners(frame: ChainFrame) -> np.ndarray:
+    """Corners (P, 4, 3), m, of the drawn plates: quads parallel to the chain plane between their two end centres,
+    ``PLATE_HEIGHT`` of the centre distance wide across it (a drawing size)."""
+    a, b = frame.plate_ends[:, 0], frame.plate_ends[:, 1]
+    d = b[:, :2] - a[:, :2]
+    across = np.column_stack([-d[:, 1], d[:, 0], np.zeros(len(d))]) * (PLATE_HEIGHT / 2)
+    return np.stack([a - across, a + across, b + across, b - across], axis=1)
+
+
+def plate_mesh(frame: ChainFrame):
+    """The plates of :func:`plate_corners` as one pyvista PolyData (a quad cell each)."""
+    import pyvista as pv
+
+    corners = plate_corners(frame)
+    k = len(corners)
+    return pv.PolyData(corners.reshape(-1, 3), faces=np.column_stack([np.full(k, 4), 4 * np.arange(k)[:, None]
+                                                                      + np.arange(4)]).ravel())
+
+
 # ----- colours ---------------------------------------------------------------------------------------------
 def colour_kind(model, spec) -> str | None:
-    """How output ``spec`` colours the chain: ``"link"`` (one value per link), ``"pin"`` (per pin), ``"half"`` (per
-    pin half of A5: half - of every pin, then half +), ``"end"`` (per pin end, or pin-half end, and shaft,
-    ``contact.*``), or None (not drawable)."""
+    """How output ``spec`` colours the chain: ``"link"`` (one value per link), ``"plate"`` (per plate: the plates
+    are drawn), ``"pin"`` (per pin), ``"half"`` (per pin half of A5: half - of every pin, then half +), ``"end"``
+    (per pin end, or pin-half end, and shaft, ``contact.*``), or None (not drawable)."""
     n = model.family.n
     if spec.name.startswith("contact.") and spec.size == 2 * model.n_ends:
         return "end"
+    if spec.name.startswith("chain.plate_") and spec.size == plate_outputs(model):
+        return "plate"
     if halves(model) and spec.size == 2 * n and "half" in spec.name:
         return "half"
     if spec.size != n:
@@ -276,16 +353,17 @@ def check_colour(model, name: str, stored=None, option: str = "--color") -> str:
                and (stored is None or s.name in stored)}
     if name not in allowed:
         where = " stored in the results file" if stored is not None else ""
-        raise InputError(option, name, f"must be an output{where} with one value per link, per pin, per pin half or "
-                         "per pin end and shaft: " + ", ".join(sorted(allowed)))
+        raise InputError(option, name, f"must be an output{where} with one value per link, per plate, per pin, per "
+                         "pin half or per pin end and shaft: " + ", ".join(sorted(allowed)))
     return allowed[name]
 
 
 def colour_values(model, name: str, values) -> tuple[np.ndarray, str]:
-    """``(values, kind)`` as drawn: per link (n,) with kind ``"link"``; per drawn axis (N,) with kind ``"pin"`` (a
-    pin's value on both of A5's halves, A5's per-half values on their halves); per axis end (N, 2) (far, near) with
-    kind ``"end"`` for an output per pin end and shaft, summed over the two shafts (an end touches one shaft at a
-    time).  A symmetric chain's contact outputs (one end per pin, the mirror end implied) become per pin."""
+    """``(values, kind)`` as drawn: per link (n,) with kind ``"link"``; the per-plate outputs as they are, kind
+    ``"plate"`` (:attr:`ChainFrame.plate_slots` picks the drawn plates' values); per drawn axis (N,) with kind
+    ``"pin"`` (a pin's value on both of A5's halves, A5's per-half values on their halves); per axis end (N, 2)
+    (far, near) with kind ``"end"`` for an output per pin end and shaft, summed over the two shafts (an end touches
+    one shaft at a time).  A symmetric chain's contact outputs (one end per pin, the mirror end implied) become per pin."""
     spec = next(s for s in model.output_specs if s.name == name)
     kind = colour_kind(model, spec)
     v = np.asarray(values, float).reshape(-1)
@@ -338,13 +416,19 @@ def draw_frame(p, model, frame: ChainFrame, name: str, values, unit: str, clim=N
     contact = model.contact
     r_out = contact.r_outer
     axes, links = chain_meshes(frame)
-    colour_meshes(axes, links, v, kind, name, frame.link_ends)
-    clim = colour_limits(v) if clim is None else clim
     bar = {"title": f"{name} ({unit})", "color": "black", "position_x": 0.25, "width": 0.5, "fmt": "%.4g"}
-    p.add_mesh(links, scalars=name, cmap="viridis", clim=clim, show_edges=False, scalar_bar_args=bar)
+    if kind == "plate":
+        v = v[frame.plate_slots]
+        links = plate_mesh(frame)
+        links.cell_data[name] = v
+    else:
+        colour_meshes(axes, links, v, kind, name, frame.link_ends)
+    clim = colour_limits(v) if clim is None else clim
+    p.add_mesh(links, scalars=name, cmap="viridis", clim=clim, show_edges=kind == "plate", edge_color="dimgray",
+               scalar_bar_args=bar)
     radius = PIN_FRACTION * r_out * (0.6 if halves(model) else 1.0)
     tubes = axes.tube(radius=radius, n_sides=12, capping=True)
-    if kind == "link":
+    if kind in ("link", "plate"):
         p.add_mesh(tubes, color="dimgray", smooth_shading=True)
     else:
         p.add_mesh(tubes, scalars=name, cmap="viridis", clim=clim, smooth_shading=True, show_scalar_bar=False)
@@ -359,28 +443,42 @@ def draw_frame(p, model, frame: ChainFrame, name: str, values, unit: str, clim=N
                        font_size=14, text_color="black", shape_opacity=0.0, always_visible=True)
 
 
-def set_view(p) -> None:
-    """The oblique view of every rendering: the chain plane seen from the front, slightly from below."""
+@dataclass(frozen=True)
+class View:
+    """Camera of a rendering: ``zoom`` over the view of the whole transmission, aimed at the chain-plane point
+    ``look_at`` ``(x1, x2)`` m (None: the transmission's centre)."""
+
+    zoom: float = 1.0
+    look_at: tuple | None = None
+
+
+def set_view(p, view: View = View()) -> None:
+    """The oblique view of every rendering (the chain plane seen from the front, slightly from below), moved
+    parallel to aim at ``view.look_at`` and zoomed by ``view.zoom``."""
     p.view_vector((0.35, -0.55, 1.0), viewup=(0.0, 1.0, 0.0))
-    p.camera.zoom(1.15)
+    if view.look_at is not None:
+        focal = np.array(p.camera.focal_point)
+        shift = np.array([view.look_at[0], view.look_at[1], 0.0]) - focal
+        p.camera.position = tuple(np.array(p.camera.position) + shift)
+        p.camera.focal_point = tuple(focal + shift)
+    p.camera.zoom(1.15 * view.zoom)
 
 
 def render_transmission(model, x, path: str | Path, color_by: str = "chain.link_tension", t: float = 0.0,
                         reference=None, axial_scale: float = 1.0, size: tuple[int, int] = (1400, 800),
-                        title: str | None = None) -> Path:
+                        title: str | None = None, view: View = View()) -> Path:
     """PNG of the chain transmission in state ``x`` at time ``t`` (s): sheaves, shafts, pins and links,
-    coloured by the model output ``color_by`` (per link, per pin, or per pin end and shaft)."""
+    coloured by the model output ``color_by`` (per link, per pin, per pin half, or per pin end and shaft)."""
     unit = check_colour(model, color_by)
     q_chain, z = chain_state(model, x)
     ref = None if reference is None else chain_state(model, reference)
     frame = chain_frame(model, q_chain, z, ref, axial_scale)
     p = plotter(size)
     draw_frame(p, model, frame, color_by, model.outputs(t, x)[color_by], unit)
-    set_view(p)
+    set_view(p, view)
     note = f", axial positions x{axial_scale:g}" if axial_scale != 1.0 else ""
     p.add_text(title or f"chain transmission at t = {t:.4g} s: coloured by {color_by}{note}",
                font_size=10, color="black")
     p.screenshot(str(path))
     p.close()
     return Path(path)
-

@@ -3,13 +3,15 @@ and mesh, collected by a ``.pvd`` file per mesh (``chain.pvd``, ``sheaves.pvd``)
 
 ``chain_NNNNN.vtu``: every drawn axis (a pin, or a pin half of A5) a polyline of ``PIN_POINTS - 1`` line cells
 (block 0), every link a line cell between the mid-points of the two axes it joins (block 1), with the chain's
-points of :func:`~cvtfem.render.transmission.chain_frame` (m); for each stored output that colours the chain, cell
-data (per-axis values on the axis cells, per-link values on the link cells, NaN on the other block; per-end values:
-their mean on an axis's cells) and, for the per-axis outputs, point data (an end's value at its end, linear along
-the axis).  ``sheaves_NNNNN.vtu``: the four sheave faces as drawn (on elastic shafts displaced and tilted) as quads
-with cell data ``shaft`` (0 driving, 1 driven) and ``side`` (-1, +1).  The times are in the ``.pvd`` files
-(meshio's VTU writer drops field data).  meshio reads a chain file back as one line block: the axis cells, then the
-links.
+points of :func:`~cvtfem.render.transmission.chain_frame` (m), and for the chains with plates every plate a quad
+(block 2, :func:`~cvtfem.render.transmission.plate_corners`); for each stored output that colours the chain, cell data
+(per-axis values on the axis cells, per-link values on the link cells, per-plate values on the plates, NaN on the
+other blocks; per-end values: their mean on an axis's cells) and, for the per-axis outputs, point data (an end's
+value at its end, linear along the axis; NaN at the plates' corners).  ``sheaves_NNNNN.vtu``: the four sheave
+faces as drawn (on elastic shafts displaced and tilted) as quads with cell data ``shaft`` (0 driving, 1 driven)
+and ``side`` (-1, +1).  The times are in the ``.pvd`` files
+(meshio's VTU writer drops field data).  meshio reads a chain file back with one line block (the axis cells,
+then the links) and the plates' quads.
 """
 from __future__ import annotations
 
@@ -20,7 +22,7 @@ import numpy as np
 
 from cvtfem.errors import InputError
 from cvtfem.render.stored_run import StoredRun
-from cvtfem.render.transmission import colour_values
+from cvtfem.render.transmission import colour_values, plate_corners
 
 
 def chain_mesh(run: StoredRun, row: int, names, axial_scale: float = 1.0):
@@ -29,23 +31,31 @@ def chain_mesh(run: StoredRun, row: int, names, axial_scale: float = 1.0):
 
     frame = run.frame(row, axial_scale)
     n, m, _ = frame.pin_axes.shape
-    points = np.concatenate([frame.pin_axes.reshape(-1, 3), frame.pin_axes[:, (m - 1) // 2]])
+    points = [frame.pin_axes.reshape(-1, 3), frame.pin_axes[:, (m - 1) // 2]]
     start = m * np.arange(n)[:, None] + np.arange(m - 1)
-    pin_cells = np.stack([start, start + 1], axis=-1).reshape(-1, 2)
-    link_cells = n * m + frame.link_ends
+    blocks = [("line", np.stack([start, start + 1], axis=-1).reshape(-1, 2)), ("line", n * m + frame.link_ends)]
+    if frame.plate_ends is not None:
+        corners = plate_corners(frame)
+        blocks.append(("quad", n * m + n + np.arange(corners.size // 3).reshape(-1, 4)))
+        points.append(corners.reshape(-1, 3))
+    points = np.concatenate(points)
+    n_plate_points = len(points) - n * m - n
     point_data, cell_data = {}, {}
     xi = np.linspace(-1.0, 1.0, m)
+
+    def nan(block):
+        return np.full(len(blocks[block][1]), np.nan)
     for name in names:
         v, kind = colour_values(run.model, name, run.results.series[name][row])
-        if kind == "link":
-            cell_data[name] = [np.full(len(pin_cells), np.nan), v]
+        if kind in ("link", "plate"):
+            cell_data[name] = [nan(0), v if kind == "link" else nan(1)] + (
+                [v[frame.plate_slots] if kind == "plate" else nan(2)] if len(blocks) == 3 else [])
             continue
         ends = np.column_stack([v, v]) if kind == "pin" else v
         along = ends[:, :1] + (ends[:, 1:] - ends[:, :1]) * (xi + 1) / 2
-        point_data[name] = np.concatenate([along.ravel(), ends.mean(axis=1)])
-        cell_data[name] = [np.repeat(ends.mean(axis=1), m - 1), np.full(len(link_cells), np.nan)]
-    return meshio.Mesh(points, [("line", pin_cells), ("line", link_cells)], point_data=point_data,
-                       cell_data=cell_data)
+        point_data[name] = np.concatenate([along.ravel(), ends.mean(axis=1), np.full(n_plate_points, np.nan)])
+        cell_data[name] = [np.repeat(ends.mean(axis=1), m - 1), nan(1)] + ([nan(2)] if len(blocks) == 3 else [])
+    return meshio.Mesh(points, blocks, point_data=point_data, cell_data=cell_data)
 
 
 def sheave_mesh(run: StoredRun, row: int, axial_scale: float = 1.0):

@@ -132,7 +132,8 @@ def test_colours_per_half_per_pin_and_per_half_end(e_model):
     kinds = {s.name: tr.colour_kind(model, s) for s in model.output_specs}
     assert kinds["chain.pin_half_axial_force"] == kinds["chain.half_pack_slip"] == "half"
     assert kinds["chain.roll_force"] == "pin" and kinds["chain.link_tension"] == "link"
-    assert kinds["contact.normal_force"] == "end" and kinds["chain.plate_tension"] is None
+    assert kinds["contact.normal_force"] == "end" and kinds["chain.plate_tension"] == "plate"
+    assert kinds["chain.plate_state"] == "plate" and kinds["contact.friction_force"] is None
     per_half = np.arange(2 * n, dtype=float)                       # half - of every pin, then half +
     v, kind = tr.colour_values(model, "chain.pin_half_axial_force", per_half)
     assert kind == "pin"
@@ -248,10 +249,84 @@ def test_variant_e_results_draw_every_pin_half(cli, tmp_path):
     for i, xi in ((0, -1.0), (m - 1, 1.0)):
         ends = run.model.family.chain.axis_points(q, pins, half, np.full(2 * n, xi))
         np.testing.assert_allclose(mesh.points[i:2 * n * m:m], ends, rtol=0, atol=1e-12)
-    (lines,) = mesh.cells
-    assert len(lines.data) == 2 * n * (m - 1) + n
+    lines, plates = mesh.cells
+    assert len(lines.data) == 2 * n * (m - 1) + n and plates.type == "quad"
+    frame = run.frame(row)
+    T = run.results.series["chain.plate_tension"][row]
+    np.testing.assert_array_equal(mesh.cell_data["chain.plate_tension"][-1], T[frame.plate_slots])
+    np.testing.assert_allclose(mesh.points[plates.data], tr.plate_corners(frame), rtol=0, atol=1e-12)
     mid = lines.data[2 * n * (m - 1):] - 2 * n * m                  # links join half - of p and half + of p + 1
     np.testing.assert_array_equal(mid, np.column_stack([2 * np.arange(n), 2 * np.roll(np.arange(n), -1) + 1]))
     F = run.results.series["chain.pin_half_axial_force"][row].reshape(2, n)
     np.testing.assert_allclose(mesh.point_data["chain.pin_half_axial_force"][:2 * n * m].reshape(n, 2, m),
                                np.repeat(F.T[:, :, None], m, axis=2), rtol=1e-15)
+
+
+def test_a5_plates_sit_at_the_pack_plus_their_offsets(e_model):
+    """With straight halves at their rest length (the placement's, straightened) every drawn plate of link ``p``
+    runs from the centre of half - of pin ``p`` to that of half + of pin ``p + 1`` in the chain plane, at
+    ``x3 = q_pack + d^k`` (1.211) on each (1e-15 m); at the placement the drawn plates' tensions of each link sum
+    to its link tension."""
+    model, x = e_model
+    chain, nc = model.family.chain, model._idx[0]
+    q = x[:nc].copy()
+    u, w, qp = model.family.split(q)                  # views of q
+    u[:, 1:] = 0.0
+    w[:, 1] = chain.l / 2
+    qp += 1e-4 * np.sin(np.arange(qp.size))
+    ends, slot, size = tr.plate_stations(model, q)
+    e, k = np.divmod(slot, chain.kmax)
+    nxt = (e + 1) % chain.n_pins
+    assert size == chain.n_pins * chain.kmax and len(slot) == int((chain.plate_w > 0).sum())
+    np.testing.assert_allclose(ends[:, 0, :2], u[0, 0, e], rtol=0, atol=1e-15)
+    np.testing.assert_allclose(ends[:, 1, :2], u[1, 0, nxt], rtol=0, atol=1e-15)
+    np.testing.assert_allclose(ends[:, 0, 2], qp[e] + chain.plate_d[e, k], rtol=0, atol=1e-15)
+    np.testing.assert_allclose(ends[:, 1, 2], qp[nxt] + chain.plate_d[e, k], rtol=0, atol=1e-15)
+    _links_sum_their_plates(model, x)
+
+
+def _links_sum_their_plates(model, x):
+    out = model.outputs(0.0, x)
+    frame = tr.chain_frame(model, *tr.chain_state(model, x))
+    T, kind = tr.colour_values(model, "chain.plate_tension", out["chain.plate_tension"])
+    assert kind == "plate"
+    chain = model.family.chain
+    link = frame.plate_slots // chain.kmax if hasattr(chain, "kmax") else chain.plate_link[frame.plate_slots]
+    sums = np.bincount(link, T[frame.plate_slots], model.family.n)
+    np.testing.assert_allclose(sums, out["chain.link_tension"], rtol=1e-12, atol=1e-9)
+    assert np.abs(out["chain.link_tension"]).max() > 100.0
+
+
+def test_a4_plates_sum_to_their_links(tmp_path):
+    """chain-A4 (one output per plate): the drawn plates of each link sum to its tension; a PNG coloured by the
+    plate tension is written."""
+    model = chain_loop(load_scene("chain-A4"))
+    x, _ = model.start()
+    kinds = {s.name: tr.colour_kind(model, s) for s in model.output_specs}
+    assert kinds["chain.plate_tension"] == kinds["chain.plate_state"] == "plate"
+    assert kinds["chain.plate_reduced_moment"] is None
+    _links_sum_their_plates(model, x)
+    png = tr.render_transmission(model, x, tmp_path / "a4.png", color_by="chain.plate_tension",
+                                 view=tr.View(3.0, (0.0, -0.05)))
+    assert png.stat().st_size > 10_000
+
+
+def test_camera_options_through_the_cli(cli, s2_elastic_file, tmp_path):
+    """``--zoom`` and ``--look-at`` aim a close-up (a PNG differing from the full view); bad values and a rotor
+    scene are refused by name, before anything is drawn."""
+    from PIL import Image
+
+    full, close = tmp_path / "full.png", tmp_path / "close.png"
+    assert cli("render", str(s2_elastic_file), "--png", str(full), timeout=300).returncode == 0
+    res = cli("render", str(s2_elastic_file), "--png", str(close), "--zoom", "4", "--look-at", "0", "-0.05",
+              timeout=300)
+    assert res.returncode == 0, res.stderr
+    a, b = (np.asarray(Image.open(p).convert("L"), float) for p in (full, close))
+    assert a.shape == b.shape and np.abs(a - b).mean() > 5.0
+    for args, option in ((("--zoom", "0"), "`--zoom`"), (("--zoom", "nan"), "`--zoom`"),
+                         (("--look-at", "0", "inf"), "`--look-at`")):
+        bad = cli("render", str(s2_elastic_file), "--png", str(tmp_path / "bad.png"), *args)
+        assert bad.returncode == 2 and option in bad.stderr
+    bad = cli("render", "friswell_5_9_1", "--png", str(tmp_path / "bad.png"), "--zoom", "2")
+    assert bad.returncode == 2 and "`--zoom`" in bad.stderr and "chain transmissions" in bad.stderr
+    assert not (tmp_path / "bad.png").exists()
