@@ -9,12 +9,13 @@ symmetric chains (S2, S3), the movable sheave at ``z`` and the fixed one at ``fi
 reference position ``z_ref`` in the frame of its sheave, carried by the sheave's translation ``a`` and tilt
 ``theta`` about its pivot ``o`` exactly as the contacts see it (``X = o + (I - theta x)(x - o - a)``, inverted),
 and each shaft is the polyline of its displaced beam nodes.  Each pin is drawn along its axis from its far end
-(``x3 < 0``) to its near end: straight from ``-u3`` to ``u3`` (S2, S3; the S3 pin bending is not drawn), through
-the shape functions (1.132) of its ten coordinates (A family: two independent ends, bent axis); A5 draws each
+(``x3 < 0``) to its near end: from ``-u3`` to ``u3``, straight (S2) or bent by the parabola ``h_1(xi) u'_p`` (S3),
+through the shape functions (1.132) of its ten coordinates (A family: two independent ends, bent axis); A5 draws each
 pin half so (2 axes per pin, half - then half +).  Each link is a ribbon across the plate pack (the axes at
 ``xi = +-PACK_FRACTION``) between its two pins, or A5's half - of pin ``p`` and half + of pin ``p + 1``,
 coloured by a per-link output, or by a per-pin, per-half or per-pin-end output interpolated along the link and
-the axes.  Axial positions (the ``x3`` of every drawn point: pins, faces, shafts) can be exaggerated about a
+the axes; coloured by a per-plate output, the plates are drawn instead (quads parallel to the chain plane between
+their stations on the two axes).  Axial positions (the ``x3`` of every drawn point: pins, faces, shafts) can be exaggerated about a
 reference state: ``x3 = x3_ref + axial_scale (x3 - x3_ref)``; in-plane positions are drawn as they are.
 """
 from __future__ import annotations
@@ -25,6 +26,7 @@ from pathlib import Path
 import numpy as np
 
 from cvtfem.elements.chain.asymmetric import shape_functions
+from cvtfem.elements.chain.geometry import h1
 from cvtfem.elements.chain.halves import ChainA5
 from cvtfem.elements.chain.sheave_contact import face_profile
 from cvtfem.errors import InputError
@@ -75,10 +77,12 @@ def pin_axis_points(model, q_chain, xi, z=None) -> np.ndarray:
         perp = np.einsum("im,inc->nmc", h, u)
         axial = w[0][:, None] + xi[None, :] * w[1][:, None]
     else:
-        u, u3, _ = fam.split(q_chain)
+        u, u3, up = fam.split(q_chain)
         if u3 is None:                                   # S1: the ends are not coordinates
             u3 = model.pin_end_axial(q_chain, np.asarray(z, float))
         perp = np.repeat(u[:, None, :], xi.size, axis=1)
+        if up is not None:                               # S3: the parabola h_1(xi) u'_p through the ends (1.96b)
+            perp = perp + h1(xi, fam.geom.l)[None, :, None] * up[:, None, :]
         axial = xi[None, :] * u3[:, None]
     return np.concatenate([perp, axial[..., None]], axis=2)
 

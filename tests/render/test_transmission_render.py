@@ -97,3 +97,25 @@ def test_png_through_the_cli(cli, tmp_path):
     assert coloured.mean() > 0.01
     bad = cli("render", "chain-S2", "--png", str(png), "--mode", "1")
     assert bad.returncode == 2 and "`--mode`" in bad.stderr
+
+
+def test_s3_pins_are_drawn_bent_by_their_parabola():
+    """S3: the drawn axis ends at the pin's ends (``u``, ``-+u3``; 1e-15), its mid-point is displaced by
+    ``-l/2 u'_p`` and its second derivative over ``xi`` is ``l u'_p`` (1.96b; the central difference over +-0.5, exact
+    for a parabola, 1e-12)."""
+    model = chain_loop(load_scene("chain-S3-refined"))
+    fam = model.family
+    n, l = fam.n, fam.geom.l
+    rng = np.random.default_rng(3)
+    q = 1e-3 * rng.standard_normal(fam.size)
+    u, u3, up = fam.split(q)
+    h = 0.5
+    xi = np.array([-1.0, -h, 0.0, h, 1.0])
+    pts = tr.pin_axis_points(model, q, xi)
+    np.testing.assert_allclose(pts[:, 0, :2], u, rtol=0, atol=1e-15)
+    np.testing.assert_allclose(pts[:, -1, :2], u, rtol=0, atol=1e-15)
+    np.testing.assert_allclose(pts[:, [0, -1], 2], np.column_stack([-u3, u3]), rtol=0, atol=1e-15)
+    np.testing.assert_allclose(pts[:, 2, :2], u - l / 2 * up, rtol=0, atol=1e-15)
+    second = (pts[:, 1, :2] - 2 * pts[:, 2, :2] + pts[:, 3, :2]) / h ** 2
+    np.testing.assert_allclose(second, l * up, rtol=0, atol=1e-12 * np.abs(l * up).max())
+    assert n == len(pts)
