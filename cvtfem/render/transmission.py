@@ -15,8 +15,9 @@ pin half so (2 axes per pin, half - then half +).  Each link is a ribbon across 
 ``xi = +-PACK_FRACTION``) between its two pins, or A5's half - of pin ``p`` and half + of pin ``p + 1``,
 coloured by a per-link output, or by a per-pin, per-half or per-pin-end output interpolated along the link and
 the axes; coloured by a per-plate output, the plates are drawn instead (quads parallel to the chain plane between
-their stations on the two axes).  Axial positions (the ``x3`` of every drawn point: pins, faces, shafts) can be exaggerated about a
-reference state: ``x3 = x3_ref + axial_scale (x3 - x3_ref)``; in-plane positions are drawn as they are.
+their stations on the two axes).  Axial positions (the ``x3`` of every drawn point: pins, plates, faces, shafts)
+can be exaggerated about a reference state: ``x3 = x3_ref + axial_scale (x3 - x3_ref)``; in-plane positions are
+drawn as they are.
 """
 from __future__ import annotations
 
@@ -282,15 +283,6 @@ def chain_state(model, x) -> tuple[np.ndarray, np.ndarray]:
     return np.array(q[:nc]), np.array(q[iz])
 
 
-def sheave_surface(face, centre, z: float, side: float, r_in: float, r_out: float, n_r: int = 12,
-                   n_theta: int = 96):
-    """The face ``x3 = side (z + s(r))`` of one sheave as a pyvista StructuredGrid (m)."""
-    import pyvista as pv
-
-    X, Y, Z = sheave_face_points(face, centre, z, side, r_in, r_out, n_r, n_theta)
-    return pv.StructuredGrid(X, Y, Z)
-
-
 def sheave_face_points(face, centre, z: float, side: float, r_in: float, r_out: float, n_r: int = 12,
                        n_theta: int = 96) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Grid ``(x1, x2, x3)`` arrays (n_r, n_theta), m, of the face ``x3 = side (z + s(r))``."""
@@ -367,7 +359,8 @@ def colour_values(model, name: str, values) -> tuple[np.ndarray, str]:
     ``"plate"`` (:attr:`ChainFrame.plate_slots` picks the drawn plates' values); per drawn axis (N,) with kind
     ``"pin"`` (a pin's value on both of A5's halves, A5's per-half values on their halves); per axis end (N, 2)
     (far, near) with kind ``"end"`` for an output per pin end and shaft, summed over the two shafts (an end touches
-    one shaft at a time).  A symmetric chain's contact outputs (one end per pin, the mirror end implied) become per pin."""
+    one shaft at a time).  A symmetric chain's contact outputs (one end per pin, the mirror end implied) become per
+    pin."""
     spec = next(s for s in model.output_specs if s.name == name)
     kind = colour_kind(model, spec)
     v = np.asarray(values, float).reshape(-1)

@@ -33,7 +33,7 @@ def test_drawn_pin_ends_penetrate_the_drawn_faces_by_the_model_penetration(runni
         def s(r):
             return -flat.z0(r)
         np.testing.assert_array_equal(frame.sheaves[k], z[k])
-        pts = np.asarray(tr.sheave_surface(face, c, z[k], -1.0, 0.01, contact.r_outer).points)
+        pts = frame.faces[k, 0].reshape(3, -1).T                          # the face at x3 < 0
         np.testing.assert_allclose(pts[:, 2], -(z[k] + s(np.hypot(pts[:, 0] - c[0], pts[:, 1] - c[1]))),
                                    rtol=1e-12, atol=1e-15)
         r_pin = np.hypot(*(u - c).T)
