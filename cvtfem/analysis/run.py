@@ -98,11 +98,17 @@ def resume_run(results: str | Path, show_progress: bool = True,
     ``title`` and ``description``: a difference is an :class:`InputError` naming the first differing key,
     unless ``changed``: then the run continues with ``scene``'s values from the checkpoint (which must have
     its state layout), and the file stores ``scene`` and the changes (``/stats`` ``scene_changed``).
+
+    On elastic shafts the faces' reference positions ``z_ref`` come from the file (the series
+    ``*.face_reference``, since session 17), not from the rigid start solved again: a resume costs no start, and
+    with ``changed`` the faces stay where the run had them (a changed regime would otherwise move them).
     """
-    from cvtfem.io.results import ResultsWriter, read_checkpoint, read_scene_toml
+    from cvtfem.io.results import ResultsWriter, read_checkpoint, read_first_row, read_scene_toml
+    from cvtfem.machines.chain_cvt_elastic import FACE_REFERENCE, with_face_reference
     from cvtfem.scene.loader import _parse, scene_from_dict
 
     text = read_scene_toml(results, "--resume")
+    faces = read_first_row(results, FACE_REFERENCE, "--resume")     # elastic shafts: the faces stay where they were
     diff = []
     if scene is not None:
         stored = scene_from_dict(_parse(text, str(results)), source=str(results))
@@ -137,6 +143,7 @@ def resume_run(results: str | Path, show_progress: bool = True,
             raise InputError("--resume", str(results), "must hold a checkpoint of this cvtfem version's run driver "
                              f"(state layout {writer.checkpoint_layout} differs)")
         run.specs = writer.specs
+        run.loop = with_face_reference(run.loop, faces)
         writer.flush_interval = stored.output.flush_interval
     except BaseException as err:
         writer.close("failed", f"resume: {err}")

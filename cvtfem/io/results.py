@@ -512,3 +512,15 @@ def read_results(path: str | Path) -> Results:
         units = {name: str(d.attrs.get("unit", "")) for name, d in group.items()}
         return Results(path=path, attrs=attrs, scene_toml=_scene_text(f, path, "RESULTS"),
                        stats=dict(f["stats"].attrs), time=group["time"][:rows], series=series, units=units)
+
+
+def read_first_row(path: str | Path, names: Sequence[str], where: str = "RESULTS") -> dict[str, np.ndarray] | None:
+    """The first stored row of each series ``names`` (the file is only read), None when the file lacks one of
+    them or holds no row."""
+    path = Path(path)
+    with _reading(path, where) as f:
+        _, group = _checked(f, path, where)
+        if any(name not in group or group[name].shape[0] == 0 for name in names):
+            return None
+        return {name: np.array(group[name][0]) for name in names}
+

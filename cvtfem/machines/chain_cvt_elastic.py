@@ -40,6 +40,7 @@ import scipy.sparse as sp
 from scipy.optimize import least_squares
 
 from cvtfem.assembly.model import StateLayout
+from cvtfem.blas import single_thread_blas
 from cvtfem.elements.base import Block
 from cvtfem.elements.chain import mapped_contact_kernel as MCK
 from cvtfem.elements.chain.sheave_contact import central_local_jacobian
@@ -148,6 +149,9 @@ class ElasticChainCVT(CompiledMappedContacts, ChainCVT):
             new.append(OutputSpec(f"{name}.shaft_coordinates", "m, rad", f"Structure coordinates of the {name} shaft "
                                   "(per beam node u1 u2 u3 theta1 theta2 phi, then the movable sheave's zeta): "
                                   "renderings of a results file.", 6 * len(x) + 1))
+            new.append(OutputSpec(f"{name}.face_reference", "m", f"Reference positions z_ref of the fixed, then the "
+                                  f"movable sheave face of the {name} shaft in their sheaves' frames (the run's "
+                                  "constant: renderings and resumes read it instead of solving the start again).", 2))
         rigid_only = ("driving.sheave_position", "driven.sheave_position")   # the rigid model's z: here sheave_shift
         return tuple(o for o in super().output_specs if o.name not in rigid_only) + tuple(new)
 
@@ -310,7 +314,11 @@ class ElasticChainCVT(CompiledMappedContacts, ChainCVT):
 
     @cached_property
     def _structure_inverse(self) -> np.ndarray:
-        return sla.inv(self.structure.M.toarray())
+        """``M^-1`` of the structure, dense, computed on one BLAS thread: a multi-threaded inverse rounds
+        differently, and its bits would depend on where the model first needs it (inside a run, which steps on one
+        thread, or before)."""
+        with single_thread_blas():
+            return sla.inv(self.structure.M.toarray())
 
     def solve_mass(self, Q):
         nc = self._idx[0]
@@ -497,6 +505,7 @@ class ElasticChainCVT(CompiledMappedContacts, ChainCVT):
             out[f"{name}.sheave_tilt"] = tilt[i]
             out[f"{name}.sheave_shift"] = shift[i]
             out[f"{name}.shaft_coordinates"] = qs[s.offset[i]:s.offset[i] + 6 * len(s.x[i]) + 1]
+            out[f"{name}.face_reference"] = self.face_ref[i]
         return {o.name: out[o.name] for o in self.output_specs}
 
     # ----- initial state -----------------------------------------------------------------------
@@ -770,6 +779,20 @@ class ElasticChainA2CVT(ElasticChainACVT, ChainA2CVT):
     def rigid(self) -> ChainA2CVT:
         return ChainA2CVT(self.family, self.contact, self.J, self.m_sheave, self.regime, self.F_appl, self.control,
                           self.movable_side, self.fixed_z, self.start_chain)
+
+
+#: Series holding each shaft's face reference ``z_ref`` (:meth:`ElasticChainCVT.outputs`).
+FACE_REFERENCE = ("driving.face_reference", "driven.face_reference")
+
+
+def with_face_reference(model, row):
+    """``model`` with the faces' reference ``z_ref`` of ``row`` (the first row of a results file's
+    :data:`FACE_REFERENCE` series, :func:`~cvtfem.io.results.read_first_row`), so that the rigid start need not be
+    solved again and a resumed run keeps the faces where they were; ``model`` itself when it is not on elastic
+    shafts or ``row`` is None (a file that predates the series)."""
+    if row is None or not isinstance(model, ElasticChainCVT):
+        return model
+    return replace(model, z_ref=np.stack([np.asarray(row[name], float) for name in FACE_REFERENCE]))
 
 
 def shaft_parameters(scene) -> tuple[ShaftParameters, ShaftParameters]:

@@ -32,10 +32,16 @@ class StoredRun:
 
     @cached_property
     def model(self):
-        """The transmission of the stored scene (:func:`~cvtfem.machines.cvt.chain_loop`)."""
+        """The transmission of the stored scene (:func:`~cvtfem.machines.cvt.chain_loop`); on elastic shafts with the
+        faces' reference the run stored (no start solved)."""
+        from cvtfem.io.results import read_first_row
+        from cvtfem.machines.chain_cvt_elastic import FACE_REFERENCE, with_face_reference
         from cvtfem.machines.cvt import chain_loop
 
-        return chain_loop(self.scene)
+        model = chain_loop(self.scene)
+        if not self.scene.cvt.effects.shaft_elasticity:
+            return model
+        return with_face_reference(model, read_first_row(self.results.path, FACE_REFERENCE))
 
     @classmethod
     def of(cls, results: Results, scene, where: str = "RESULTS") -> StoredRun:

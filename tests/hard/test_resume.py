@@ -414,3 +414,52 @@ def test_resume_with_a_changed_scene(tmp_path, capsys):
     np.testing.assert_array_equal(res.series["driving.torque"][:kept.sum()], ref.series["driving.torque"][:kept.sum()])
     assert np.all(res.series["driving.torque"][res.time > t_ck] == 250.0)
     assert ref.series["driving.torque"][-1] == 200.0
+
+
+ELASTIC = """preset = ["chain-S2", "shafts-elastic"]
+[cvt.regime]
+torque = {torque}
+[solver]
+method = "rk4"
+h = 2e-7
+[output]
+step = 1e-5
+checkpoint_interval = 2e-5
+"""
+
+
+def test_elastic_resume_keeps_the_stored_face_reference(tmp_path, monkeypatch):
+    """On elastic shafts the run stores its faces' reference ``z_ref`` (``*.face_reference``, every row the run's
+    constant); a resume reads it instead of solving the rigid start again: with that solve refused it equals one
+    run bitwise, and with --resume-changed (a new torque, whose own start would put the faces elsewhere) the faces
+    stay where the run had them."""
+    from cvtfem.machines.chain_cvt_elastic import ElasticChainCVT
+    from cvtfem.machines.cvt import chain_loop
+
+    def scene(torque):
+        path = tmp_path / f"e{torque}.toml"
+        path.write_text(ELASTIC.format(torque=torque), encoding="utf-8")
+        return load_scene(path)
+
+    ref_path, path = tmp_path / "ref.h5", tmp_path / "part.h5"
+    run_scene(scene(200.0), until=6e-5, results=ref_path, show_progress=False)
+    run_scene(scene(200.0), until=4e-5, results=path, show_progress=False)
+    ref = read_results(ref_path)
+    stored = np.stack([ref.series["driving.face_reference"], ref.series["driven.face_reference"]], axis=1)
+    assert np.all(stored == stored[0]) and np.all(np.abs(stored[0]) > 1.0)       # constant (toroidal faces' z_ref)
+    np.testing.assert_array_equal(stored[0], chain_loop(scene(200.0)).face_ref)
+    moved = chain_loop(scene(150.0)).face_ref
+    assert np.abs(moved - stored[0]).max() > 1e-7                              # another torque, other faces
+
+    def refuse(self, *args, **kwargs):
+        raise AssertionError("the rigid start was solved on a resume")
+
+    monkeypatch.setattr(ElasticChainCVT, "_rigid_static_state", refuse)
+    resume_run(path, show_progress=False, until=6e-5)
+    res = read_results(path)
+    assert res.attrs["status"] == "finished" and _series_equal(ref, res), _difference(ref, res)
+    resume_run(path, show_progress=False, until=8e-5, scene=scene(150.0), changed=True)
+    res = read_results(path)
+    assert res.attrs["status"] == "finished" and "torque = 150.0" in res.scene_toml
+    after = np.stack([res.series["driving.face_reference"], res.series["driven.face_reference"]], axis=1)
+    assert np.all(after == stored[0])

@@ -159,12 +159,17 @@ def s2_elastic_file(tmp_path_factory):
     return path
 
 
-def test_stored_run_on_elastic_shafts_draws_the_stored_penetrations(s2_elastic_file):
+def test_stored_run_on_elastic_shafts_draws_the_stored_penetrations(s2_elastic_file, monkeypatch):
     """At the last row the drawn pin ends, carried into the drawn sheaves' frames, lie beyond the faces by the
-    penetrations the run stored (their mean over a pair's two sheaves, 1e-9 relative): the file's
-    shaft coordinates place the faces where the contacts were."""
+    penetrations the run stored (their mean over a pair's two sheaves, 1e-9 relative): the file's shaft
+    coordinates and face reference place the faces where the contacts were, and no start is solved to draw."""
     from cvtfem.commands.render import open_run
+    from cvtfem.machines.chain_cvt_elastic import ElasticChainCVT
 
+    def refuse(self, *args, **kwargs):
+        raise AssertionError("the rigid start was solved to draw a results file")
+
+    monkeypatch.setattr(ElasticChainCVT, "_rigid_static_state", refuse)
     run = open_run(s2_elastic_file)
     model, row = run.model, len(run.time) - 1
     q_chain, q_s = run.geometry(row)
