@@ -16,7 +16,8 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--scale", type=float, help="rotor: displacement scale (default: 8 %% of the shaft length); "
                    "results file: axial positions exaggerated by this factor about the first row (default 1)")
     p.add_argument("--color", default="chain.link_tension",
-                   help="chain transmission: output colouring the links (per link, per pin, or per pin end and shaft)")
+                   help="chain transmission: output colouring the chain (per link, per plate: the plates drawn, per "
+                   "pin, per pin half, or per pin end and shaft)")
     p.add_argument("--zoom", type=float, help="chain transmission: camera zoom over the whole transmission "
                    "(default 1)")
     p.add_argument("--look-at", type=float, nargs=2, metavar=("X1", "X2"), help="chain transmission: chain-plane "
@@ -114,7 +115,7 @@ def _render_chain(args: argparse.Namespace) -> int:
     view = _view(args)
     x0, report = model.start()
     path = render_transmission(model, x0, args.png, color_by=args.color, view=view,
-                               title=f"{args.scene}: start state ({report['kind']}), links coloured by {args.color}")
+                               title=f"{args.scene}: start state ({report['kind']}), coloured by {args.color}")
     print(f"wrote {path}")
     return 0
 
