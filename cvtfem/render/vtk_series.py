@@ -8,8 +8,9 @@ points of :func:`~cvtfem.render.transmission.chain_frame` (m), and for the chain
 (per-axis values on the axis cells, per-link values on the link cells, per-plate values on the plates, NaN on the
 other blocks; per-end values: their mean on an axis's cells) and, for the per-axis outputs, point data (an end's
 value at its end, linear along the axis; NaN at the plates' corners).  ``sheaves_NNNNN.vtu``: the four sheave
-faces as drawn (on elastic shafts displaced and tilted) as quads with cell data ``shaft`` (0 driving, 1 driven)
-and ``side`` (-1, +1).  The times are in the ``.pvd`` files
+faces as drawn (on elastic shafts displaced and tilted) as quads and the shafts' axes as lines (on elastic shafts
+through their displaced beam nodes), with cell data ``shaft`` (0 driving, 1 driven) and ``side`` (-1, +1; 0 on a
+shaft).  The times are in the ``.pvd`` files
 (meshio's VTU writer drops field data).  meshio reads a chain file back with one line block (the axis cells,
 then the links) and the plates' quads.
 """
@@ -59,10 +60,12 @@ def chain_mesh(run: StoredRun, row: int, names, axial_scale: float = 1.0):
 
 
 def sheave_mesh(run: StoredRun, row: int, axial_scale: float = 1.0):
-    """The four sheave faces at ``row`` as drawn, one quad mesh (cell data ``shaft``, ``side``)."""
+    """The four sheave faces at ``row`` as drawn, quads (block 0), and the two shafts' axes, lines (block 1), in one
+    mesh with cell data ``shaft`` (0 driving, 1 driven) and ``side`` (-1, +1 for a face, 0 for a shaft)."""
     import meshio
 
-    faces = run.frame(row, axial_scale).faces                  # (2, 2, 3, n_r, n_theta)
+    frame = run.frame(row, axial_scale)
+    faces = frame.faces                                        # (2, 2, 3, n_r, n_theta)
     n_r, n_theta = faces.shape[-2:]
     idx = np.arange(n_r * n_theta).reshape(n_r, n_theta)
     one = np.stack([idx[:-1, :-1], idx[1:, :-1], idx[1:, 1:], idx[:-1, 1:]], axis=-1).reshape(-1, 4)
@@ -73,8 +76,16 @@ def sheave_mesh(run: StoredRun, row: int, axial_scale: float = 1.0):
             points.append(faces[k, j].reshape(3, -1).T)
             shaft.append(np.full(len(one), k))
             side.append(np.full(len(one), s))
-    return meshio.Mesh(np.concatenate(points), [("quad", np.concatenate(quads))],
-                       cell_data={"shaft": [np.concatenate(shaft)], "side": [np.concatenate(side)]})
+    base, lines, line_shaft = 4 * n_r * n_theta, [], []
+    for k, axis in enumerate(frame.shafts):
+        lines.append(base + np.column_stack([np.arange(len(axis) - 1), np.arange(1, len(axis))]))
+        line_shaft.append(np.full(len(axis) - 1, k))
+        points.append(axis)
+        base += len(axis)
+    lines, line_shaft = np.concatenate(lines), np.concatenate(line_shaft)
+    return meshio.Mesh(np.concatenate(points), [("quad", np.concatenate(quads)), ("line", lines)],
+                       cell_data={"shaft": [np.concatenate(shaft), line_shaft],
+                                  "side": [np.concatenate(side), np.zeros(len(lines), int)]})
 
 
 def write_pvd(path: Path, times, files) -> Path:

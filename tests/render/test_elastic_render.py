@@ -208,10 +208,15 @@ def test_elastic_png_gif_and_vtu_through_the_cli(cli, s2_elastic_file, tmp_path)
     run = open_run(s2_elastic_file)
     times, files = read_pvd(vtu / "sheaves.pvd")
     np.testing.assert_array_equal(times, run.time)
-    faces = run.frame(len(times) - 1, 50.0).faces
+    frame = run.frame(len(times) - 1, 50.0)
     mesh = meshio.read(files[-1])
-    np.testing.assert_allclose(mesh.points, np.concatenate([faces[k, j].reshape(3, -1).T for k in range(2)
-                                                            for j in range(2)]), rtol=0, atol=1e-12)
+    drawn = np.concatenate([frame.faces[k, j].reshape(3, -1).T for k in range(2) for j in range(2)]
+                           + list(frame.shafts))
+    np.testing.assert_allclose(mesh.points, drawn, rtol=0, atol=1e-12)
+    quads, lines = mesh.cells                               # the faces, then the shafts through their beam nodes
+    assert quads.type == "quad" and lines.type == "line"
+    assert len(lines.data) == sum(len(a) - 1 for a in frame.shafts) and len(frame.shafts[0]) > 2
+    np.testing.assert_array_equal(mesh.cell_data["side"][1], 0)
 
 
 def test_a_run_on_elastic_shafts_without_its_structure_is_refused(tmp_path):
