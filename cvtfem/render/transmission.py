@@ -359,7 +359,7 @@ def colour_values(model, name: str, values) -> tuple[np.ndarray, str]:
     ``"plate"`` (:attr:`ChainFrame.plate_slots` picks the drawn plates' values); per drawn axis (N,) with kind
     ``"pin"`` (a pin's value on both of A5's halves, A5's per-half values on their halves); per axis end (N, 2)
     (far, near) with kind ``"end"`` for an output per pin end and shaft, summed over the two shafts (an end touches
-    one shaft at a time).  A symmetric chain's contact outputs (one end per pin, the mirror end implied) become per
+    one shaft at a time; A2's two coupled halves' ends summed on their whole pin's end).  A symmetric chain's contact outputs (one end per pin, the mirror end implied) become per
     pin."""
     spec = next(s for s in model.output_specs if s.name == name)
     kind = colour_kind(model, spec)
@@ -368,6 +368,8 @@ def colour_values(model, name: str, values) -> tuple[np.ndarray, str]:
         v = v.reshape(-1, 2).sum(axis=1)
         if not whole_pin(model):
             return v, "pin"
+        if v.size == 4 * model.family.n and not halves(model):       # A2: both coupled halves' ends on one pin end
+            v = v.reshape(-1, 2, 2).sum(axis=1).ravel()
         return v.reshape(-1, 2), "end"
     if kind == "half":
         return v.reshape(2, -1).T.ravel(), "pin"

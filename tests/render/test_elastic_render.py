@@ -340,3 +340,17 @@ def test_camera_options_through_the_cli(cli, s2_elastic_file, tmp_path):
     bad = cli("render", "friswell_5_9_1", "--png", str(tmp_path / "bad.png"), "--zoom", "2")
     assert bad.returncode == 2 and "`--zoom`" in bad.stderr and "chain transmissions" in bad.stderr
     assert not (tmp_path / "bad.png").exists()
+
+
+def test_a2_half_end_values_sum_on_the_whole_pin_ends():
+    """Variant (v) (A2: coupled halves on A1's whole pins, ends ``4 p + 2 half + near``): a per-end-and-shaft output
+    colours pin ``p``'s far end with the sum over both halves' far ends and both shafts."""
+    model = chain_loop(load_scene("variant-v"))
+    n = model.family.n
+    assert model.n_ends == 4 * n and tr.whole_pin(model) and not tr.halves(model)
+    per_end_shaft = np.arange(8 * n, dtype=float)                  # value 2 (4 p + 2 h + s) + shaft
+    v, kind = tr.colour_values(model, "contact.normal_force", per_end_shaft)
+    assert kind == "end" and v.shape == (n, 2)
+    p, s = np.arange(n)[:, None], np.arange(2)[None, :]
+    expected = sum(2 * (4 * p + 2 * h + s) * 2 + 1 for h in (0, 1))            # both halves, both shafts
+    np.testing.assert_array_equal(v, expected)
