@@ -8,16 +8,16 @@ symmetric chains (S2, S3), the movable sheave at ``z`` and the fixed one at ``fi
 (A family).  On elastic shafts (:mod:`~cvtfem.machines.chain_cvt_elastic`) each face is that surface at its
 reference position ``z_ref`` in the frame of its sheave, carried by the sheave's translation ``a`` and tilt
 ``theta`` about its pivot ``o`` exactly as the contacts see it (``X = o + (I - theta x)(x - o - a)``, inverted),
-and each shaft is the polyline of its displaced beam nodes.  Each pin is drawn along its axis from its far end
-(``x3 < 0``) to its near end: from ``-u3`` to ``u3``, straight (S2) or bent by the parabola ``h_1(xi) u'_p`` (S3),
-through the shape functions (1.132) of its ten coordinates (A family: two independent ends, bent axis); A5 draws each
-pin half so (2 axes per pin, half - then half +).  Each link is a ribbon across the plate pack (the axes at
-``xi = +-PACK_FRACTION``) between its two pins, or A5's half - of pin ``p`` and half + of pin ``p + 1``,
-coloured by a per-link output, or by a per-pin, per-half or per-pin-end output interpolated along the link and
-the axes; coloured by a per-plate output, the plates are drawn instead (quads parallel to the chain plane between
-their stations on the two axes).  Axial positions (the ``x3`` of every drawn point: pins, plates, faces, shafts)
-can be exaggerated about a reference state: ``x3 = x3_ref + axial_scale (x3 - x3_ref)``; in-plane positions are
-drawn as they are.
+and each shaft is the polyline of its displaced beam nodes, with its two bearings at their nodes.  Each pin is
+drawn along its axis from its far end (``x3 < 0``) to its near end: from ``-u3`` to ``u3``, straight (S2) or bent
+by the parabola ``h_1(xi) u'_p`` (S3), through the shape functions (1.132) of its ten coordinates (A family: two
+independent ends, bent axis); A5 draws each pin half so (2 axes per pin, half - then half +).  Each link is a
+ribbon across the plate pack (the axes at ``xi = +-PACK_FRACTION``) between its two pins, or A5's half - of pin
+``p`` and half + of pin ``p + 1``, coloured by a per-link output, or by a per-pin, per-half or per-pin-end output
+interpolated along the link and the axes; coloured by a per-plate output, the plates are drawn instead (quads
+parallel to the chain plane between their stations on the two axes).  Axial positions (the ``x3`` of every drawn
+point: pins, plates, faces, shafts, bearings) can be exaggerated about a reference state:
+``x3 = x3_ref + axial_scale (x3 - x3_ref)``; in-plane positions are drawn as they are.
 """
 from __future__ import annotations
 
@@ -33,8 +33,8 @@ from cvtfem.elements.chain.sheave_contact import face_profile
 from cvtfem.errors import InputError
 from cvtfem.render.rotor import plotter
 
-#: Drawn radii as fractions of the sheaves' outer radius: shaft, pin tube.
-SHAFT_FRACTION, PIN_FRACTION = 0.12, 0.018
+#: Drawn radii as fractions of the sheaves' outer radius: shaft, pin tube, bearing (elastic shafts).
+SHAFT_FRACTION, PIN_FRACTION, BEARING_FRACTION = 0.12, 0.018, 0.2
 #: Half-width of a link's ribbon as a fraction of the pin's half-length (the plate pack inside the pin ends).
 PACK_FRACTION = 0.8
 #: Points drawn along each pin axis (a curve for the A family).
@@ -211,14 +211,26 @@ def shaft_lines(model, placement) -> tuple[np.ndarray, np.ndarray]:
     return tuple(out)
 
 
+def bearing_points(model, placement) -> np.ndarray | None:
+    """Centres (2 shafts, 2 bearings, 3), m, of the bearings of elastic shafts: their beam nodes as displaced by
+    ``placement = q_structure`` (the points of :func:`shaft_lines` there); None on rigid shafts (no bearings
+    modelled)."""
+    if not elastic(model):
+        return None
+    s, lines = model.structure, shaft_lines(model, placement)
+    nodes = (s.bearing_dofs[:, :, 0] - s.offset[:, None]) // 6
+    return np.stack([lines[k][nodes[k]] for k in range(2)])
+
+
 @dataclass(frozen=True)
 class ChainFrame:
     """What is drawn of the transmission at one state (m): the axes (N, PIN_POINTS, 3) of the pins (or pin halves)
     from the far end to the near end, the axes each link joins (n, 2), link ribbon corners (n, 4, 3) (first axis
     at ``-+PACK``, second at ``+-PACK``), the sheave positions (2 shafts, 2 sides) of :func:`sheave_positions`
     (rigid shafts; elastic: the faces' reference positions ``z_ref`` in their sheaves' frames), the face grids of
-    :func:`sheave_faces`, the shafts' axes of :func:`shaft_lines` and, for chains with plates, the plates' end
-    centres (P, 2, 3) and output slots of :func:`plate_stations`."""
+    :func:`sheave_faces`, the shafts' axes of :func:`shaft_lines`, for chains with plates the plates' end centres
+    (P, 2, 3) and output slots of :func:`plate_stations`, and on elastic shafts the bearings of
+    :func:`bearing_points`."""
 
     pin_axes: np.ndarray
     link_ends: np.ndarray
@@ -228,6 +240,7 @@ class ChainFrame:
     shafts: tuple
     plate_ends: np.ndarray | None = None
     plate_slots: np.ndarray | None = None
+    bearings: np.ndarray | None = None
 
 
 def sheave_reference(model, placement) -> np.ndarray:
@@ -250,8 +263,8 @@ def chain_frame(model, q_chain, placement, reference=None, axial_scale: float = 
     def points(q, place):
         plates = plate_stations(model, q)
         return (pin_axis_points(model, q, xi, place), sheave_faces(model, place), shaft_lines(model, place),
-                (None, None) if plates is None else plates[:2])
-    pts, faces, shafts, (plate_ends, slots) = points(q_chain, placement)
+                (None, None) if plates is None else plates[:2], bearing_points(model, place))
+    pts, faces, shafts, (plate_ends, slots), bearings = points(q_chain, placement)
     sheaves = sheave_reference(model, placement)
     if reference is not None and axial_scale != 1.0:
         ref = points(*reference)
@@ -264,13 +277,15 @@ def chain_frame(model, q_chain, placement, reference=None, axial_scale: float = 
             exaggerate(line, r_line)
         if plate_ends is not None:
             exaggerate(plate_ends, ref[3][0])
+        if bearings is not None:
+            exaggerate(bearings, ref[4])
         ref_sheaves = sheave_reference(model, reference[1])
         sheaves = ref_sheaves + axial_scale * (sheaves - ref_sheaves)
     pack = pts[:, PIN_POINTS:]
     a, b = link_axes(model).T
     corners = np.stack([pack[a, 0], pack[a, 1], pack[b, 1], pack[b, 0]], axis=1)
     return ChainFrame(pts[:, :PIN_POINTS], np.column_stack([a, b]), corners, sheaves, faces, shafts, plate_ends,
-                      slots)
+                      slots, bearings)
 
 
 def chain_state(model, x) -> tuple[np.ndarray, np.ndarray]:
@@ -359,8 +374,8 @@ def colour_values(model, name: str, values) -> tuple[np.ndarray, str]:
     ``"plate"`` (:attr:`ChainFrame.plate_slots` picks the drawn plates' values); per drawn axis (N,) with kind
     ``"pin"`` (a pin's value on both of A5's halves, A5's per-half values on their halves); per axis end (N, 2)
     (far, near) with kind ``"end"`` for an output per pin end and shaft, summed over the two shafts (an end touches
-    one shaft at a time; A2's two coupled halves' ends summed on their whole pin's end).  A symmetric chain's contact outputs (one end per pin, the mirror end implied) become per
-    pin."""
+    one shaft at a time; A2's two coupled halves' ends summed on their whole pin's end).  A symmetric chain's
+    contact outputs (one end per pin, the mirror end implied) become per pin."""
     spec = next(s for s in model.output_specs if s.name == name)
     kind = colour_kind(model, spec)
     v = np.asarray(values, float).reshape(-1)
@@ -438,6 +453,9 @@ def draw_frame(p, model, frame: ChainFrame, name: str, values, unit: str, clim=N
         line = frame.shafts[k]
         shaft = pv.lines_from_points(line).tube(radius=SHAFT_FRACTION * r_out, n_sides=48, capping=True)
         p.add_mesh(shaft, color="slategray", smooth_shading=True)
+        for centre in () if frame.bearings is None else frame.bearings[k]:
+            p.add_mesh(pv.Cylinder(center=centre, direction=(0, 0, 1), radius=BEARING_FRACTION * r_out,
+                                   height=0.15 * r_out, resolution=48), color="darkgoldenrod", smooth_shading=True)
     p.add_point_labels(np.column_stack([contact.centres, np.full(2, 0.5 * r_out)]), ["driving", "driven"],
                        font_size=14, text_color="black", shape_opacity=0.0, always_visible=True)
 

@@ -354,3 +354,20 @@ def test_a2_half_end_values_sum_on_the_whole_pin_ends():
     p, s = np.arange(n)[:, None], np.arange(2)[None, :]
     expected = sum(2 * (4 * p + 2 * h + s) * 2 + 1 for h in (0, 1))            # both halves, both shafts
     np.testing.assert_array_equal(v, expected)
+
+
+def test_bearings_are_drawn_where_their_forces_act():
+    """On elastic shafts each drawn bearing sits at its beam node as displaced: at rest the drawn displacement
+    times the bearings' stiffness is the force the structure's bearings carry (exact), and the node lies on its
+    shaft's drawn axis; rigid shafts draw none."""
+    model, q = _perturbed(chain_loop(load_scene("variant-e")), 9)
+    nc, s = model._idx[0], model.structure
+    drawn = tr.bearing_points(model, q[nc:])
+    rest = tr.bearing_points(model, np.zeros(s.n))
+    force = s.bearing_forces(q[nc:], np.zeros(s.n))                     # (2, 2, 3): K_b u + C_b 0
+    np.testing.assert_allclose(force, s.bearing_K * (drawn - rest), rtol=1e-9, atol=1e-9 * np.abs(force).max())
+    assert np.abs(force).max() > 1.0
+    lines = tr.shaft_lines(model, q[nc:])
+    for k in range(2):
+        assert all(np.any(np.all(lines[k] == b, axis=1)) for b in drawn[k])
+    assert tr.bearing_points(chain_loop(load_scene("chain-A5")), np.zeros(2)) is None
