@@ -34,14 +34,13 @@ class StoredRun:
     def model(self):
         """The transmission of the stored scene (:func:`~cvtfem.machines.cvt.chain_loop`); on elastic shafts with the
         faces' reference the run stored (no start solved)."""
-        from cvtfem.io.results import read_first_row
         from cvtfem.machines.chain_cvt_elastic import FACE_REFERENCE, with_face_reference
         from cvtfem.machines.cvt import chain_loop
 
-        model = chain_loop(self.scene)
-        if not self.scene.cvt.effects.shaft_elasticity:
-            return model
-        return with_face_reference(model, read_first_row(self.results.path, FACE_REFERENCE))
+        series = self.results.series                     # already read: the first row of each reference series
+        stored = all(name in series and len(series[name]) for name in FACE_REFERENCE)
+        return with_face_reference(chain_loop(self.scene),
+                                   {name: series[name][0] for name in FACE_REFERENCE} if stored else None)
 
     @classmethod
     def of(cls, results: Results, scene, where: str = "RESULTS") -> StoredRun:

@@ -215,9 +215,12 @@ def bearing_points(model, placement) -> np.ndarray | None:
     """Centres (2 shafts, 2 bearings, 3), m, of the bearings of elastic shafts: their beam nodes as displaced by
     ``placement = q_structure`` (the points of :func:`shaft_lines` there); None on rigid shafts (no bearings
     modelled)."""
-    if not elastic(model):
-        return None
-    s, lines = model.structure, shaft_lines(model, placement)
+    return None if not elastic(model) else _bearings_on(model, shaft_lines(model, placement))
+
+
+def _bearings_on(model, lines) -> np.ndarray:
+    """The bearing nodes' points (2, 2, 3) of the shafts' drawn axes ``lines`` (:func:`shaft_lines`)."""
+    s = model.structure
     nodes = (s.bearing_dofs[:, :, 0] - s.offset[:, None]) // 6
     return np.stack([lines[k][nodes[k]] for k in range(2)])
 
@@ -261,9 +264,9 @@ def chain_frame(model, q_chain, placement, reference=None, axial_scale: float = 
     xi = np.concatenate([np.linspace(-1.0, 1.0, PIN_POINTS), [-PACK_FRACTION, PACK_FRACTION]])
 
     def points(q, place):
-        plates = plate_stations(model, q)
-        return (pin_axis_points(model, q, xi, place), sheave_faces(model, place), shaft_lines(model, place),
-                (None, None) if plates is None else plates[:2], bearing_points(model, place))
+        plates, lines = plate_stations(model, q), shaft_lines(model, place)
+        return (pin_axis_points(model, q, xi, place), sheave_faces(model, place), lines,
+                (None, None) if plates is None else plates[:2], _bearings_on(model, lines) if elastic(model) else None)
     pts, faces, shafts, (plate_ends, slots), bearings = points(q_chain, placement)
     sheaves = sheave_reference(model, placement)
     if reference is not None and axial_scale != 1.0:
@@ -315,9 +318,16 @@ def chain_meshes(frame: ChainFrame):
     n, m, _ = frame.pin_axes.shape
     lines = np.column_stack([np.full(n, m), np.arange(n * m).reshape(n, m)]).ravel()
     axes = pv.PolyData(frame.pin_axes.reshape(-1, 3), lines=lines)
-    k = len(frame.link_corners)
-    faces = np.column_stack([np.full(k, 4), 4 * np.arange(k)[:, None] + np.arange(4)]).ravel()
-    return axes, pv.PolyData(frame.link_corners.reshape(-1, 3), faces=faces)
+    return axes, _quads(frame.link_corners)
+
+
+def _quads(corners):
+    """A pyvista PolyData of one quad cell per corner set ``corners`` (k, 4, 3)."""
+    import pyvista as pv
+
+    k = len(corners)
+    return pv.PolyData(corners.reshape(-1, 3), faces=np.column_stack([np.full(k, 4), 4 * np.arange(k)[:, None]
+                                                                      + np.arange(4)]).ravel())
 
 
 def plate_corners(frame: ChainFrame) -> np.ndarray:
@@ -331,12 +341,7 @@ def plate_corners(frame: ChainFrame) -> np.ndarray:
 
 def plate_mesh(frame: ChainFrame):
     """The plates of :func:`plate_corners` as one pyvista PolyData (a quad cell each)."""
-    import pyvista as pv
-
-    corners = plate_corners(frame)
-    k = len(corners)
-    return pv.PolyData(corners.reshape(-1, 3), faces=np.column_stack([np.full(k, 4), 4 * np.arange(k)[:, None]
-                                                                      + np.arange(4)]).ravel())
+    return _quads(plate_corners(frame))
 
 
 # ----- colours ---------------------------------------------------------------------------------------------
