@@ -18,15 +18,25 @@ method whose stage count follows the spectral radius of ``f_E`` alone, ``f_I`` t
   kinetic-energy balance over the stage), ``f_I`` at the step's start as ``F - f_E`` (one RHS call, shared with the
   dense output of the step before); the option ``explicit`` is not used;
 * ``imex-rk4-2``: the same with an explicit third stage of the ESDIRK (``f_I = F - f_E`` there: one RHS call instead
-  of a solve), two solves per step.
+  of a solve), two solves per step;
+* ``multirate-rk4``: no solve.  RK4 on the averaged rate ``f_eta`` of the multirate Runge-Kutta-Chebyshev idea
+  (Abdulle, Grote & Rosilho de Souza, Math. Comp. 2022): at each stage ``f_E`` plus the mean acceleration of the
+  stiff part over ``eta = 0.75 h``, found by integrating ``u' = a_E + f_I(u)`` (positions frozen, ``a_E`` the stage's
+  explicit accelerations held) with the damped first-order Chebyshev method (:func:`~cvtfem.integrate.stabilized.
+  rkc1_coefficients`), as many stages as the split's ``rate`` bound asks (the cheap stiff part is evaluated many
+  times, ``f_E`` four times a step); that mean force's work booked by ``hold``.  Order one; the stiff part's rate at
+  the middle node is shared by the two middle stages.
 
 Fixed steps only (no error estimate).  The friction solves count as ``nnewton`` (iterations) and ``nlu`` (one sparse
 LU each), timed in ``t_lu``.
 """
 from __future__ import annotations
 
+import numpy as np
+
 from cvtfem.errors import InputError
 from cvtfem.integrate.base import Attempt, Stepper
+from cvtfem.integrate.stabilized import RKC1_BETA_PER_S2, rkc1_coefficients
 from cvtfem.integrate.system import OdeSystem
 
 __all__ = ["StrangFriction"]
@@ -34,7 +44,7 @@ __all__ = ["StrangFriction"]
 #: The explicit methods a split step may use.
 EXPLICIT = ("dumka3", "rk4", "rock4", "dopri45")
 #: How a step combines the two parts (module docstring).
-SCHEMES = ("strang", "frozen", "frozen-mid", "imex-rk4", "imex-rk4-2")
+SCHEMES = ("strang", "frozen", "frozen-mid", "imex-rk4", "imex-rk4-2", "multirate-rk4")
 #: The implicit tableaus of the IMEX schemes (rows 2-4; the first stage explicit): nodes ``(0, 1/2, 1/2, 1)`` and
 #: weights ``(1, 2, 2, 1)/6`` as RK4's (so each pair has order 2), the last row the weights (stiffly accurate), the
 #: middle rows chosen for ``R(inf) = 0`` with ``|R| <= 1`` on the left half-plane; ``imex-rk4-2`` has an explicit
@@ -42,6 +52,10 @@ SCHEMES = ("strang", "frozen", "frozen-mid", "imex-rk4", "imex-rk4-2")
 IMEX_RK4_IMPLICIT = {"imex-rk4": ((0.0, 0.5), (0.25, -0.25, 0.5), (1 / 6, 1 / 3, 1 / 3, 1 / 6)),
                      "imex-rk4-2": ((0.1, 0.4), (0.1, 0.4, 0.0), (1 / 6, 1 / 3, 1 / 3, 1 / 6))}
 _RK4_EXPLICIT = ((0.5,), (0.0, 0.5), (0.0, 0.0, 1.0))
+#: multirate-rk4: the inner span over the step (the averaged rate's fast part lies in ``[-2 / eta, 0]``: RK4 is stable
+#: on it up to ``h = 2.78 / (2 / eta)``); power iterations per step for the stiff part's spectral radius (warm started
+#: from the step before; more at the first step) and the margin on it.
+ETA, POWER_ITERATIONS, FIRST_POWER_ITERATIONS, SAFETY = 0.75, 4, 30, 1.2
 
 
 class StrangFriction(Stepper):
@@ -71,8 +85,10 @@ class StrangFriction(Stepper):
             raise InputError("options", sorted(unknown), f"must be options of {explicit}: {sorted(cls.OPTIONS)}")
         if scheme not in SCHEMES:
             raise InputError("scheme", scheme, f"must be one of {SCHEMES}")
-        self.scheme, self._frozen = scheme, None
+        self.scheme, self._frozen, self._power = scheme, None, None
         split = self.split = system.split.variant(friction)
+        if scheme == "multirate-rk4" and split.rate is None:
+            raise InputError("scheme", scheme, "needs the split's `rate` (the stiff part's rate at frozen positions)")
         if scheme != "strang" and split.hold is None:
             raise InputError("scheme", scheme, "needs the split's `hold` (the work rate of the held forces)")
         if scheme == "strang":
@@ -116,7 +132,45 @@ class StrangFriction(Stepper):
         b = IMEX_RK4_IMPLICIT[self.scheme][-1]
         return x + h * sum(bi * (ke + ki) for bi, ke, ki in zip(b, KE, KI)), F0
 
+    def _averaged(self, t, x, h, first=False, reuse=False):
+        """The averaged rate ``f_eta(x)`` of ``multirate-rk4``: ``f_E(x)`` plus the split's held rate (:meth:`hold`) of
+        the stiff part's mean acceleration over ``eta``, ``(u(eta) - v) / eta - a_E``, where ``u' = a_E + rate(u)`` from
+        ``u(0) = v`` with the positions frozen (``a_E``: ``f_E(x)``'s velocity rows), by the damped first-order
+        Chebyshev method with as many stages as the rate's spectral radius asks.  ``first``: a new step (the radius is
+        estimated again); ``reuse``: the rate of the stage before (the same node)."""
+        split, st, n2 = self.split, self.stats, self.system.n2
+        fe = split.explicit(t, x)
+        st.add("nfev")
+        if not reuse:
+            with st.timer("t_lu"):
+                self._rate, bound = split.rate(x)
+                if first:
+                    its = POWER_ITERATIONS if self._power is not None else FIRST_POWER_ITERATIONS
+                    radius, self._power = bound(self._power, its)
+                    self._bound = SAFETY * radius
+        rate, eta = self._rate, ETA * h
+        s = max(2, int(np.ceil(np.sqrt(eta * self._bound / RKC1_BETA_PER_S2))))
+        st.add("nnewton", s)
+        mu, nu, mu_t = rkc1_coefficients(s)
+        a = np.zeros_like(x)
+        a[n2:2 * n2] = fe[n2:2 * n2]
+        y_prev, y = x, x + mu_t[1] * eta * (a + rate(x))
+        for j in range(2, s + 1):
+            y, y_prev = mu[j] * y + nu[j] * y_prev + mu_t[j] * eta * (a + rate(y)), y
+        return fe + split.hold(x, (y - x) / eta - a)
+
+    def _multirate_rk4(self, t, x, h):
+        """One step of ``multirate-rk4``: RK4 on the averaged rate (the middle stages share their stiff rate)."""
+        k1 = self._averaged(t, x, h, first=True)
+        k2 = self._averaged(t + h / 2, x + h / 2 * k1, h)
+        k3 = self._averaged(t + h / 2, x + h / 2 * k2, h, reuse=True)
+        k4 = self._averaged(t + h, x + h * k3, h)
+        return x + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+
     def attempt(self, t, x, h):
+        if self.scheme == "multirate-rk4":
+            self.stages = 4
+            return Attempt(t, x, h, self._multirate_rk4(t, x, h))
         if self.scheme in IMEX_RK4_IMPLICIT:
             y, F0 = self._imex_rk4(t, x, h)
             self.stages = 4

@@ -20,7 +20,8 @@ import numpy as np
 from cvtfem.errors import InputError
 from cvtfem.integrate.base import Attempt, StepFailure, Stepper, proportional_ratio
 
-__all__ = ["RKC", "rkc_coefficients", "rkc_stability_length", "spectral_radius"]
+__all__ = ["RKC", "rkc_coefficients", "rkc_stability_length", "spectral_radius", "rkc1_coefficients",
+           "RKC1_DAMPING", "RKC1_BETA_PER_S2"]
 
 EPS_DAMP = 2 / 13
 MAX_STAGES = 1000
@@ -60,6 +61,29 @@ def rkc_coefficients(s: int):
     c[2:] = dT[s] * ddT[2:] / (ddT[s] * dT[2:])
     c[1] = c[2] / dT[2]
     return mu, nu, mu_t, gam_t, c
+
+
+#: The damped first-order Chebyshev method (Hundsdorfer & Verwer, 2003, V.1): damping ``eps`` (``|R| <= 1 - eps``
+#: roughly on its interval), and a lower bound of its real stability length over ``s^2`` (``(2 - 4 eps / 3) s^2``).
+RKC1_DAMPING, RKC1_BETA_PER_S2 = 0.05, 1.9
+
+
+@lru_cache(maxsize=None)
+def rkc1_coefficients(s: int) -> tuple:
+    """``(mu, nu, mu_t)`` of the s-stage damped first-order Chebyshev method ``Y_1 = Y_0 + mu_t[1] h F(Y_0)``,
+    ``Y_j = mu[j] Y_{j-1} + nu[j] Y_{j-2} + mu_t[j] h F(Y_{j-1})`` (j = 2..s), ``R_s(z) = T_s(w0 + w1 z) / T_s(w0)``
+    with ``w0 = 1 + eps / s^2``, ``w1 = T_s(w0) / T_s'(w0)``."""
+    if s < 1:
+        raise InputError("stages", s, "must be at least 1")
+    w0 = 1 + RKC1_DAMPING / s ** 2
+    T, dT, _ = _chebyshev(s, w0)
+    w1 = T[s] / dT[s]
+    mu, nu, mu_t = np.zeros(s + 1), np.zeros(s + 1), np.zeros(s + 1)
+    mu_t[1] = w1 / w0
+    mu[2:] = 2 * w0 * T[1:s] / T[2:]
+    nu[2:] = -T[:s - 1] / T[2:]
+    mu_t[2:] = 2 * w1 * T[1:s] / T[2:]
+    return mu, nu, mu_t
 
 
 @lru_cache(maxsize=None)

@@ -33,6 +33,7 @@ class StiffSplit:
     solve: Callable[[float, np.ndarray, float], tuple]
     hold: Callable[[np.ndarray, np.ndarray], np.ndarray] | None = None
     variants: dict | None = None
+    rate: Callable[[np.ndarray], tuple] | None = None
 
     def variant(self, name: str | None) -> "StiffSplit":
         """This split (``name`` None) or its variant ``name``."""

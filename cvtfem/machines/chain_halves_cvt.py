@@ -38,6 +38,9 @@ from cvtfem.machines.chain_cvt import ChainCVT
 from cvtfem.machines.static_balance import lifted_newton
 from cvtfem.outputs import OutputSpec
 
+#: The steepest slope of each friction law over ``f0 / v0`` (its slope at zero slip).
+STEEPEST = {"linear-saturated": 1.0, "nonsmooth": 1.0, "tanh": 1.0, "arctan": 1.0, "smoothed": 1.5}
+
 #: Assumed half-pin and contact parameters (no source values; docs/chain.md "Parameters assumed"): half offset
 #: ``h_pin`` (m), rolling radii (m), rolling and hole penalties (N/m^2), hole contour, back face, its extent and
 #: the clearance (m), stopper stiffness (N/m) and play (m), turn of the section axes ``gamma_0`` (rad); the chain's
@@ -374,8 +377,8 @@ class ChainHalvesCVT(ChainACVT):
         :meth:`friction_solve_all`); None without friction in the halves or where :attr:`_splits` is False."""
         if not self._splits or self.family.chain.f0 == 0.0:
             return None
-        variants = {"all": (self.rhs_explicit_all, self.friction_solve_all, self.friction_hold)} if (
-            self._sheave_friction) else {}
+        variants = {"all": (self.rhs_explicit_all, self.friction_solve_all, self.friction_hold, None,
+                            self.friction_rate)} if self._sheave_friction else {}
         return self.rhs_explicit, self.friction_solve, self.friction_hold, variants
 
     @property
@@ -505,6 +508,39 @@ class ChainHalvesCVT(ChainACVT):
         out[n2:2 * n2] = v
         out[2 * n2 + self.control.size + 2] += W
         return out, its
+
+    def friction_rate(self, x) -> tuple:
+        """``(rate, bound)`` of all friction at the positions of ``x`` frozen: ``rate(v)`` gives the friction's
+        accelerations (n2,; m/s^2, rad/s^2) at the velocities ``v`` and the power they dissipate (W, >= 0);
+        ``bound(z, iterations)`` ``(radius, z)``: the spectral radius (1/s) of ``M^-1 S^T D S`` with every slip at its
+        law's steepest slope (at least that of ``d rate / d v``) by power iteration from the velocity vector ``z`` (None:
+        a seeded random one), and the last iterate."""
+        sets = self.friction_sets(x)
+        Mi = self._masses[1]
+        S = sp.vstack([s.S for s in sets], format="csr")
+        ST = S.T.tocsr()
+        rows = np.cumsum([0] + [s.S.shape[0] for s in sets])
+        steep = np.concatenate([np.repeat(s.c * s.f0 / s.v0 * STEEPEST[s.law], s.dim) for s in sets])
+
+        n2 = self.n2
+
+        def rate(y):
+            f = S @ y[n2:2 * n2]
+            f = np.concatenate([s.forces(f[a:b]) for s, a, b in zip(sets, rows[:-1], rows[1:])])
+            out = np.zeros(self.size)
+            out[n2:2 * n2] = -(Mi @ (ST @ f))
+            return out
+
+        def bound(z, iterations: int) -> tuple[float, np.ndarray]:
+            if z is None:
+                z = np.random.default_rng(1).standard_normal(n2)
+            lam = 0.0
+            for _ in range(iterations):
+                z = Mi @ (ST @ (steep * (S @ (z / np.linalg.norm(z)))))
+                lam = float(np.linalg.norm(z))
+            return lam, z
+
+        return rate, bound
 
     def friction_hold(self, x, d):
         """The rate at ``x`` of the friction forces ``M d_v`` held constant (``d_v``: ``d``'s velocity rows, m/s^2 and

@@ -70,3 +70,25 @@ def test_bisected_h_max_matches_observed_blow_up():
         return np.max(np.abs(res.y[:, -1])) if res.success else np.inf
     assert grow(0.97 * h) <= 1.0 + 1e-9
     assert grow(1.03 * h) > 10.0
+
+
+@pytest.mark.parametrize("s", [1, 2, 3, 7, 20, 60])
+def test_rkc1_recurrence_gives_the_damped_chebyshev_polynomial_and_its_interval(s):
+    """The stages of :func:`rkc1_coefficients` on ``y' = lambda y`` give ``R_s(z) = T_s(w0 + w1 z) / T_s(w0)``
+    (first order: ``R_s'(0) = 1``), bounded by one on ``[-1.9 s^2, 0]``, the interval multirate-rk4 counts on."""
+    from numpy.polynomial import chebyshev as C
+
+    from cvtfem.integrate.stabilized import RKC1_BETA_PER_S2, RKC1_DAMPING, rkc1_coefficients
+
+    mu, nu, mu_t = rkc1_coefficients(s)
+    z = np.linspace(-RKC1_BETA_PER_S2 * s * s, 0.0, 4001)
+    y_prev, y = np.ones_like(z), 1 + mu_t[1] * z
+    for j in range(2, s + 1):
+        y, y_prev = mu[j] * y + nu[j] * y_prev + mu_t[j] * z * y, y
+    w0 = 1 + RKC1_DAMPING / s ** 2
+    Ts = C.Chebyshev.basis(s)
+    w1 = Ts(w0) / Ts.deriv()(w0)
+    assert np.allclose(y, Ts(w0 + w1 * z) / Ts(w0), rtol=0, atol=1e-14 * s * s)   # the recurrence's round-off
+    assert np.abs(y).max() <= 1.0 + 1e-12
+    dz = 1e-6
+    assert (1 + mu_t[1] * dz if s == 1 else Ts(w0 + w1 * dz) / Ts(w0)) == pytest.approx(1 + dz, abs=1e-10)
