@@ -65,7 +65,7 @@ def rkc_coefficients(s: int):
 
 #: The damped first-order Chebyshev method (Hundsdorfer & Verwer, 2003, V.1): damping ``eps`` (``|R| <= 1 - eps``
 #: roughly on its interval), and a lower bound of its real stability length over ``s^2`` (``(2 - 4 eps / 3) s^2``).
-RKC1_DAMPING, RKC1_BETA_PER_S2 = 0.05, 1.9
+RKC1_DAMPING, RKC1_BETA_PER_S2 = 2.0, 0.96
 
 
 @lru_cache(maxsize=None)

@@ -29,7 +29,7 @@ from cvtfem.elements.chain import halves_kernel as HK
 from cvtfem.elements.chain import sheave_contact_kernel as SK
 from cvtfem.elements.chain.halves import ChainA5
 from cvtfem.elements.chain.halves_placement import half_centres, rolling_link_directions, rolling_spacing
-from cvtfem.elements.chain.implicit_friction import FrictionSet, friction_step
+from cvtfem.elements.chain.implicit_friction import FrictionRate, FrictionSet, friction_step
 from cvtfem.elements.chain.placement import Placement, place_on_path
 from cvtfem.elements.contact.friction import POTENTIAL_LAWS
 from cvtfem.errors import InputError, NumericalError
@@ -37,9 +37,6 @@ from cvtfem.machines.chain_a_cvt import PLATE_HEIGHT, PLATE_THICKNESS, POISSON, 
 from cvtfem.machines.chain_cvt import ChainCVT
 from cvtfem.machines.static_balance import lifted_newton
 from cvtfem.outputs import OutputSpec
-
-#: The steepest slope of each friction law over ``f0 / v0`` (its slope at zero slip).
-STEEPEST = {"linear-saturated": 1.0, "nonsmooth": 1.0, "tanh": 1.0, "arctan": 1.0, "smoothed": 1.5}
 
 #: Assumed half-pin and contact parameters (no source values; docs/chain.md "Parameters assumed"): half offset
 #: ``h_pin`` (m), rolling radii (m), rolling and hole penalties (N/m^2), hole contour, back face, its extent and
@@ -509,38 +506,17 @@ class ChainHalvesCVT(ChainACVT):
         out[2 * n2 + self.control.size + 2] += W
         return out, its
 
-    def friction_rate(self, x) -> tuple:
-        """``(rate, bound)`` of all friction at the positions of ``x`` frozen: ``rate(v)`` gives the friction's
-        accelerations (n2,; m/s^2, rad/s^2) at the velocities ``v`` and the power they dissipate (W, >= 0);
-        ``bound(z, iterations)`` ``(radius, z)``: the spectral radius (1/s) of ``M^-1 S^T D S`` with every slip at its
-        law's steepest slope (at least that of ``d rate / d v``) by power iteration from the velocity vector ``z`` (None:
-        a seeded random one), and the last iterate."""
-        sets = self.friction_sets(x)
-        Mi = self._masses[1]
-        S = sp.vstack([s.S for s in sets], format="csr")
-        ST = S.T.tocsr()
-        rows = np.cumsum([0] + [s.S.shape[0] for s in sets])
-        steep = np.concatenate([np.repeat(s.c * s.f0 / s.v0 * STEEPEST[s.law], s.dim) for s in sets])
+    def friction_rate(self, x) -> FrictionRate:
+        """All friction at the positions of ``x`` frozen (:meth:`friction_sets`) as the compiled rate of multirate-rk4:
+        its accelerations at given velocities on all velocities (chain, shafts or structure) and its stiffness bound
+        (:class:`~cvtfem.elements.chain.implicit_friction.FrictionRate`)."""
+        return FrictionRate(self._inverse_mass_arrays, self.friction_sets(x))
 
-        n2 = self.n2
-
-        def rate(y):
-            f = S @ y[n2:2 * n2]
-            f = np.concatenate([s.forces(f[a:b]) for s, a, b in zip(sets, rows[:-1], rows[1:])])
-            out = np.zeros(self.size)
-            out[n2:2 * n2] = -(Mi @ (ST @ f))
-            return out
-
-        def bound(z, iterations: int) -> tuple[float, np.ndarray]:
-            if z is None:
-                z = np.random.default_rng(1).standard_normal(n2)
-            lam = 0.0
-            for _ in range(iterations):
-                z = Mi @ (ST @ (steep * (S @ (z / np.linalg.norm(z)))))
-                lam = float(np.linalg.norm(z))
-            return lam, z
-
-        return rate, bound
+    @cached_property
+    def _inverse_mass_arrays(self) -> tuple:
+        """``M^-1`` of :attr:`_masses` as CSR arrays ``(indptr, indices, data)`` for the compiled friction rate."""
+        Mi = sp.csr_matrix(self._masses[1])
+        return Mi.indptr.astype(np.int64), Mi.indices.astype(np.int64), Mi.data.astype(float)
 
     def friction_hold(self, x, d):
         """The rate at ``x`` of the friction forces ``M d_v`` held constant (``d_v``: ``d``'s velocity rows, m/s^2 and

@@ -91,36 +91,48 @@ def test_friction_rate_is_the_split_friction_and_its_bound_holds(model):
     """``friction_rate`` (multirate-rk4's stiff part, positions frozen): its accelerations equal the compiled force
     passes' friction (``f - f_E`` of the variant ``"all"``) to round-off, and its bound, the power iteration with every
     slip at its law's steepest slope, is not below the spectral radius of its own velocity Jacobian (ARPACK on central
-    differences), nor far above it at the placed state where the slips stick."""
+    differences), nor far above it at the placed state where the slips stick; its compiled Chebyshev stages are the
+    same recurrence on the rate written in Python."""
     from scipy.sparse.linalg import LinearOperator, eigs
+
+    from cvtfem.integrate.stabilized import rkc1_coefficients
 
     m, x0 = model
     n2 = m.n2
     explicit = m.stiff_split[3]["all"][0]
     for x in _states(m, x0):
-        rate, bound = m.friction_rate(x)
-        f, fE, fI = m.rhs(0.0, x), explicit(0.0, x), rate(x)
-        assert np.array_equal(fI[:n2], np.zeros(n2)) and np.array_equal(fI[2 * n2:], np.zeros(m.size - 2 * n2))
-        assert np.abs(fI[n2:2 * n2] - (f - fE)[n2:2 * n2]).max() <= 1e-12 * np.abs(f).max()
-        radius, _ = bound(None, 300)
+        rate = m.friction_rate(x)
+        f, fE, fI = m.rhs(0.0, x), explicit(0.0, x), np.empty(n2)
+        rate(x[n2:2 * n2], fI)
+        assert np.abs(fI - (f - fE)[n2:2 * n2]).max() <= 1e-12 * np.abs(f).max()
+        radius, _ = rate.bound(None, 300)
         eps = 1e-7 * np.abs(x[n2:2 * n2]).max()
 
         def jv(w):
-            y1, y2 = x.copy(), x.copy()
-            y1[n2:2 * n2] += eps * w
-            y2[n2:2 * n2] -= eps * w
-            return (rate(y1) - rate(y2))[n2:2 * n2] / (2 * eps)
+            r1, r2 = np.empty(n2), np.empty(n2)
+            rate(x[n2:2 * n2] + eps * w, r1)
+            rate(x[n2:2 * n2] - eps * w, r2)
+            return (r1 - r2) / (2 * eps)
 
         lam = eigs(LinearOperator((n2, n2), matvec=jv), k=1, which="LM", v0=np.ones(n2),
                    return_eigenvectors=False)[0]
         assert abs(lam) <= radius * (1 + 1e-6) and abs(lam) >= 0.2 * radius, (lam, radius)
+        # the compiled Chebyshev stages = the same recurrence on the rate in Python
+        eta, mu, nu, mu_t = 1.5e-6, *rkc1_coefficients(12)
+        a, v, g = fE[n2:2 * n2], x[n2:2 * n2], np.empty(n2)
+        rate(v, g)
+        u_prev, u = v, v + mu_t[1] * eta * (a + g)
+        for j in range(2, 13):
+            rate(u, g)
+            u, u_prev = mu[j] * u + nu[j] * u_prev + mu_t[j] * eta * (a + g), u
+        assert np.abs(rate.advance(v, a, eta, (mu, nu, mu_t)) - u).max() <= 1e-12 * np.abs(u).max()
 
 
 def test_multirate_rk4_converges_to_a_fine_explicit_run(model):
     """From a running state off balance (its stiff modes ringing), multirate-rk4 at h = 1e-6, 5e-7, 2.5e-7 s against
     DUMKA3 at 5e-8 s over 4 us: the velocities' and the dissipated work's errors fall with the step at order 0.8 or
-    more at each halving (found 15.8, 4.3, 1.7 m/s of a change of 368 m/s, and 1.7e-2, 1.5e-3, 5e-4 of the work; imex-rk4
-    23, 11, 4 m/s), to within 1 % of the change at 2.5e-7 s."""
+    more at each halving (found 9.8, 3.1, 1.6 m/s of a change of 368 m/s, and 2.4e-2, 1.4e-3, 3.8e-4 of the work;
+    imex-rk4 23, 11, 4 m/s), to within 1 % of the change at 2.5e-7 s."""
     m, x0 = model
     x = _running(m, x0, 5)
     t, n2 = (0.0, 4e-6), m.n2
