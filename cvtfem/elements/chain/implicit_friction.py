@@ -301,32 +301,47 @@ def _plan(sets, n, Mi_in, border) -> _Plan:
 
 
 @njit(cache=True)
-def _rate(v, S, St, Mi, law, slips, r, Q, out):
-    """``out = -M^-1 S^T r(S v)``: the friction's accelerations at the velocities ``v``; ``law`` per contact its first
-    row, rows, ``c``, ``f0``, ``v0`` and law code (:data:`~cvtfem.elements.contact.kernels.LAW_CODES`)."""
+def _slip_forces(v, S, law, Q):
+    """``Q = S^T r(S v)`` (the friction forces on the velocities, with the sign of ``r``), row by row of ``S``: each
+    contact's slips, its law, and its rows scattered back at once."""
+    indptr, indices, data = S
     first, sizes, c, f0, v0, code = law
-    _csr_times(*S, v, slips)
+    s = np.zeros(3)
+    Q[:] = 0.0
     for k in range(sizes.shape[0]):
         f, d = first[k], sizes[k]
-        g = c[k] * _gain(_speed(slips, f, d), f0[k], v0[k], code[k], 0.1)
         for a in range(d):
-            r[f + a] = g * slips[f + a]
-    _csr_times(*St, r, Q)
+            acc = 0.0
+            for p in range(indptr[f + a], indptr[f + a + 1]):
+                acc += data[p] * v[indices[p]]
+            s[a] = acc
+        g = c[k] * _gain(_speed(s, 0, d), f0[k], v0[k], code[k], 0.1)
+        for a in range(d):
+            r = g * s[a]
+            for p in range(indptr[f + a], indptr[f + a + 1]):
+                Q[indices[p]] += r * data[p]
+
+
+@njit(cache=True)
+def _rate(v, S, Mi, law, Q, out):
+    """``out = -M^-1 S^T r(S v)``: the friction's accelerations at the velocities ``v``; ``law`` per contact its first
+    row, rows, ``c``, ``f0``, ``v0`` and law code (:data:`~cvtfem.elements.contact.kernels.LAW_CODES`)."""
+    _slip_forces(v, S, law, Q)
     _csr_times(*Mi, Q, out)
     for i in range(out.shape[0]):
         out[i] = -out[i]
 
 
 @njit(cache=True)
-def _chebyshev(v, a, eta, mu, nu, mu_t, S, St, Mi, law, slips, r, Q, g, u, u_prev, u_next):
+def _chebyshev(v, a, eta, mu, nu, mu_t, S, Mi, law, Q, g, u, u_prev, u_next):
     """``u(eta)`` of ``u' = a + rate(u)``, ``u(0) = v``, by the Chebyshev stages ``(mu, nu, mu_t)`` into ``u``."""
     n = v.shape[0]
-    _rate(v, S, St, Mi, law, slips, r, Q, g)
+    _rate(v, S, Mi, law, Q, g)
     for i in range(n):
         u_prev[i] = v[i]
         u[i] = v[i] + mu_t[1] * eta * (a[i] + g[i])
     for j in range(2, mu.shape[0]):
-        _rate(u, S, St, Mi, law, slips, r, Q, g)
+        _rate(u, S, Mi, law, Q, g)
         for i in range(n):
             u_next[i] = mu[j] * u[i] + nu[j] * u_prev[i] + mu_t[j] * eta * (a[i] + g[i])
         for i in range(n):
@@ -335,30 +350,19 @@ def _chebyshev(v, a, eta, mu, nu, mu_t, S, St, Mi, law, slips, r, Q, g, u, u_pre
 
 
 @njit(cache=True)
-def _power(z, iterations, S, St, Mi, steep, slips, r, Q):
-    """``iterations`` power iterations of ``M^-1 S^T diag(steep) S`` on ``z`` (in place); returns the last norm ratio."""
-    radius = 0.0
+def _power(z, iterations, S, Mi, law, Q):
+    """``iterations`` power iterations of ``M^-1 S^T D S`` on ``z`` (in place), ``D`` the slopes ``c f0 / v0`` of
+    ``law`` (the linear law, each contact's steepest slope factor folded into its ``c``), on slips kept far inside its
+    linear part; returns the last norm ratio."""
+    radius, small = 0.0, 1e-6 * law[4].min() if law[4].shape[0] else 1.0     # slips well inside the linear part
     for _ in range(iterations):
-        norm = np.sqrt(np.sum(z * z))
-        _csr_times(*S, z, slips)
-        for i in range(slips.shape[0]):
-            r[i] = steep[i] * slips[i] / norm
-        _csr_times(*St, r, Q)
+        norm = np.sqrt(np.sum(z * z)) / small
+        for i in range(z.shape[0]):
+            z[i] /= norm
+        _slip_forces(z, S, law, Q)
         _csr_times(*Mi, Q, z)
-        radius = np.sqrt(np.sum(z * z))
+        radius = np.sqrt(np.sum(z * z)) / small
     return radius
-
-
-def _stacked(sets: list[FrictionSet]) -> tuple:
-    """The CSR arrays (int64, int64, float) of the sets' slip rows stacked, and of their transpose."""
-    indptr = [np.zeros(1, np.int64)]
-    for f in sets:
-        indptr.append(f.S.indptr[1:].astype(np.int64) + indptr[-1][-1])
-    S = (np.concatenate(indptr), np.concatenate([f.S.indices for f in sets]).astype(np.int64),
-         np.concatenate([f.S.data for f in sets]).astype(float))
-    shape = (S[0].shape[0] - 1, sets[0].S.shape[1])
-    T = sp.csr_matrix((S[2], S[1], S[0]), shape=shape).tocsc()
-    return S, (T.indptr.astype(np.int64), T.indices.astype(np.int64), T.data)
 
 
 class FrictionRate:
@@ -369,35 +373,39 @@ class FrictionRate:
     def __init__(self, Mi: tuple, sets: list[FrictionSet]) -> None:
         counts = [len(f.c) for f in sets]
         sizes = np.repeat([f.dim for f in sets], counts).astype(np.int64)
+        first = np.concatenate([[0], np.cumsum(sizes)[:-1]]).astype(np.int64)
         c = np.concatenate([f.c for f in sets]).astype(float)
         f0, v0 = (np.repeat([float(getattr(f, k)) for f in sets], counts) for k in ("f0", "v0"))
-        self.law = (np.concatenate([[0], np.cumsum(sizes)[:-1]]).astype(np.int64), sizes, c, f0, v0,
-                    np.repeat([KERNEL_LAW_CODES[f.law] for f in sets], counts).astype(np.int64))
-        self.S, self.St = _stacked(sets)
+        self.law = (first, sizes, c, f0, v0, np.repeat([KERNEL_LAW_CODES[f.law] for f in sets], counts).astype(np.int64))
+        steep = c * np.repeat([STEEPEST[f.law] for f in sets], counts)      # the linear law at these slopes
+        self._steep = (first, sizes, steep, f0, v0, np.zeros(len(c), np.int64))
+        indptr = [np.zeros(1, np.int64)]
+        for f in sets:
+            indptr.append(f.S.indptr[1:].astype(np.int64) + indptr[-1][-1])
+        self.S = (np.concatenate(indptr), np.concatenate([f.S.indices for f in sets]).astype(np.int64),
+                  np.concatenate([f.S.data for f in sets]).astype(float))
         self.Mi = Mi
-        self._steep = np.repeat(c * f0 / v0 * np.repeat([STEEPEST[f.law] for f in sets], counts), sizes)
-        n = Mi[0].shape[0] - 1
-        self._work = (np.empty(sizes.sum()), np.empty(sizes.sum()), np.empty(n))
-        self._stages = tuple(np.empty(n) for _ in range(4))
+        self._stages = tuple(np.empty(Mi[0].shape[0] - 1) for _ in range(5))
 
     def __call__(self, v, out) -> None:
         """Write the accelerations at the velocities ``v`` (n,) into ``out`` (n,)."""
-        _rate(v, self.S, self.St, self.Mi, self.law, *self._work, out)
+        _rate(v, self.S, self.Mi, self.law, self._stages[0], out)
 
     def advance(self, v, a, eta: float, coefficients: tuple) -> np.ndarray:
         """``u(eta)`` (n,) of ``u' = a + rate(u)`` from ``u(0) = v`` by the s-stage Chebyshev method of ``coefficients``
         ``(mu, nu, mu_t)`` (:func:`~cvtfem.integrate.stabilized.rkc1_coefficients`), compiled (:func:`_chebyshev`)."""
-        g, u, u_prev, u_next = self._stages
-        _chebyshev(np.ascontiguousarray(v), np.ascontiguousarray(a), float(eta), *coefficients, self.S, self.St,
-                   self.Mi, self.law, *self._work, g, u, u_prev, u_next)
+        Q, g, u, u_prev, u_next = self._stages
+        _chebyshev(np.ascontiguousarray(v), np.ascontiguousarray(a), float(eta), *coefficients, self.S, self.Mi,
+                   self.law, Q, g, u, u_prev, u_next)
         return u.copy()
 
     def bound(self, z, iterations: int) -> tuple[float, np.ndarray]:
         """``(radius, z)``: the spectral radius (1/s) of ``M^-1 S^T D S`` with every slip at its law's steepest slope
         (:data:`STEEPEST`; at least that of the rate's velocity Jacobian) by power iteration from the velocities ``z``
         (None: a seeded random vector), and the last iterate."""
-        z = np.random.default_rng(1).standard_normal(self._work[2].shape[0]) if z is None else np.array(z, float)
-        return _power(z, iterations, self.S, self.St, self.Mi, self._steep, *self._work), z
+        n = self._stages[0].shape[0]
+        z = np.random.default_rng(1).standard_normal(n) if z is None else np.array(z, float)
+        return _power(z, iterations, self.S, self.Mi, self._steep, self._stages[0]), z
 
 
 def friction_step(M: sp.spmatrix, Mi: sp.spmatrix, sets: list[FrictionSet], v_star: np.ndarray, h: float,
