@@ -7,7 +7,7 @@
 #                                                  # w-4ms-dumka3, variant-b-4ms-smoothed, w-4ms-smoothed,
 #                                                  # imex-all-short, elastic-short: both faces,
 #                                                  # elastic-inclined-short, elastic-inclined-4ms,
-#                                                  # elastic-inclined-4ms-smoothed)
+#                                                  # elastic-inclined-4ms-smoothed, multirate)
 # Each test-2 run prints its speed-up table (Table 2.4 style); the logs go next to the results.
 set -euo pipefail
 cd "$(dirname "$0")/../.."
@@ -277,3 +277,28 @@ for law in linear-saturated smoothed; do
       | tee "$out/variant-e-$tag-step-floor.log"
   fi
 done
+# Session 18: multirate-rk4 (all friction integrated by damped Chebyshev stages at frozen positions inside RK4, no
+# solve) beside the RK4 baseline and DUMKA3 on the short window and over [1, 5] ms of (e) as the presets build it (the
+# caches of elastic-inclined-short and elastic-inclined-4ms: their references and starts), and at the settled
+# stationary regime (stationary_rows.py on the newest checkpoint of a stationary run: a copy of it is read).
+if [[ $part == all || $part == multirate ]]; then
+  mr() { local cache=$1 tag=$2 window=$3 ref=$4; shift 4
+    nice "$cvtfem" study accuracy-cost studies/accuracy-cost/scenes/variant-e-elastic-inclined-chapter2-linear-saturated.toml \
+      --skip-spectrum --window "$window" --sample 1e-6 --repeats 1 --reference "DOP853:$ref" --check "dopri78:$ref" \
+      --cache "$cache" --png "$out/variant-e-$tag.png" --csv "$out/variant-e-$tag.csv" --json "$out/variant-e-$tag.json" "$@"; }
+  for w in "out/studies/e-elastic-inclined-short-cache multirate-short 2e-4:4e-4 1e-7" \
+           "out/studies/e-elastic-inclined-4ms-cache multirate-4ms 1e-3:5e-3 1e-6"; do
+    set -- $w
+    mr "$@" --fixed rk4 --steps 5e-8 --adaptive ""
+    mr "$@" --fixed dumka3 --steps 2e-6,3e-6 --adaptive dumka3 --rtols 3e-2
+    mr "$@" --fixed strang-friction:scheme=multirate-rk4:friction=all --steps 2e-6,1.5e-6 --adaptive ""
+    mr "$@" --from-cache | tee "$out/variant-e-$2.log"
+    uptime | tee -a "$out/variant-e-$2.log"
+  done
+  run=out/studies/chain/variant_e_inclined.h5      # `cvtfem run studies/chain/variant-e-stationary-inclined.toml` (0.3 s)
+  if [[ -f $run ]]; then
+    cp "$run" out/studies/chain/variant_e_inclined_rows.h5
+    nice .venv/bin/python studies/accuracy-cost/stationary_rows.py out/studies/chain/variant_e_inclined_rows.h5 \
+      | tee "$out/variant-e-stationary-rows.log"
+  fi
+fi
