@@ -29,6 +29,7 @@ from pathlib import Path
 import numpy as np
 
 from cvtfem.errors import InputError
+from cvtfem.integrate.stabilized import rkc1_coefficients
 from cvtfem.problems.base import Problem
 
 __all__ = ["PinForceProblem", "cvt_problem", "pin_force_problem", "output_of", "output_component", "window_error",
@@ -91,7 +92,7 @@ class PinForceProblem(Problem):
 
     def warm_up(self) -> None:
         """One right-hand side, one Jacobian where the loop has one, each stiff split's explicit part and friction
-        solve (over 1 ns), and the output at the start state: the one-off costs of a process (loading or compiling the
+        solve (over 1 ns) and its friction rate where it has one, and the output at the start state: the one-off costs of a process (loading or compiling the
         kernels) then stay out of the first timed run (session 13: a first imex row took 53 s CPU of which ~45 s were
         the friction kernels' compilation)."""
         kw = Problem.solve_kwargs(self)
@@ -101,9 +102,14 @@ class PinForceProblem(Problem):
             kw["jac"](t0, y0)
         split = getattr(self.loop, "stiff_split", None)
         if split is not None:
-            for explicit, solve, *_ in (split[:3], *(split[3] or {}).values()):
+            n2 = self.loop.n2
+            for explicit, solve, *rest in (split[:3], *(split[3] or {}).values()):
                 explicit(t0, y0)
                 solve(t0, y0, 1e-9)
+                if len(rest) > 2 and rest[2] is not None:                   # multirate-rk4's friction rate
+                    rate = rest[2](y0)
+                    rate.bound(None, 1)
+                    rate.advance(y0[n2:2 * n2], y0[n2:2 * n2], 1e-9, rkc1_coefficients(2))
         self.pin_forces(np.asarray(self.y0)[:, None], [t0])
 
     def error(self, res) -> float:

@@ -21,11 +21,12 @@ method whose stage count follows the spectral radius of ``f_E`` alone, ``f_I`` t
   of a solve), two solves per step;
 * ``multirate-rk4``: no solve.  RK4 on the averaged rate ``f_eta`` of the multirate Runge-Kutta-Chebyshev idea
   (Abdulle, Grote & Rosilho de Souza, Math. Comp. 2022): at each stage ``f_E`` plus the mean acceleration of the
-  stiff part over ``eta = 0.75 h``, found by integrating ``u' = a_E + f_I(u)`` (positions frozen, ``a_E`` the stage's
-  explicit accelerations held) with the damped first-order Chebyshev method (:func:`~cvtfem.integrate.stabilized.
-  rkc1_coefficients`), as many stages as the split's ``rate`` bound asks (the cheap stiff part is evaluated many
-  times, ``f_E`` four times a step); that mean force's work booked by ``hold``.  Order one; the stiff part's rate at
-  the middle node is shared by the two middle stages.
+  stiff part over ``eta = 2/3 h``, found by integrating ``u' = a_E + f_I(u)`` (positions frozen, ``a_E`` the stage's
+  explicit accelerations held) with the strongly damped first-order Chebyshev method
+  (:func:`~cvtfem.integrate.stabilized.rkc1_coefficients`), as many stages as the split's ``rate`` bound asks (the
+  cheap stiff part is evaluated many times, ``f_E`` four times a step); that mean force's work booked by ``hold``.
+  Order one; the stiff part's rate at the middle node is shared by the two middle stages, the end node's carried to
+  the next step's first.
 
 Fixed steps only (no error estimate).  The friction solves count as ``nnewton`` (iterations) and ``nlu`` (one sparse
 LU each), timed in ``t_lu``.
@@ -52,9 +53,10 @@ SCHEMES = ("strang", "frozen", "frozen-mid", "imex-rk4", "imex-rk4-2", "multirat
 IMEX_RK4_IMPLICIT = {"imex-rk4": ((0.0, 0.5), (0.25, -0.25, 0.5), (1 / 6, 1 / 3, 1 / 3, 1 / 6)),
                      "imex-rk4-2": ((0.1, 0.4), (0.1, 0.4, 0.0), (1 / 6, 1 / 3, 1 / 3, 1 / 6))}
 _RK4_EXPLICIT = ((0.5,), (0.0, 0.5), (0.0, 0.0, 1.0))
-#: multirate-rk4: the inner span over the step (the averaged rate's fast part lies in ``[-2 / eta, 0]``: RK4 is stable
-#: on it up to ``h = 2.78 / (2 / eta)``); power iterations per step for the stiff part's spectral radius (warm started
-#: from the step before; more at the first step) and the margin on it.
+#: multirate-rk4: the inner span over the step (the inner method leaves a stiff mode at ``|R| <= 0.29``, so its mean
+#: rate lies in ``[-1.29 / eta, -0.71 / eta]``: at ``eta = 2/3 h`` RK4 sees it at ``h lambda`` in ``[-1.9, -1.1]`` and
+#: damps it to 0.28-0.34 a step); power iterations per step for the stiff part's spectral radius (warm started from
+#: the step before; more at the first step) and the margin on it.
 ETA, POWER_ITERATIONS, FIRST_POWER_ITERATIONS, SAFETY = 2 / 3, 4, 30, 1.2
 
 
@@ -133,11 +135,11 @@ class StrangFriction(Stepper):
         return x + h * sum(bi * (ke + ki) for bi, ke, ki in zip(b, KE, KI)), F0
 
     def _averaged(self, t, x, h, first=False, reuse=False):
-        """The averaged rate ``f_eta(x)`` of ``multirate-rk4``: ``f_E(x)`` plus the split's held rate (:meth:`hold`) of
-        the stiff part's mean acceleration over ``eta``, ``(u(eta) - v) / eta - a_E``, where ``u' = a_E + rate(u)`` from
-        ``u(0) = v`` (the velocities) with the positions frozen (``a_E``: ``f_E(x)``'s velocity rows), by the damped first-order
-        Chebyshev method with as many stages as the rate's spectral radius asks.  ``first``: a new step (the radius is
-        estimated again); ``reuse``: the rate of the stage before (the same node)."""
+        """The averaged rate ``f_eta(x)`` of ``multirate-rk4``: ``f_E(x)`` plus the split's held rate (:meth:`hold`)
+        of the stiff part's mean acceleration over ``eta``, ``(u(eta) - v) / eta - a_E``, where ``u' = a_E + rate(u)``
+        from ``u(0) = v`` (the velocities) with the positions frozen (``a_E``: ``f_E(x)``'s velocity rows), by the
+        damped first-order Chebyshev method with as many stages as the rate's spectral radius asks.  ``first``: a new
+        step (the radius is estimated again); ``reuse``: the rate of the stage before (the same node)."""
         split, st, n2 = self.split, self.stats, self.system.n2
         fe = split.explicit(t, x)
         st.add("nfev")

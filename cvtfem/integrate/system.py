@@ -24,16 +24,19 @@ class StiffSplit:
     ``explicit(t, x)`` is ``f_E``; ``solve(t, x, h)`` returns ``(x_new, iterations)``: backward Euler of
     ``x' = f_I(t, x)`` over ``h`` from ``x`` (``x_new = x + h f_I(t, x_new)``, each iteration one sparse LU);
     ``hold(x, d)`` (optional) the rate at ``x`` of the stiff part's forces held constant: ``d``'s velocity rows (the
-    forces' accelerations) and the work rows at the power those forces deliver at ``x``.  ``variants`` (optional)
-    other splits of the same system by name, each as such a tuple ``(explicit, solve[, hold])`` (A5: ``"all"``, all
-    friction in the stiff part); :meth:`variant` picks one.
+    forces' accelerations) and the work rows at the power those forces deliver at ``x``.  ``rate(x)`` (optional) the
+    stiff part with the positions of ``x`` frozen, for multirate-rk4: an object with ``advance(v, a, eta,
+    coefficients)`` (``u(eta)`` of ``u' = a + f_I(u)`` from the velocities ``v`` by the given Chebyshev stages) and
+    ``bound(z, iterations)`` (a spectral radius of ``f_I``'s velocity Jacobian, at least, and the power iterate).
+    ``variants`` (optional) other splits of the same system by name, each as such a tuple ``(explicit, solve[, hold,
+    None, rate])`` (A5: ``"all"``, all friction in the stiff part); :meth:`variant` picks one.
     """
 
     explicit: Callable[[float, np.ndarray], np.ndarray]
     solve: Callable[[float, np.ndarray, float], tuple]
     hold: Callable[[np.ndarray, np.ndarray], np.ndarray] | None = None
     variants: dict | None = None
-    rate: Callable[[np.ndarray], tuple] | None = None
+    rate: Callable[[np.ndarray], object] | None = None
 
     def variant(self, name: str | None) -> "StiffSplit":
         """This split (``name`` None) or its variant ``name``."""

@@ -35,7 +35,8 @@ def test_slip_map_gives_the_kernels_friction(model):  # noqa: F811
 
 def test_explicit_plus_all_friction_equals_the_rhs(model):  # noqa: F811
     m, x0 = model
-    assert m.stiff_split[3] == {"all": (m.rhs_explicit_all, m.friction_solve_all, m.friction_hold)}
+    assert m.stiff_split[3] == {"all": (m.rhs_explicit_all, m.friction_solve_all, m.friction_hold, None,
+                                        m.friction_rate)}
     for x in _states(m, x0):
         f, fE, fI = m.rhs(0.0, x), m.rhs_explicit_all(0.0, x), friction_rate(m, x)
         iphi = m.n2 + m._idx[1]

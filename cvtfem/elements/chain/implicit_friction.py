@@ -354,7 +354,7 @@ def _power(z, iterations, S, Mi, law, Q):
     """``iterations`` power iterations of ``M^-1 S^T D S`` on ``z`` (in place), ``D`` the slopes ``c f0 / v0`` of
     ``law`` (the linear law, each contact's steepest slope factor folded into its ``c``), on slips kept far inside its
     linear part; returns the last norm ratio."""
-    radius, small = 0.0, 1e-6 * law[4].min() if law[4].shape[0] else 1.0     # slips well inside the linear part
+    radius, small = 0.0, 1e-6 * law[4].min()                             # slips well inside the linear part
     for _ in range(iterations):
         norm = np.sqrt(np.sum(z * z)) / small
         for i in range(z.shape[0]):
@@ -376,7 +376,8 @@ class FrictionRate:
         first = np.concatenate([[0], np.cumsum(sizes)[:-1]]).astype(np.int64)
         c = np.concatenate([f.c for f in sets]).astype(float)
         f0, v0 = (np.repeat([float(getattr(f, k)) for f in sets], counts) for k in ("f0", "v0"))
-        self.law = (first, sizes, c, f0, v0, np.repeat([KERNEL_LAW_CODES[f.law] for f in sets], counts).astype(np.int64))
+        codes = np.repeat([KERNEL_LAW_CODES[f.law] for f in sets], counts).astype(np.int64)
+        self.law = (first, sizes, c, f0, v0, codes)
         steep = c * np.repeat([STEEPEST[f.law] for f in sets], counts)      # the linear law at these slopes
         self._steep = (first, sizes, steep, f0, v0, np.zeros(len(c), np.int64))
         indptr = [np.zeros(1, np.int64)]
@@ -405,6 +406,8 @@ class FrictionRate:
         (None: a seeded random vector), and the last iterate."""
         n = self._stages[0].shape[0]
         z = np.random.default_rng(1).standard_normal(n) if z is None else np.array(z, float)
+        if not self.law[1].shape[0]:                                    # no contact in touch: nothing stiff
+            return 0.0, z
         return _power(z, iterations, self.S, self.Mi, self._steep, self._stages[0]), z
 
 
