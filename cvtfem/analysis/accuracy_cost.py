@@ -32,8 +32,8 @@ from cvtfem.errors import InputError
 from cvtfem.integrate.stabilized import rkc1_coefficients
 from cvtfem.problems.base import Problem
 
-__all__ = ["PinForceProblem", "cvt_problem", "pin_force_problem", "output_of", "output_component", "window_error",
-           "jacobian_spectrum", "spectrum_with_v0", "local_error_table", "block_scales", "baseline_time", "state_at",
+__all__ = ["PinForceProblem", "chain_output", "energy_balance", "cvt_problem", "pin_force_problem", "output_of",
+           "output_component", "window_error", "jacobian_spectrum", "spectrum_with_v0", "local_error_table", "block_scales", "baseline_time", "state_at",
            "StudyCache", "ACCEPT_E", "ACCEPT_ENERGY", "operation_costs", "rhs_equivalents", "distinct_labels"]
 
 #: The source's acceptance of test 2.
@@ -83,18 +83,13 @@ class PinForceProblem(Problem):
         t = self.t_eval if t is None else t
         if self.output == BAND_FORCE:
             return np.array([self.loop.outputs(ti, yi)[BAND_FORCE] for ti, yi in zip(t, np.asarray(y).T)])
-        fam = self.loop.family
-        out = []
-        for yi in np.asarray(y).T:
-            q, v = self.loop.split(yi)[:2]
-            out.append(fam.outputs(q[:fam.size], v[:fam.size])[self.output])
-        return np.array(out)
+        return chain_output(self.loop, y, self.output)
 
     def warm_up(self) -> None:
         """One right-hand side, one Jacobian where the loop has one, each stiff split's explicit part and friction
-        solve (over 1 ns) and its friction rate where it has one, and the output at the start state: the one-off costs of a process (loading or compiling the
-        kernels) then stay out of the first timed run (session 13: a first imex row took 53 s CPU of which ~45 s were
-        the friction kernels' compilation)."""
+        solve (over 1 ns) and its friction rate where it has one, and the output at the start state: the one-off costs
+        of a process (loading or compiling the kernels) then stay out of the first timed run (session 13: a first imex
+        row took 53 s CPU of which ~45 s were the friction kernels' compilation)."""
         kw = Problem.solve_kwargs(self)
         t0, y0 = kw["t_span"][0], kw["y0"]
         kw["fun"](t0, y0)
@@ -125,12 +120,29 @@ class PinForceProblem(Problem):
         loop = self.loop
         if not res.success or not (hasattr(loop, "energy") and hasattr(loop, "split")):
             return {}
-        x0, x1 = np.asarray(self.y0, float), np.asarray(res.y[:, -1], float)
-        dW = np.asarray(loop.split(x1)[3]) - np.asarray(loop.split(x0)[3])
-        if len(dW) != 4 or not dW[0] > 0:
-            return {}
-        residual = dW[0] - dW[1] - dW[2] + dW[3] - (loop.energy(x1) - loop.energy(x0))
-        return {"energy_residual": float(residual / dW[0]), "dissipated": float(dW[2])}
+        return energy_balance(loop, self.y0, res.y[:, -1])
+
+
+def chain_output(loop, y, name: str) -> np.ndarray:
+    """The chain family's output ``name`` (samples, components) at the states ``y`` (n, samples) of the transmission
+    ``loop``, from the family's own outputs (the contacts and loops of the full output set are not needed)."""
+    fam, out = loop.family, []
+    for yi in np.asarray(y).T:
+        q, v = loop.split(yi)[:2]
+        out.append(fam.outputs(q[:fam.size], v[:fam.size])[name])
+    return np.array(out)
+
+
+def energy_balance(loop, x0, x1) -> dict:
+    """``energy_residual`` = (input work - output work - dissipated work + clamping work - change of the stored
+    energy) / input work from state ``x0`` to ``x1`` of the transmission ``loop``, and ``dissipated`` (friction and
+    damping, J); empty where the loop has no four work integrals or no input work."""
+    x0, x1 = np.asarray(x0, float), np.asarray(x1, float)
+    dW = np.asarray(loop.split(x1)[3]) - np.asarray(loop.split(x0)[3])
+    if len(dW) != 4 or not dW[0] > 0:
+        return {}
+    residual = dW[0] - dW[1] - dW[2] + dW[3] - (loop.energy(x1) - loop.energy(x0))
+    return {"energy_residual": float(residual / dW[0]), "dissipated": float(dW[2])}
 
 
 #: Packages whose code decides a run's result: the model (its start state and the references) ...

@@ -17,6 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
+from cvtfem.analysis.accuracy_cost import chain_output, energy_balance
 from cvtfem.analysis.timing import machine
 from cvtfem.integrate import solve
 from cvtfem.io.results import read_checkpoint, read_first_row, read_scene_toml
@@ -24,26 +25,12 @@ from cvtfem.machines.chain_cvt_elastic import FACE_REFERENCE, with_face_referenc
 from cvtfem.machines.cvt import chain_loop
 from cvtfem.scene.loader import _parse, scene_from_dict
 
+HALVES = "chain.pin_half_axial_force"
 MULTIRATE = dict(method="strang-friction", adaptive=False, scheme="multirate-rk4", friction="all")
 ROWS = [("DUMKA3 adaptive rtol 3e-2 (the preset)", dict(method="dumka3", rtol=3e-2, atol=3e-5)),
         ("multirate-rk4, 2e-6 s", dict(MULTIRATE, h=2e-6)),
         ("multirate-rk4, 1.5e-6 s", dict(MULTIRATE, h=1.5e-6)),
         ("multirate-rk4, 1e-6 s", dict(MULTIRATE, h=1e-6))]
-
-
-def halves(loop, y) -> np.ndarray:
-    """The pin halves' axial forces (samples, halves), N."""
-    fam, out = loop.family, []
-    for yi in np.asarray(y).T:
-        q, v = loop.split(yi)[:2]
-        out.append(fam.outputs(q[:fam.size], v[:fam.size])["chain.pin_half_axial_force"])
-    return np.array(out)
-
-
-def residual(loop, x0, x1) -> float:
-    """(input - output - dissipated + clamping work - change of stored energy) / input work over the span."""
-    dW = np.asarray(loop.split(x1)[3]) - np.asarray(loop.split(x0)[3])
-    return float((dW[0] - dW[1] - dW[2] + dW[3] - (loop.energy(x1) - loop.energy(x0))) / dW[0])
 
 
 def main() -> None:
@@ -65,7 +52,8 @@ def main() -> None:
     if ref_file.exists():
         P = np.load(ref_file)
     else:
-        P = halves(loop, solve(loop, (t, t + args.span), x, method="dumka3", rtol=1e-3, atol=1e-6, t_eval=ts).y)
+        P = chain_output(loop, solve(loop, (t, t + args.span), x, method="dumka3", rtol=1e-3, atol=1e-6,
+                                     t_eval=ts).y, HALVES)
         np.save(ref_file, P)
     print("| method | E (all halves) | energy residual | CPU s per simulated ms | RHS calls | inner stages |")
     print("|---|---|---|---|---|---|")
@@ -73,8 +61,9 @@ def main() -> None:
         c0 = time.process_time()
         r = solve(loop, (t, t + args.span), x, t_eval=ts, split=loop.stiff_split, **kw)
         cpu = time.process_time() - c0
-        E = np.abs(halves(loop, r.y) - P).max() / np.abs(P).max()
-        print(f"| {label} | {E:.2e} | {residual(loop, x, r.y[:, -1]):.1e} | {cpu / (args.span * 1e3):.2f} | "
+        E = np.abs(chain_output(loop, r.y, HALVES) - P).max() / np.abs(P).max()
+        residual = energy_balance(loop, x, r.y[:, -1])["energy_residual"]
+        print(f"| {label} | {E:.2e} | {residual:.1e} | {cpu / (args.span * 1e3):.2f} | "
               f"{r.stats['nfev']} | {r.stats['nnewton']} |", flush=True)
 
 
