@@ -72,7 +72,9 @@ class SimpleController:
         """Unlimited step-size factor for an attempt with error ``err_norm`` (> 0)."""
         return SAFETY * err_norm ** (-1.0 / (q + 1))
 
-    def propose(self, h: float, err_norm: float, q: int) -> tuple[bool, float]:
+    def propose(self, h: float, err_norm: float, q: int, cap: float = np.inf) -> tuple[bool, float]:
+        """``(accept, next h)`` after an attempt of size ``h`` with error norm ``err_norm``; ``cap``: the method's
+        largest step, s (the quantum does not hold a step that could grow to it)."""
         if not np.isfinite(err_norm):
             self.rejected = True
             return False, h * MIN_FACTOR
@@ -80,7 +82,7 @@ class SimpleController:
         factor = MAX_FACTOR if err_norm == 0.0 else self.factor(err_norm, q)
         if accept:   # an accepted step near the tolerance shrinks h (else the next one is rejected)
             factor = min(1.0 if self.rejected else MAX_FACTOR, max(MIN_FACTOR, factor))
-            if 1.0 <= factor < self.quantum:
+            if 1.0 <= factor < self.quantum and h * factor < cap:
                 factor = 1.0
             self.accepted(err_norm)
         else:
@@ -130,8 +132,8 @@ class PredictiveController(SimpleController):
     h_acc: float = 0.0
     err_acc: float = 1.0
 
-    def propose(self, h: float, err_norm: float, q: int) -> tuple[bool, float]:
-        accept, h_new = super().propose(h, err_norm, q)
+    def propose(self, h: float, err_norm: float, q: int, cap: float = np.inf) -> tuple[bool, float]:
+        accept, h_new = super().propose(h, err_norm, q, cap)
         if accept:
             if self.h_acc > 0.0:
                 trend = SAFETY * (h / self.h_acc) * (self.err_acc / max(err_norm, 1e-10) ** 2) ** (1.0 / (q + 1))

@@ -26,10 +26,16 @@ method whose stage count follows the spectral radius of ``f_E`` alone, ``f_I`` t
   (:func:`~cvtfem.integrate.stabilized.rkc1_coefficients`), as many stages as the split's ``rate`` bound asks (the
   cheap stiff part is evaluated many times, ``f_E`` four times a step); that mean force's work booked by ``hold``.
   Order one; the stiff part's rate at the middle node is shared by the two middle stages, the end node's carried to
-  the next step's first.
+  the next step's first.  The only scheme with an error estimate (adaptive runs): the embedded third-order solution
+  with RK4's weights on the first three stages and ``1/6`` on the averaged rate at the step's end (``k5``, first
+  same as last: it is the next step's first stage while ``h`` stays), taken on ``f_E`` alone:
+  ``err = h/6 (f_E(y4) - f_E(x1))``.  It measures RK4's truncation on the frictionless dynamics; the averaging's
+  error is ``O(eta)`` and the averaged friction modes sit near ``h lambda = -1.5`` at every step by construction, so
+  an estimate of them would shrink ``h`` without gain.  The option ``max_step`` (s) caps the steps (the study's step,
+  docs/accuracy-cost.md).
 
-Fixed steps only (no error estimate).  The friction solves count as ``nnewton`` (iterations) and ``nlu`` (one sparse
-LU each), timed in ``t_lu``.
+The other schemes take fixed steps only.  The friction solves count as ``nnewton`` (iterations) and ``nlu`` (one
+sparse LU each), timed in ``t_lu``; multirate-rk4 counts its Chebyshev stages as ``nnewton``.
 """
 from __future__ import annotations
 
@@ -58,27 +64,31 @@ _RK4_EXPLICIT = ((0.5,), (0.0, 0.5), (0.0, 0.0, 1.0))
 #: damps it to 0.28-0.34 a step); power iterations per step for the stiff part's spectral radius (warm started from
 #: the step before; more at the first step) and the margin on it.
 ETA, POWER_ITERATIONS, FIRST_POWER_ITERATIONS, SAFETY = 2 / 3, 4, 30, 1.2
+#: multirate-rk4 run adaptive keeps ``h`` unless the controller asks 1.2x or more (the last stage stays the next
+#: step's first, whose averaging span follows ``h``).
+MULTIRATE_STEP_QUANTUM = 1.2
 
 
 class StrangFriction(Stepper):
     """``explicit`` (a registered explicit method, default DUMKA3, with its options ``stages``, ``spectral_radius``,
     ``rho_every``) on ``f_E``, the system's own backward Euler on ``f_I``, combined by ``scheme`` (:data:`SCHEMES`);
     ``friction`` names a variant of the system's split (A5: ``"all"``, the pin-sheave friction in ``f_I`` too;
-    default the split itself, the halves' friction)."""
+    default the split itself, the halves' friction); ``max_step`` (s): the largest step of an adaptive
+    ``multirate-rk4`` run."""
 
     name, order = "strang-friction", 1
     #: Runs only on a system with a :class:`~cvtfem.integrate.system.StiffSplit` (generic method loops skip it).
     needs_split = True
-    OPTIONS = frozenset({"explicit", "scheme", "friction", "stages", "spectral_radius", "rho_every"})
+    OPTIONS = frozenset({"explicit", "scheme", "friction", "max_step", "stages", "spectral_radius", "rho_every"})
 
     def __init__(self, system: OdeSystem, stats=None, explicit: str = "dumka3", scheme: str = "strang",
-                 friction: str | None = None, **options) -> None:
+                 friction: str | None = None, max_step: float = np.inf, **options) -> None:
         super().__init__(system, stats)
         from cvtfem.integrate.methods import METHODS
 
         if system.split is None:
-            raise InputError("method", self.name, "needs a system with a stiff split (StiffSplit): the A5 chain on "
-                                                  "rigid shafts with internal friction (variants (e), (zh)) has one")
+            raise InputError("method", self.name, "needs a system with a stiff split (StiffSplit): the A5 chain with "
+                                                  "internal friction (variants (e), (zh)) has one")
         if explicit not in EXPLICIT:
             raise InputError("explicit", explicit, f"must be one of {EXPLICIT}")
         cls = METHODS[explicit]
@@ -87,7 +97,14 @@ class StrangFriction(Stepper):
             raise InputError("options", sorted(unknown), f"must be options of {explicit}: {sorted(cls.OPTIONS)}")
         if scheme not in SCHEMES:
             raise InputError("scheme", scheme, f"must be one of {SCHEMES}")
-        self.scheme, self._frozen, self._power, self._end = scheme, None, None, None
+        if isinstance(max_step, bool) or not (isinstance(max_step, (int, float)) and max_step > 0):
+            raise InputError("max_step", max_step, "must be a step > 0, s")
+        if scheme != "multirate-rk4" and np.isfinite(max_step):
+            raise InputError("max_step", max_step, "is taken by scheme=multirate-rk4 alone (the others have fixed "
+                                                   "steps)")
+        self.scheme, self._frozen, self._power, self._end, self._last = scheme, None, None, None, None
+        if scheme == "multirate-rk4":
+            self.error_order, self.STEP_QUANTUM, self._h_max = 3, MULTIRATE_STEP_QUANTUM, float(max_step)
         split = self.split = system.split.variant(friction)
         if scheme == "multirate-rk4" and split.rate is None:
             raise InputError("scheme", scheme, "needs the split's `rate` (the stiff part's rate at frozen positions)")
@@ -158,28 +175,48 @@ class StrangFriction(Stepper):
         u = rate.advance(v, a, eta, rkc1_coefficients(s))
         d = np.zeros_like(x)
         d[n2:2 * n2] = (u - v) / eta - a
+        self._fe = fe
         return fe + split.hold(x, d)
 
-    def _multirate_rk4(self, t, x, h):
-        """One step of ``multirate-rk4``: RK4 on the averaged rate (the middle stages share their stiff rate)."""
-        n2 = self.system.n2
-        end, self._end = self._end, None
+    def _near_end(self, t, x, h) -> bool:
+        """The stiff rate of the last node (:attr:`_end`) serves ``x`` at ``t``: the same time and positions within
+        ``h`` times the largest speed (the friction set of the same contacts)."""
+        n2, end = self.system.n2, self._end
         near = (end is not None and end[0] == t
                 and np.abs(x[:n2] - end[1]).max() <= h * np.abs(x[n2:2 * n2]).max())
         if near:
             self._rate = end[2]
-        k1 = self._averaged(t, x, h, first=True, reuse=near)
+        return near
+
+    def _multirate_rk4(self, t, x, h):
+        """One step of ``multirate-rk4``: RK4 on the averaged rate (the middle stages share their stiff rate), and
+        with ``need_error`` the error estimate from the averaged rate at the end (kept as the next first stage)."""
+        n2, last = self.system.n2, self._last
+        if last is not None and last[0] == t and last[1] == h and np.array_equal(last[2], x):
+            k1 = last[3]
+        else:
+            k1 = self._averaged(t, x, h, first=True, reuse=self._near_end(t, x, h))
+        self._end = self._last = None
         k2 = self._averaged(t + h / 2, x + h / 2 * k1, h)
         k3 = self._averaged(t + h / 2, x + h / 2 * k2, h, reuse=True)
         y4 = x + h * k3
         k4 = self._averaged(t + h, y4, h)
-        self._end = (t + h, y4[:n2], self._rate)
-        return x + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+        fe4, self._end = self._fe, (t + h, y4[:n2], self._rate)
+        x1 = x + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+        if not self.need_error:
+            return x1, None
+        k5 = self._averaged(t + h, x1, h, first=True, reuse=self._near_end(t + h, x1, h))
+        self._end, self._last = (t + h, x1[:n2], self._rate), (t + h, h, x1, k5)
+        return x1, h / 6 * (fe4 - self._fe)
+
+    def max_step(self) -> float:
+        return self._h_max if self.scheme == "multirate-rk4" else np.inf
 
     def attempt(self, t, x, h):
         if self.scheme == "multirate-rk4":
             self.stages = 4
-            return Attempt(t, x, h, self._multirate_rk4(t, x, h))
+            x1, err = self._multirate_rk4(t, x, h)
+            return Attempt(t, x, h, x1, err=err)
         if self.scheme in IMEX_RK4_IMPLICIT:
             y, F0 = self._imex_rk4(t, x, h)
             self.stages = 4

@@ -132,7 +132,7 @@ class NativeEngine:
                 return self._candidate(att), None
             if failure is None:
                 err = error_norm(att.err, x, att.x1, self.rtol, self.atol)
-                accept, h_new = self.ctrl.propose(h_try, err, stepper.error_order)
+                accept, h_new = self.ctrl.propose(h_try, err, stepper.error_order, stepper.max_step())
             else:
                 accept, h_new = False, 0.25 * h_try
                 self.ctrl.rejected = True

@@ -7,7 +7,7 @@
 #                                                  # w-4ms-dumka3, variant-b-4ms-smoothed, w-4ms-smoothed,
 #                                                  # imex-all-short, elastic-short: both faces,
 #                                                  # elastic-inclined-short, elastic-inclined-4ms,
-#                                                  # elastic-inclined-4ms-smoothed, multirate)
+#                                                  # elastic-inclined-4ms-smoothed, multirate, adaptive)
 # Each test-2 run prints its speed-up table (Table 2.4 style); the logs go next to the results.
 set -euo pipefail
 cd "$(dirname "$0")/../.."
@@ -301,4 +301,19 @@ if [[ $part == all || $part == multirate ]]; then
     nice .venv/bin/python studies/accuracy-cost/stationary_rows.py out/studies/chain/variant_e_inclined_rows.h5 \
       | tee "$out/variant-e-stationary-rows.log"
   fi
+fi
+# Session 19: multirate-rk4 adaptive below its 1.5e-6 s cap (the default of variant-e since then) beside the same
+# method at the fixed cap, the former default (DUMKA3 adaptive, rtol 3e-2) and the RK4 baseline over [1, 5] ms of (e)
+# as the presets build it (the elastic-inclined-4ms cache: its references and start).
+if [[ $part == all || $part == adaptive ]]; then
+  ad() { nice "$cvtfem" study accuracy-cost studies/accuracy-cost/scenes/variant-e-elastic-inclined-chapter2-linear-saturated.toml \
+      --skip-spectrum --window 1e-3:5e-3 --sample 1e-6 --repeats 1 --reference DOP853:1e-6 --check dopri78:1e-6 \
+      --cache out/studies/e-elastic-inclined-4ms-cache --png "$out/variant-e-adaptive-4ms.png" \
+      --csv "$out/variant-e-adaptive-4ms.csv" --json "$out/variant-e-adaptive-4ms.json" "$@"; }
+  ad --fixed rk4 --steps 5e-8 --adaptive ""
+  ad --fixed "" --adaptive dumka3 --rtols 3e-2
+  ad --fixed strang-friction:scheme=multirate-rk4:friction=all --steps 1.5e-6 --adaptive ""
+  ad --fixed "" --adaptive strang-friction:scheme=multirate-rk4:friction=all:max_step=1.5e-6 --rtols 1e-2,3e-3,1e-3
+  ad --from-cache | tee "$out/variant-e-adaptive-4ms.log"
+  uptime | tee -a "$out/variant-e-adaptive-4ms.log"
 fi

@@ -6,7 +6,7 @@ span (residual over the input work) and the CPU time (process time of the solve 
     OPENBLAS_NUM_THREADS=1 .venv/bin/python studies/accuracy-cost/stationary_rows.py RESULTS.h5 [--span 1e-3]
     # RESULTS.h5: a run of studies/chain/variant-e-stationary-inclined.toml (a copy: the file is only read)
 
-The reference is kept beside the file (``RESULTS.h5.reference-<t>-<span>.npy``).  docs/accuracy-cost.md, session 18.
+The reference is kept beside the file (``RESULTS.h5.reference-<t>-<span>.npy``).  docs/accuracy-cost.md, sessions 18-19.
 """
 from __future__ import annotations
 
@@ -27,10 +27,14 @@ from cvtfem.scene.loader import _parse, scene_from_dict
 
 HALVES = "chain.pin_half_axial_force"
 MULTIRATE = dict(method="strang-friction", adaptive=False, scheme="multirate-rk4", friction="all")
-ROWS = [("DUMKA3 adaptive rtol 3e-2 (the preset)", dict(method="dumka3", rtol=3e-2, atol=3e-5)),
+ROWS = [("DUMKA3 adaptive rtol 3e-2 (the preset to session 18)", dict(method="dumka3", rtol=3e-2, atol=3e-5)),
         ("multirate-rk4, 2e-6 s", dict(MULTIRATE, h=2e-6)),
         ("multirate-rk4, 1.5e-6 s", dict(MULTIRATE, h=1.5e-6)),
-        ("multirate-rk4, 1e-6 s", dict(MULTIRATE, h=1e-6))]
+        ("multirate-rk4, 1e-6 s", dict(MULTIRATE, h=1e-6)),
+        ("multirate-rk4 adaptive rtol 3e-3, steps <= 1.5e-6 s (the preset since session 19)",
+         dict(MULTIRATE, adaptive=True, max_step=1.5e-6, rtol=3e-3, atol=3e-6)),
+        ("multirate-rk4 adaptive rtol 1e-2, steps <= 1.5e-6 s",
+         dict(MULTIRATE, adaptive=True, max_step=1.5e-6, rtol=1e-2, atol=1e-5))]
 
 
 def main() -> None:
@@ -55,15 +59,15 @@ def main() -> None:
         P = chain_output(loop, solve(loop, (t, t + args.span), x, method="dumka3", rtol=1e-3, atol=1e-6,
                                      t_eval=ts).y, HALVES)
         np.save(ref_file, P)
-    print("| method | E (all halves) | energy residual | CPU s per simulated ms | RHS calls | inner stages |")
-    print("|---|---|---|---|---|---|")
+    print("| method | E (all halves) | energy residual | CPU s per simulated ms | steps | RHS calls | inner stages |")
+    print("|---|---|---|---|---|---|---|")
     for label, kw in ROWS:
         c0 = time.process_time()
         r = solve(loop, (t, t + args.span), x, t_eval=ts, split=loop.stiff_split, **kw)
         cpu = time.process_time() - c0
         E = np.abs(chain_output(loop, r.y, HALVES) - P).max() / np.abs(P).max()
         residual = energy_balance(loop, x, r.y[:, -1])["energy_residual"]
-        print(f"| {label} | {E:.2e} | {residual:.1e} | {cpu / (args.span * 1e3):.2f} | "
+        print(f"| {label} | {E:.2e} | {residual:.1e} | {cpu / (args.span * 1e3):.2f} | {r.stats['nsteps']} | "
               f"{r.stats['nfev']} | {r.stats['nnewton']} |", flush=True)
 
 

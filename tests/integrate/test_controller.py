@@ -5,7 +5,8 @@ import pytest
 
 from cvtfem.errors import InputError
 from cvtfem.integrate import solve
-from cvtfem.integrate.controller import MAX_FACTOR, PIController, SimpleController, make_controller, step_floor
+from cvtfem.integrate.controller import (MAX_FACTOR, SAFETY, PIController, SimpleController, make_controller,
+                                         step_floor)
 from cvtfem.problems import heat1d, van_der_pol_stiff
 
 
@@ -69,6 +70,16 @@ def test_accepted_step_near_tolerance_shrinks_h():
     slowly growing error does not make every other step a rejection."""
     ok, h = SimpleController().propose(1.0, 0.9, 3)
     assert ok and h == pytest.approx(0.9 * 0.9 ** -0.25)
+
+
+def test_the_quantum_holds_h_except_up_to_the_methods_cap():
+    """A proposed growth below the quantum keeps h (the LU or first stage stays valid), unless the grown step would
+    reach the method's largest step: then h grows, so a run cannot stay stuck just below its cap."""
+    err = (SAFETY / 1.1) ** 4                           # factor 1.1 for q = 3
+    ctrl = SimpleController(quantum=1.2)
+    assert ctrl.propose(1.0, err, 3) == (True, 1.0)
+    ok, h = ctrl.propose(1.0, err, 3, cap=1.05)
+    assert ok and h == pytest.approx(1.1)
 
 
 def test_predictive_controller_on_van_der_pol_transients():

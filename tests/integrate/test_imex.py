@@ -145,6 +145,26 @@ def test_multirate_converges_with_order_one_and_stays_accurate_at_long_steps(ref
     assert 0.8 < order < 1.6, order
 
 
+def test_adaptive_multirate_error_falls_with_the_tolerance(reference):
+    """The embedded third-order estimate on the frictionless rate steers the steps: the error at the end does not grow
+    with a tighter rtol from 1e-2 to 1e-6 and falls 50x or more over that range (found 2.0e-2, 7.3e-3, 7.0e-3, 9.4e-4,
+    2.2e-4: the averaging's O(eta) error, which the estimate does not see, keeps it above rtol and flat between 1e-3
+    and 1e-4, where the spring's steps barely change)."""
+    errs = [np.abs(solve(SYSTEM, (0.0, 0.5), X0, method="strang-friction", scheme="multirate-rk4", rtol=rtol,
+                         atol=1e-2 * rtol).y[:2, -1] - reference[:2]).max() for rtol in 10.0 ** -np.arange(2, 7)]
+    assert np.all(np.diff(errs) <= 0.05 * np.array(errs[:-1])) and errs[-1] < min(errs[0] / 50, 3e-4), errs
+
+
+def test_adaptive_multirate_at_its_cap_is_the_fixed_step_run():
+    """A tolerance no step exceeds keeps every step at ``max_step``; the end stage is then the next step's first,
+    computed as the fixed-step run computes it: the same states bitwise."""
+    fixed = solve(SYSTEM, (0.0, 0.5), X0, method="strang-friction", scheme="multirate-rk4", h=1e-3)
+    capped = solve(SYSTEM, (0.0, 0.5), X0, method="strang-friction", scheme="multirate-rk4", h=1e-3, adaptive=True,
+                   rtol=0.5, atol=1.0, max_step=1e-3)
+    assert len(capped.t) == len(fixed.t) == 501 and capped.stats["nreject"] == 0
+    np.testing.assert_array_equal(capped.y, fixed.y)
+
+
 def test_multirate_energy_balance_closes():
     """The friction's mean force over each stage's ``eta`` is booked at the power it delivers at the stage (the split's
     ``hold``): the balance stays RK4's."""
@@ -163,3 +183,9 @@ def test_bad_input():
         solve(no_hold, (0.0, 0.01), X0, method="strang-friction", h=1e-3, scheme="frozen")
     with pytest.raises(InputError, match="rate"):
         solve(no_hold, (0.0, 0.01), X0, method="strang-friction", h=1e-3, scheme="multirate-rk4")
+    for bad in ({"scheme": "multirate-rk4", "max_step": 0.0}, {"scheme": "multirate-rk4", "max_step": "1e-3s"},
+                {"scheme": "frozen", "max_step": 1e-3}):
+        with pytest.raises(InputError, match="max_step"):
+            solve(SYSTEM, (0.0, 0.01), X0, method="strang-friction", h=1e-3, **bad)
+    with pytest.raises(InputError, match="no error estimate"):
+        solve(SYSTEM, (0.0, 0.01), X0, method="strang-friction", scheme="imex-rk4")

@@ -368,9 +368,9 @@ def test_cvtfem_run_variant_e(cli, tmp_path):
     continuation, and then the elastic solve from it (chain and structure together: 1.1e-3 of F2 after 5972
     evaluations for this chain, so "off balance"; the uniform chain's converges, test below), every output is finite,
     the input speed stays at 3500 rpm and the work integrals close the energy balance to 1e-5 of the input work.
-    The flat face (theta = 0): the preset's rtol 3e-2 was chosen on it (balance 5.2e-6 over these 2 us).  With the
-    presets' inclined face the same run closes to 5.6e-5 (rtol 1e-2: 1.3e-5; 185 / 247 RHS calls, session 13), an open
-    point for the accuracy-cost study of (e), not for this test."""
+    The flat face (theta = 0): the former preset solver (DUMKA3, rtol 3e-2) was chosen on it (balance 5.2e-6 over
+    these 2 us); the preset's multirate-rk4 since session 19 closes it to 4.5e-6 at its rtol 3e-3 (1.2e-5 at 1e-2,
+    which is why the preset takes 3e-3)."""
     import json
 
     import h5py
