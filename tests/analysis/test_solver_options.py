@@ -55,7 +55,7 @@ def test_parse_options_converts_numbers_and_booleans():
 
 @pytest.mark.slow
 @pytest.mark.timeout(900)
-@pytest.mark.parametrize("scheme, bound", [("imex-rk4", 1e-5), ("multirate-rk4", 1e-4)])
+@pytest.mark.parametrize("scheme, bound", [("imex-rk4", 1e-5), ("multirate-rk4", 1e-4), ("preset", 1e-4)])
 def test_a_run_with_strang_friction_options_resumes(tmp_path, scheme, bound):
     """Variant (e) on rigid shafts with all friction split off (``strang-friction``, ``scheme``, ``friction=all``, the
     options through the scene): the checkpoint layout is built with the run's split and options, and a run killed at
@@ -64,13 +64,16 @@ def test_a_run_with_strang_friction_options_resumes(tmp_path, scheme, bound):
     a checkpoint does not keep, and stops at slip changes below ``ChainHalvesCVT.FRICTION_TOL`` v0 (its chord-step end:
     within 1e-5, 3e-7 before the chord step of session 15); multirate-rk4 restarts its stiffness bound's power iteration
     and builds the first stage's friction set from the positions instead of carrying the last step's (found 2.1e-5, the
-    friction power)."""
+    friction power).  ``preset``: the preset's own solver, multirate-rk4 adaptive below its cap (session 19), which
+    also restarts its first stage (the last step's end rate is not kept) and continues from the checkpoint's step
+    size and controller memory."""
     from cvtfem.analysis.run import resume_run
     from cvtfem.io.results import read_results
 
+    solver = {} if scheme == "preset" else {"solver": {"method": "strang-friction",
+                                                      "options": [f"scheme={scheme}", "friction=all"], "h": 2e-6}}
     scene = load_scene("variant-e,regime-chapter2,chain-uniform", {
-        "cvt": {"effects": {"shaft_elasticity": False}},
-        "solver": {"method": "strang-friction", "options": [f"scheme={scheme}", "friction=all"], "h": 2e-6},
+        "cvt": {"effects": {"shaft_elasticity": False}}, **solver,
         "output": {"step": 1e-5, "checkpoint_interval": 2e-5}})
     run_scene(scene, until=6e-5, results=tmp_path / "full.h5", show_progress=False)
     run_scene(scene, until=3e-5, results=tmp_path / "part.h5", show_progress=False)
