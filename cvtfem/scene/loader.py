@@ -2,7 +2,8 @@
 
 A scene may start from a preset (``preset = "NAME"``), or from a preset combined with parts such as a
 regime (``preset = ["chain-S2", "regime-A"]``, merged in order), and override keys: tables merge key by
-key, arrays of tables are replaced whole.
+key, arrays of tables are replaced whole.  ``solver.options`` belong to ``solver.method``: a layer that names
+another method without options of its own drops the options below it.
 """
 from __future__ import annotations
 
@@ -73,14 +74,24 @@ def _drop_none(value: Any) -> Any:
 
 
 def merge(base: Mapping[str, Any], override: Mapping[str, Any]) -> dict[str, Any]:
-    """Deep-merge ``override`` into ``base``: tables merge, everything else replaces."""
+    """Deep-merge ``override`` into ``base``: tables merge, everything else replaces (the ``solver`` table's
+    options go with its method: :func:`_solver_below`)."""
     out = dict(base)
     for key, value in override.items():
         if isinstance(value, Mapping) and isinstance(out.get(key), Mapping):
-            out[key] = merge(out[key], value)
+            out[key] = merge(_solver_below(out[key], value) if key == "solver" else out[key], value)
         else:
             out[key] = value
     return out
+
+
+def _solver_below(below: Mapping[str, Any], over: Mapping[str, Any]) -> Mapping[str, Any]:
+    """The ``solver`` table ``below`` as the layer ``over`` builds on: without its ``options`` where ``over`` names
+    another method and no options (a preset's method options, e.g. strang-friction's scheme, are refused by another
+    method)."""
+    if "method" in over and over["method"] != below.get("method") and "options" not in over:
+        return {k: v for k, v in below.items() if k != "options"}
+    return below
 
 
 def preset_names() -> list[str]:

@@ -72,6 +72,20 @@ def test_preset_override_merges_tables():
     assert scene.cvt.chain.n_pins == 84
 
 
+def test_a_layer_naming_another_method_drops_the_method_options_below_it(tmp_path):
+    """variant-e's solver options (strang-friction's scheme) do not reach a scene that names another method, in a file
+    or through ``replace``; the same method keeps them, and options given with the new method are that method's."""
+    e = load_scene("variant-e")
+    assert e.solver.method == "strang-friction" and "scheme=multirate-rk4" in e.solver.options
+    radau = tmp_path / "radau.toml"
+    radau.write_text('preset = ["variant-e", "regime-stationary"]\n[solver]\nmethod = "Radau"\n')
+    assert load_scene(radau).solver.options == ()
+    assert e.replace({"solver": {"method": "dumka3"}}).solver.options == ()
+    assert e.replace({"solver": {"method": "strang-friction", "rtol": 1e-2}}).solver.options == e.solver.options
+    own = e.replace({"solver": {"method": "gbs", "options": ["stages=2"]}})
+    assert own.solver.options == ("stages=2",)
+
+
 def test_scene_is_immutable():
     scene = load_scene("reference_cvt")
     with pytest.raises(AttributeError):
