@@ -43,9 +43,7 @@ class StiffSplit:
         if name is None:
             return self
         if name not in (self.variants or {}):
-            raise InputError("friction", name, f"must be one of the split's variants {sorted(self.variants or {})} "
-                                               "(A5's 'all' needs the compiled refined contact H2 with pin-sheave "
-                                               "friction: variant (e))")
+            raise InputError("friction", name, f"must be one of the split's variants {sorted(self.variants or {})}")
         return StiffSplit(*self.variants[name])
 
 
