@@ -50,9 +50,13 @@ def test_run_and_solve_give_the_same_bits(tmp_path, method):
 
 
 def test_terminal_event_ends_the_run_at_the_crossing(tmp_path):
-    """ratio falling through 2.3 during a ratio change: the run ends there, at the time a tight `solve()`
-    finds to 1e-9 relative (Radau rtol 1e-9 against 1e-11: 2.4e-10 measured), with the same time bit for bit
-    as `solve()` at the run's own settings; the results file records the event and ends on it."""
+    """ratio falling through 2.3 during a ratio change: the run ends there, with the same time bit for bit
+    as `solve()` at the run's own settings, and a tight `solve()` (rtol 1e-11) puts the ratio at that time
+    2.3 to within the run's rtol 1e-9; the results file records the event and ends on it.
+
+    The crossing is slow (d ratio/dt = -1.14 1/s at t = 0.107 s), so the time itself is only fixed to about
+    2.3 rtol / 1.14 = 2e-9 s (19 rtol relative): measured 4.6e-11 s on OpenBLAS's Haswell kernels and
+    4.9e-10 s on Sandybridge, that is 0.02 and 0.24 of the bound on the ratio."""
     scene = _scene("Radau", 1e-9, 1e-11)
     summary = run_scene(scene, until=0.2, results=tmp_path / "r.h5", show_progress=False)
     res = read_results(tmp_path / "r.h5")
@@ -64,8 +68,12 @@ def test_terminal_event_ends_the_run_at_the_crossing(tmp_path):
         assert np.array_equal(f["event.0.times"][()], [t_event]) and f["event.0.times"].attrs["unit"] == "s"
     _, same = _solve(scene, 0.2)
     assert same.status == 1 and same.t_events[0][0] == t_event
-    _, tight = _solve(_scene("Radau", 1e-11, 1e-13), 0.2)
-    assert abs(t_event - tight.t_events[0][0]) < 1e-9 * t_event
+    before = t_event - np.array([1e-4, 5e-5])  # s, both before either crossing
+    run, tight = _solve(_scene("Radau", 1e-11, 1e-13), 0.2, t_eval=before)
+    ratio = [float(np.ravel(run.loop.outputs(t, x)["ratio"])[0]) for t, x in zip(tight.t, tight.y.T)]
+    slope = (ratio[1] - ratio[0]) / (before[1] - before[0])  # 1/s
+    assert tight.status == 1 and -1.2 < slope < -1.0
+    assert abs(slope * (t_event - tight.t_events[0][0])) < 1e-9 * 2.3
 
 
 def test_run_interrupted_before_the_event_resumes_bitwise(tmp_path):
