@@ -39,6 +39,18 @@ def plate_energy(delta, eps, c, c1, c2, h):
     return 0.5 * c * t ** 2 + 0.5 * (c1 * (z[..., 0] ** 2 + z[..., 1] ** 2) + 2 * c2 * z[..., 0] * z[..., 1])
 
 
+def energy_rounding(delta, eps, c, c1, c2, h):
+    """Bound on the rounding error of :func:`plate_energy` at delta, J: 2 ulp of every term's first-order
+    sensitivity to the rounding of t and z = psi - delta (z cancels when delta ~ psi) and of the sum."""
+    psi, Delta = eps[..., :2], eps[..., 2]
+    t = np.maximum(Delta + h / 2 * np.abs(delta).sum(-1), 0.0)
+    z = psi - delta
+    Cz = np.stack([c1 * z[..., 0] + c2 * z[..., 1], c2 * z[..., 0] + c1 * z[..., 1]], -1)
+    terms = 0.5 * c * t ** 2 + 0.5 * (c1 * (z ** 2).sum(-1) + 2 * np.abs(c2 * z[..., 0] * z[..., 1]))
+    return 2 * np.finfo(float).eps * (c * t * (np.abs(Delta) + h / 2 * np.abs(delta).sum(-1))
+                                      + (np.abs(Cz) * (np.abs(psi) + np.abs(delta))).sum(-1) + terms)
+
+
 def table_states(eps, c, c1, c2, h):
     """Existence conditions of the spec table (section 4.3) as written there: bool (n, 10)."""
     psi1, psi2, Delta = eps.T
@@ -153,14 +165,19 @@ def run_oracle(cases, n):
         dmax = max(dmax, np.abs(d - st.delta[k]).max() / s)
         E = plate_energy(d, eps[k], c[k], c1[k], c2[k], h[k])
         excess = max(excess, (E - st.energy[k]) / (c1[k] * s * s))
-        assert E >= st.energy[k] * (1 - 1e-12)           # the closed form is never beaten
+        # the closed form is never beaten beyond the rounding of the two energies (the oracle's delta moves
+        # with the BLAS kernel: on all cases the worst came to 0.58 of half this bound, on Sandybridge)
+        d0 = st.delta[k]
+        law = c[k], c1[k], c2[k], h[k]
+        bound = energy_rounding(d, eps[k], *law) + energy_rounding(d0, eps[k], *law)
+        assert E >= plate_energy(d0, eps[k], *law) - bound
     return agree, dmax, excess
 
 
 # The oracle stops on a relative energy decrease of 1e-16: its minimiser is then accurate to about
 # sqrt(1e-16 * condition) ~ 1e-7 of the strain scale (conditions up to ~200 here), so delta is compared to
-# 1e-6 of the scale.  Its energy never falls below the closed form's (asserted in run_oracle); how far above
-# it stops is the solver's business and is only printed.
+# 1e-6 of the scale.  Its energy never falls below the closed form's beyond rounding (asserted in run_oracle); how
+# far above it stops is the solver's business and is only printed.
 def test_scipy_oracle_agrees_on_a_subsample(cases):
     agree, dmax, _ = run_oracle(cases, 2000)
     assert agree == 2000
