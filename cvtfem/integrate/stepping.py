@@ -164,11 +164,10 @@ class NativeEngine:
                 att.f0 = stepper.f(att.t0, att.x0)
             return hermite(att, att.f1, tq)
 
-        precise = None
-        if stepper.substep_dense and self.adaptive:
-            def precise(tq):
-                return stepper.solution_at(att, tq)
-        return Candidate(att.t0, att.x0, att.h, att.t0 + att.h, att.x1, att.f0, dense, att, precise)
+        def precise(tq):
+            return stepper.solution_at(att, tq)
+        exact = precise if stepper.substep_dense and self.adaptive else None
+        return Candidate(att.t0, att.x0, att.h, att.t0 + att.h, att.x1, att.f0, dense, att, exact)
 
     def commit(self, cand: Candidate) -> None:
         self.stepper.accept(cand.raw)
