@@ -117,7 +117,7 @@ def pin_mesh(half_length: float = 3.0e-3, half_height: float = 1.2e-3, face_radi
 def load_section_mesh(path: str | Path):  # noqa: ANN201
     """Read a section mesh with meshio (``triangle6`` -> MeshTri2, ``triangle`` -> MeshTri1)."""
     import meshio
-    from skfem import MeshTri1, MeshTri2
+    from skfem import MeshTri1
 
     path = Path(path)
     if not path.is_file():
